@@ -1,0 +1,20 @@
+"""roughpaths: level-2 geometric rough paths, signatures, Brownian lifts, norms and RDE solvers.
+
+Conventions are fixed once, in ``CONVENTIONS.md`` of the project: the area ``XX[i, j]`` is
+``∫ (X^i - X^i_s) dX^j`` (iisignature ordering), the Lévy area is ``½(XX - XXᵀ)``, and the
+Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
+"""
+
+from .level2 import level2_exp, level2_inv, level2_log, level2_mul
+from .rough_path import RoughPath, chen_defect
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "RoughPath",
+    "chen_defect",
+    "level2_mul",
+    "level2_inv",
+    "level2_exp",
+    "level2_log",
+]

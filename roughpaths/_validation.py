@@ -1,0 +1,139 @@
+"""Input checks shared by every public function (private).
+
+Every check raises a ``TypeError`` (wrong kind of object) or ``ValueError`` (wrong value) whose
+message names the argument, shows the offending value or shape, and says how to fix it.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+__all__ = [
+    "as_float_array",
+    "check_times",
+    "check_antisymmetric",
+    "check_rng",
+    "check_positive_int",
+    "check_same_batch",
+]
+
+
+def _describe(x) -> str:
+    if isinstance(x, np.ndarray):
+        return f"array of shape {x.shape} and dtype {x.dtype}"
+    text = repr(x)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
+                   last_dims: tuple | None = None, allow_nonfinite: bool = False) -> np.ndarray:
+    """Convert ``x`` to a float64 array and check its rank, trailing shape and finiteness.
+
+    Parameters
+    ----------
+    x : array_like
+        Real numbers (bool, integer or float); complex and object arrays are rejected.
+    name : str
+        The argument's name, used in error messages.
+    min_ndim, ndim : int, optional
+        Required minimum / exact number of axes.
+    last_dims : tuple of (int or None), optional
+        Required sizes of the trailing axes (``None`` leaves one free).
+    allow_nonfinite : bool
+        If false (default) NaN and inf raise ``ValueError``.
+    """
+    if isinstance(x, (str, bytes)) or x is None:
+        raise TypeError(f"{name} must be an array of real numbers, got {_describe(x)}; "
+                        f"pass a numpy array (or nested lists) of floats.")
+    try:
+        arr = np.asarray(x)
+    except Exception as exc:  # pragma: no cover - exotic inputs
+        raise TypeError(f"{name} could not be converted to an array ({exc}); "
+                        f"pass a numpy array of floats.") from None
+    if arr.dtype.kind == "c":
+        raise TypeError(f"{name} must be real, got a complex {_describe(arr)}; "
+                        f"pass its real part (np.real) if the imaginary part is zero.")
+    if arr.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must hold real numbers, got {_describe(arr)}; "
+                        f"convert it with np.asarray({name}, dtype=float).")
+    arr = np.asarray(arr, dtype=np.float64)
+    if ndim is not None and arr.ndim != ndim:
+        raise ValueError(f"{name} must have {ndim} axes, got shape {arr.shape}.")
+    if arr.ndim < min_ndim:
+        raise ValueError(f"{name} must have at least {min_ndim} axes, got shape {arr.shape}; "
+                         f"add the missing axes (e.g. {name}[None]).")
+    if last_dims is not None:
+        k = len(last_dims)
+        if arr.ndim < k:
+            raise ValueError(f"{name} must have at least {k} axes, got shape {arr.shape}.")
+        for want, got in zip(last_dims, arr.shape[arr.ndim - k:]):
+            if want is not None and want != got:
+                expect = "(..., " + ", ".join("*" if w is None else str(w) for w in last_dims) + ")"
+                raise ValueError(f"{name} must have trailing shape {expect}, got shape {arr.shape}.")
+    if not allow_nonfinite and arr.size and not np.all(np.isfinite(arr)):
+        bad = int(np.count_nonzero(~np.isfinite(arr)))
+        first = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
+        raise ValueError(f"{name} contains {bad} non-finite value(s) (NaN or inf), the first at "
+                         f"index {first}; remove or interpolate them before calling.")
+    return arr
+
+
+def check_times(times, name: str = "times", *, n: int | None = None) -> np.ndarray:
+    """Check a 1-D, finite, strictly increasing time grid (of length ``n`` if given)."""
+    t = as_float_array(times, name, ndim=1)
+    if n is not None and t.shape[0] != n:
+        raise ValueError(f"{name} must have {n} entries to match the data, got {t.shape[0]}.")
+    if t.shape[0] < 2:
+        raise ValueError(f"{name} needs at least 2 points, got {t.shape[0]}.")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        k = int(np.argmax(dt <= 0))
+        raise ValueError(f"{name} must be strictly increasing, but {name}[{k}]={t[k]!r} >= "
+                         f"{name}[{k + 1}]={t[k + 1]!r}; sort the grid and drop repeated times.")
+    return t
+
+
+def check_antisymmetric(s, name: str = "s", *, dim: int | None = None, atol: float = 1e-12) -> np.ndarray:
+    """Check that ``s`` (shape ``(..., d, d)``) is antisymmetric, to ``atol`` relative to its size."""
+    arr = as_float_array(s, name, min_ndim=2)
+    if arr.shape[-1] != arr.shape[-2]:
+        raise ValueError(f"{name} must be square in its last two axes, got shape {arr.shape}.")
+    if dim is not None and arr.shape[-1] != dim:
+        raise ValueError(f"{name} must be {dim}x{dim} to match the path dimension d={dim}, "
+                         f"got shape {arr.shape}.")
+    sym = 0.5 * (arr + np.swapaxes(arr, -1, -2))
+    scale = max(1.0, float(np.max(np.abs(arr))) if arr.size else 1.0)
+    err = float(np.max(np.abs(sym))) if sym.size else 0.0
+    if err > atol * scale:
+        raise ValueError(f"{name} must be antisymmetric ({name}.T == -{name}); its symmetric part has "
+                         f"size {err:.3g}. A symmetric perturbation of the area breaks geometricity; "
+                         f"pass 0.5 * ({name} - {name}.T) if you meant its antisymmetric part.")
+    return arr
+
+
+def check_rng(rng, name: str = "rng") -> np.random.Generator:
+    """Require an explicit ``numpy.random.Generator``."""
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError(f"{name} must be a numpy.random.Generator, got {_describe(rng)}; "
+                        f"pass {name}=numpy.random.default_rng(seed).")
+    return rng
+
+
+def check_positive_int(value, name: str, *, minimum: int = 1) -> int:
+    """Check an integer ``>= minimum`` (bools rejected)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {_describe(value)}.")
+    if value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}.")
+    return int(value)
+
+
+def check_same_batch(shape_a: tuple, shape_b: tuple, name_a: str, name_b: str) -> tuple:
+    """Broadcast two batch shapes, or raise naming both arguments."""
+    try:
+        return tuple(np.broadcast_shapes(tuple(shape_a), tuple(shape_b)))
+    except ValueError:
+        raise ValueError(f"batch shapes of {name_a} {tuple(shape_a)} and {name_b} {tuple(shape_b)} "
+                         f"do not broadcast; give them the same leading axes.") from None

@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Set up the environment (first run only) and run the test suite. Extra arguments go to pytest,
+# e.g. ./test.sh -m slow  (the long statistical runs), ./test.sh -x -q tests/test_chen_identity.py
+set -euo pipefail
+cd "$(dirname "$0")"
+PY="$(tools/setup_env.sh test | tail -n 1)"
+exec "$PY" -m pytest "$@"
