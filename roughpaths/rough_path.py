@@ -363,9 +363,12 @@ class RoughPath:
             raise IndexError("this rough path has no batch axes to index.")
         probe = np.empty(self.batch_shape, dtype=bool)[index]  # validates the index on batch axes
         del probe
-        inc = self._increments[index]
-        areas = None if self._areas is None else self._areas[index]
-        return RoughPath(inc, areas, times=self._times, x0=self._x0[index], kind=self._kind, check=False)
+        # explicit trailing slices keep the core axes (N, d[, d]) untouched, also for X[..., k]
+        idx = index if isinstance(index, tuple) else (index,)
+        inc = self._increments[idx + (slice(None),) * 2]
+        areas = None if self._areas is None else self._areas[idx + (slice(None),) * 3]
+        x0 = self._x0[idx + (slice(None),)]
+        return RoughPath(inc, areas, times=self._times, x0=x0, kind=self._kind, check=False)
 
     # ------------------------------------------------------------------ diagnostics
     def geometric_defect(self) -> np.ndarray:
