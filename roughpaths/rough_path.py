@@ -287,6 +287,10 @@ class RoughPath:
         """
         tt = check_times(times, "times")
         idx = self.index_of(tt, "times")
+        if np.any(np.diff(idx) <= 0):
+            k = int(np.argmax(np.diff(idx) <= 0))
+            raise ValueError(f"times[{k}]={tt[k]!r} and times[{k + 1}]={tt[k + 1]!r} are the same grid "
+                             f"point of this rough path (to the grid tolerance); drop one of them.")
         rel = self._relative_path()
         inc = rel[..., idx[1:], :] - rel[..., idx[:-1], :]
         x0 = self.path[..., idx[0], :]
