@@ -94,7 +94,13 @@ class RoughPath:
             z = np.zeros(inc.shape[:-2] + (d,))
         else:
             z = as_float_array(x0, "x0", last_dims=(d,)) if check else np.asarray(x0, dtype=np.float64)
-            z = np.broadcast_to(z, inc.shape[:-2] + (d,)) if check else z
+            if check:
+                try:
+                    z = np.broadcast_to(z, inc.shape[:-2] + (d,))
+                except ValueError:
+                    raise ValueError(f"x0 has shape {z.shape}, which does not broadcast to the batch "
+                                     f"shape of increments, {inc.shape[:-2] + (d,)}; give x0 shape "
+                                     f"(d,) or the increments' batch axes.") from None
         if kind is not None and kind not in _KINDS:
             raise ValueError(f"kind must be one of {_KINDS}, got {kind!r}.")
         if a is not None and check:
@@ -289,7 +295,7 @@ class RoughPath:
         idx = self.index_of(tt, "times")
         if np.any(np.diff(idx) <= 0):
             k = int(np.argmax(np.diff(idx) <= 0))
-            raise ValueError(f"times[{k}]={tt[k]!r} and times[{k + 1}]={tt[k + 1]!r} are the same grid "
+            raise ValueError(f"times[{k}]={float(tt[k])!r} and times[{k + 1}]={float(tt[k + 1])!r} are the same grid "
                              f"point of this rough path (to the grid tolerance); drop one of them.")
         rel = self._relative_path()
         inc = rel[..., idx[1:], :] - rel[..., idx[:-1], :]
