@@ -332,14 +332,17 @@ class RoughPath:
         r"""Time reversal :math:`u \mapsto X_{t_0 + t_N - u}`.
 
         Each step becomes its group inverse, :math:`(x, a) \mapsto (-x, -a + x\otimes x)`, in reversed
-        order; the new ``x0`` is the old end point. Geometric paths stay geometric.
+        order; the new ``x0`` is the old end point. Geometric paths stay geometric. An Itô path
+        becomes ``kind="general"``: its reversal has :math:`\mathrm{Sym}(\mathbb{X}) = \tfrac12 X\otimes X
+        + \tfrac12 (t - s) I`` (a backward-Itô area), not the Itô symmetric part.
         """
         t = self._times[0] + self._times[-1] - self._times[::-1]
         inc = -self._increments[..., ::-1, :]
         areas = None
         if self._areas is not None:
             areas = -self._areas[..., ::-1, :, :] + outer(inc, inc)
-        return RoughPath(inc, areas, times=t, x0=self.path[..., -1, :], kind=self._kind, check=False)
+        kind = "general" if self._kind == "ito" else self._kind
+        return RoughPath(inc, areas, times=t, x0=self.path[..., -1, :], kind=kind, check=False)
 
     def perturb(self, s) -> "RoughPath":
         r"""The path with area :math:`\mathbb{X}_{s,t} + \mathsf{s}\,(t - s)`.
