@@ -95,42 +95,56 @@ def _draw_axes_triad(ax, elev, azim):
         tri.text(1.35 * u + off, 1.35 * v + off, AXIS_LABELS[k], ha="center", va="center", fontsize=9)
 
 
-def plot_sphere_portrait(ax, hfun, *, elev, azim, levels=24, equilibria=(), title="", cmap="viridis",
-                         n=500):
+_EQ_STYLE = {
+    "minimum": dict(marker="o", mfc="tab:red", label="min of h̃ (centre; stable with dissipation)"),
+    "maximum": dict(marker="o", mfc="tab:blue", label="max of h̃ (centre; unstable with dissipation)"),
+    "saddle": dict(marker="X", mfc="white", label="saddle"),
+    "degenerate": dict(marker="s", mfc="tab:orange", label="degenerate"),
+}
+
+
+def plot_sphere_portrait(ax, hfun, *, elev, azim, curves=(), separatrix=(), equilibria=(), title="",
+                         cmap="viridis", n=500, contour_levels=None):
     """Phase portrait on the unit sphere seen from ``(elev, azim)``: level sets of ``hfun``.
 
-    The visible hemisphere is coloured by ``hfun`` with its level sets drawn as black lines (the
-    orbits of the rigid body, which lie on the intersections of energy levels with the sphere);
-    ``equilibria`` are ``(point (3,), kind)`` with kind in {"stable", "unstable", ...}: visible ones
-    are filled markers, hidden ones hollow. Returns the image artist (for a colour bar).
+    The visible hemisphere is coloured by ``hfun(Pi)``. ``curves``: the level sets, as a list (one
+    entry per level) of lists of polylines ``(m, 3)`` on the sphere (e.g. from
+    :func:`mechanics.equilibria.rigid_body_level_sets`); ``separatrix[k]`` marks a saddle level
+    (drawn thicker, in red). Without ``curves`` the image is contoured at ``contour_levels``.
+    ``equilibria``: ``(point (3,), kind)`` with kind in {"minimum", "maximum", "saddle", ...};
+    visible ones are filled markers, those on the hidden side hollow. Returns the image artist.
     """
     u, v, vals = sphere_image(hfun, elev, azim, n=n)
-    finite = vals[np.isfinite(vals)]
-    # levels from the values on the whole sphere, so that every view of the same function agrees
-    lev_vals = _whole_sphere_values(hfun)
-    lv = np.linspace(lev_vals.min(), lev_vals.max(), levels + 2)[1:-1] if np.isscalar(levels) else levels
-    im = ax.imshow(vals, origin="lower", extent=(-1, 1, -1, 1), cmap=cmap, alpha=0.9,
-                   vmin=lev_vals.min(), vmax=lev_vals.max(), interpolation="bilinear")
-    if finite.size:
+    whole = _whole_sphere_values(hfun)
+    im = ax.imshow(vals, origin="lower", extent=(-1, 1, -1, 1), cmap=cmap, alpha=0.85,
+                   vmin=whole.min(), vmax=whole.max(), interpolation="bilinear")
+    if len(curves):
+        for k, level_curves in enumerate(curves):
+            sep = bool(separatrix[k]) if len(separatrix) else False
+            for line in level_curves:
+                pu, pv, depth = project(np.asarray(line), elev, azim)
+                pu = np.where(depth >= -1e-9, pu, np.nan)
+                ax.plot(pu, pv, color="tab:red" if sep else "k", lw=1.6 if sep else 0.7, zorder=3)
+        ax.plot([], [], color="tab:red", lw=1.6, label="separatrix (saddle level)")
+    else:
+        lv = contour_levels if contour_levels is not None else np.linspace(whole.min(), whole.max(), 26)[1:-1]
         ax.contour(u, v, vals, levels=lv, colors="k", linewidths=0.7)
     t = np.linspace(0, 2 * np.pi, 400)
     ax.plot(np.cos(t), np.sin(t), color="k", lw=1.2)
-    styles = {"stable": dict(marker="o", color="tab:red"), "unstable": dict(marker="X", color="white"),
-              "saddle": dict(marker="X", color="white")}
     seen = set()
     for point, kind in equilibria:
         pu, pv, depth = project(point, elev, azim)
-        st = styles.get(kind, dict(marker="s", color="tab:orange"))
-        lab = f"{kind} equilibrium" if kind not in seen and depth > 0 else None
+        st = _EQ_STYLE.get(kind, _EQ_STYLE["degenerate"])
         if depth > 0:
+            ax.plot(pu, pv, ls="none", marker=st["marker"], ms=10, mfc=st["mfc"], mec="k", mew=1.2, zorder=6,
+                    label=None if kind in seen else st["label"])
             seen.add(kind)
-            ax.plot(pu, pv, ls="none", marker=st["marker"], ms=10, mfc=st["color"], mec="k", mew=1.2,
-                    label=lab, zorder=5)
         else:
-            ax.plot(pu, pv, ls="none", marker=st["marker"], ms=8, mfc="none", mec="0.45", mew=0.9, zorder=4)
+            ax.plot(pu, pv, ls="none", marker=st["marker"], ms=8, mfc="none", mec="0.35", mew=0.9, zorder=5)
+    ax.plot([], [], ls="none", marker="o", ms=8, mfc="none", mec="0.35", label="equilibrium on the hidden side")
     _draw_axes_triad(ax, elev, azim)
-    ax.set_xlim(-1.4, 1.4)
-    ax.set_ylim(-1.4, 1.4)
+    ax.set_xlim(-1.25, 1.25)
+    ax.set_ylim(-1.25, 1.25)
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
@@ -138,8 +152,7 @@ def plot_sphere_portrait(ax, hfun, *, elev, azim, levels=24, equilibria=(), titl
         sp.set_visible(False)
     if title:
         ax.set_title(title, fontsize=10)
-    if seen:
-        ax.legend(loc="upper right", fontsize=8, framealpha=0.8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.01), fontsize=7, ncol=2, framealpha=0.8)
     return im
 
 
@@ -262,3 +275,230 @@ def _save(ctx, name, fig, data: dict):
     plt.close(fig)
     np.savez_compressed(npz, **{k: np.asarray(v) for k, v in data.items()})
     return png, npz
+
+
+# =========================================================================================== the paper
+#: the paper's Section 4 parameters
+INERTIA = (1.0, 2.0, 3.0)
+SIGMA = 0.05
+THETA = 1.0
+PI0 = np.array([0.0, 0.0, 1.0])
+_RB = ("mechanics.rigid_body", "mechanics.integrators", "mechanics.gibbs", "mechanics.equilibria")
+
+
+def s_matrix(s12: float = 0.0, s13: float = 0.0, s23: float = 0.0) -> np.ndarray:
+    """The antisymmetric 3×3 ``s`` with the given upper-triangular entries."""
+    return np.array([[0.0, s12, s13], [-s12, 0.0, s23], [-s13, -s23, 0.0]])
+
+
+def s_label(s) -> str:
+    parts = [f"s$^{{{i + 1}{j + 1}}}$={s[i, j]:g}" for i, j in ((0, 1), (0, 2), (1, 2)) if s[i, j] != 0]
+    return ", ".join(parts) if parts else "s = 0"
+
+
+def _body(ctx, s=None, xi=None, sigma=SIGMA, theta=THETA, convention=None):
+    from mechanics.rigid_body import rigid_body
+
+    return rigid_body(INERTIA, xi=xi, sigma=None if xi is not None else sigma, s=s, theta=theta,
+                      convention=ctx.convention if convention is None else convention)
+
+
+def _simulate_long(ctx, body, rng, T, dt, label, save_every):
+    """One long Brownian trajectory from Π(0) = e3, in chunks (progress bar), constant memory."""
+    from mechanics.integrators import simulate_brownian
+
+    n_steps = int(round(T / dt))
+    n_chunks = max(1, min(50, n_steps // 10_000))
+    per = n_steps // n_chunks
+    per -= per % save_every
+    mu = PI0.copy()
+    states, done = [PI0[None, :]], 0
+    with ctx.progress.bar(label, n_steps) as bar:
+        while done < n_steps:
+            k = min(per, n_steps - done) if done + per < n_steps else n_steps - done
+            _, out = simulate_brownian(body, mu, dt, k, rng, n_paths=1, save_every=save_every)
+            states.append(out[0, 1:])
+            mu = out[0, -1]
+            done += k
+            bar.update(k)
+    traj = np.concatenate(states, axis=0)
+    times = np.arange(len(traj)) * dt * save_every
+    return times, traj
+
+
+def _gibbs(body, sigma=SIGMA, theta=THETA):
+    from mechanics.gibbs import GibbsMeasure
+
+    return GibbsMeasure(INERTIA, body.torque_velocity, sigma=sigma, theta=theta)
+
+
+def _conditional_mean(g, sign: float):
+    """Gibbs mean conditioned on the hemisphere sign(Π3) = sign (the basin a trajectory explores)."""
+    f = lambda P: np.concatenate([P * (np.sign(P[..., 2:3]) == sign), (np.sign(P[..., 2:3]) == sign)], -1)
+    e = g.expectation(f)
+    return e[:3] / e[3]
+
+
+def _extent(center, half=0.32):
+    cx, cy = center
+    return ((cx - half, cx + half), (cy - half, cy + half))
+
+
+@register("fig1", "Figure 1: the dissipative stochastic rigid body and its Gibbs measure (s = 0)",
+          "Simulation of the rough-path rigid body with θ = 1, σ = 0.05, 𝕀 = diag(1, 2, 3), Π(0) = (0, 0, 1) "
+          "(red dot), s = 0, on one long Stratonovich Brownian path (Lie–Heun coadjoint scheme with the step "
+          "Lévy areas). Left: the trajectory stays on the unit sphere (coloured by time). Right: time-density "
+          "of (Π₁, Π₂) after a burn-in, with the Gibbs prediction ∝ exp(−2θh̃/σ²) on the upper hemisphere "
+          "binned the same way (cyan contours at 10..90 % of its maximum).", requires=_RB)
+def fig1(ctx) -> FigureResult:
+    body = _body(ctx)
+    T = ctx.size("fig1.T", tiny=20.0, default=2_000.0, full=20_000.0)
+    dt = ctx.size("fig1.dt", tiny=0.01, default=0.005, full=0.001)
+    save = max(1, int(round(0.05 / dt)))
+    times, traj = _simulate_long(ctx, body, ctx.rng("fig1"), T, dt, "fig1: simulate", save)
+    g = _gibbs(body)
+    keep = times >= 0.1 * T
+    xy = traj[keep][:, :2]
+    mean_pred = _conditional_mean(g, 1.0)
+    fig = _new_figure(figsize=(12.5, 5.4))
+    ax3 = fig.add_subplot(1, 2, 1, projection="3d")
+    lc = plot_trajectory_3d(ax3, traj, start=PI0, times=times, title="trajectory on the sphere |Π| = 1")
+    cb = fig.colorbar(lc, ax=ax3, fraction=0.03, pad=0.08)
+    cb.set_label("time t")
+    ax3.view_init(elev=30, azim=-60)
+    ax = fig.add_subplot(1, 2, 2)
+    H, pred, edges = plot_density(
+        ax, fig, xy, bins=70, extent=_extent((0.0, 0.0)), density_fn=g.density, hemisphere=1.0, start=PI0[:2],
+        marks=[((mean_pred[0], mean_pred[1]), dict(marker="x", color="cyan", ms=9, mew=2), "Gibbs mean"),
+               ((xy[:, 0].mean(), xy[:, 1].mean()), dict(marker="+", color="lime", ms=11, mew=2), "time average")],
+        title="density of (Π₁, Π₂), t ≥ T/10")
+    fig.suptitle(f"Figure 1: θ = {THETA:g}, σ = {SIGMA:g}, 𝕀 = diag(1, 2, 3), s = 0, T = {T:g}, dt = {dt:g}",
+                 fontsize=11)
+    png, npz = _save(ctx, "fig1", fig, dict(times=times, trajectory=traj, histogram=H, gibbs_binned=pred,
+                                            x_edges=edges[0], y_edges=edges[1], gibbs_mean_upper=mean_pred,
+                                            dt=dt, T=T))
+    return FigureResult("fig1", FIGURES["fig1"].title, FIGURES["fig1"].caption, png, npz)
+
+
+FIG2_S = (s_matrix(s13=25.0), s_matrix(s23=25.0), s_matrix(s12=25.0), s_matrix(s12=-50.0, s13=25.0, s23=25.0))
+
+
+@register("fig2", "Figure 2: the Lévy area recentres the Gibbs measure (several s, one Brownian path)",
+          "Time-densities of (Π₁, Π₂) for the same Brownian realisation and four Lévy-area perturbations s "
+          "(θ = 1, σ = 0.05, 𝕀 = diag(1, 2, 3), Π(0) = (0, 0, 1), red dot). The Lévy torque c = ½ Σ s^{ij} ξ_i × ξ_j "
+          "(rp convention: c = σ²(s²³, −s¹³, s¹²)) shifts the minimum of h̃ = ½Π·𝕀⁻¹Π + c·Π; cyan contours: the "
+          "Gibbs density exp(−2θh̃/σ²) restricted to the hemisphere the trajectory explores, binned like the "
+          "data; ×: its mean; ◆: the stable equilibrium of the modified deterministic dynamics.", requires=_RB)
+def fig2(ctx) -> FigureResult:
+    T = ctx.size("fig2.T", tiny=20.0, default=1_000.0, full=20_000.0)
+    dt = ctx.size("fig2.dt", tiny=0.01, default=0.005, full=0.001)
+    save = max(1, int(round(0.05 / dt)))
+    fig = _new_figure(figsize=(12.5, 10.5))
+    data = {}
+    for k, s in enumerate(FIG2_S):
+        body = _body(ctx, s=s)
+        # the same seed for every panel: the same Brownian path (the paper's "identical realisation")
+        times, traj = _simulate_long(ctx, body, ctx.rng("fig2"), T, dt, f"fig2: {s_label(s)}".replace("$", ""), save)
+        g = _gibbs(body)
+        keep = times >= 0.1 * T
+        xy = traj[keep][:, :2]
+        hemi = 1.0 if traj[keep][:, 2].mean() >= 0 else -1.0
+        mean_pred = _conditional_mean(g, hemi)
+        stable = [e for e in g.equilibria if e.kind == "minimum" and np.sign(e.point[2]) == hemi]
+        eq = min(stable, key=lambda e: np.linalg.norm(e.point - PI0)).point if stable else mean_pred
+        ax = fig.add_subplot(2, 2, k + 1)
+        H, pred, edges = plot_density(
+            ax, fig, xy, bins=70, extent=_extent((round(eq[0], 1), round(eq[1], 1)), 0.36), density_fn=g.density,
+            hemisphere=hemi, start=PI0[:2],
+            marks=[((mean_pred[0], mean_pred[1]), dict(marker="x", color="cyan", ms=9, mew=2), "Gibbs mean"),
+                   ((xy[:, 0].mean(), xy[:, 1].mean()), dict(marker="+", color="lime", ms=11, mew=2), "time average"),
+                   ((eq[0], eq[1]), dict(marker="D", mfc="none", mec="white", ms=8, mew=1.5), "stable equilibrium")],
+            title=f"{s_label(s)}:  c = ({', '.join(f'{v:+.4g}' for v in body.torque_velocity)})")
+        data.update({f"s_{k}": s, f"trajectory_{k}": traj, f"histogram_{k}": H, f"gibbs_binned_{k}": pred,
+                     f"x_edges_{k}": edges[0], f"y_edges_{k}": edges[1], f"gibbs_mean_{k}": mean_pred,
+                     f"equilibrium_{k}": eq, f"c_{k}": body.torque_velocity})
+    data.update(times=times, dt=dt, T=T)
+    fig.suptitle(f"Figure 2: one Brownian path, four Lévy areas (convention '{ctx.convention}', T = {T:g}, "
+                 f"dt = {dt:g})", fontsize=11)
+    fig.tight_layout()
+    png, npz = _save(ctx, "fig2", fig, data)
+    return FigureResult("fig2", FIGURES["fig2"].title, FIGURES["fig2"].caption, png, npz)
+
+
+# ------------------------------------------------------------------------------- phase portraits
+def _portrait(ctx, name, s, views, title):
+    from mechanics.equilibria import rigid_body_level_sets
+
+    body = _body(ctx, s=s, theta=0.0)
+    c = body.torque_velocity
+    n_levels = ctx.size("portrait.levels", tiny=8, default=18, full=24)
+    ls = rigid_body_level_sets(INERTIA, c, levels=n_levels, include_separatrices=True)
+    eqs = [(e.point, e.kind) for e in ls.equilibria]
+    fig = _new_figure(figsize=(6.2 * len(views), 6.4))
+    im = None
+    for k, (elev, azim) in enumerate(views):
+        ax = fig.add_subplot(1, len(views), k + 1)
+        im = plot_sphere_portrait(ax, body.modified_hamiltonian, elev=elev, azim=azim, curves=ls.curves,
+                                  separatrix=ls.separatrix, equilibria=eqs,
+                                  title=f"view: elevation {elev}°, azimuth {azim}°")
+    cb = fig.colorbar(im, ax=fig.axes, fraction=0.03, pad=0.02)
+    cb.set_label(r"$\tilde h(\Pi) = \frac{1}{2}\Pi\cdot\mathbb{I}^{-1}\Pi + c\cdot\Pi$")
+    fig.suptitle(f"{title}\nc = ({', '.join(f'{v:+.4g}' for v in c)}), convention '{ctx.convention}'", fontsize=11)
+    data = dict(c=c, s=s, levels=ls.levels, separatrix=ls.separatrix,
+                equilibria=np.array([e.point for e in ls.equilibria]),
+                equilibrium_kinds=np.array([e.kind for e in ls.equilibria]),
+                equilibrium_energies=np.array([e.energy for e in ls.equilibria]), views=np.array(views))
+    for k, lev in enumerate(ls.curves):
+        for j, line in enumerate(lev):
+            data[f"curve_{k}_{j}"] = line
+    png, npz = _save(ctx, name, fig, data)
+    return FigureResult(name, FIGURES[name].title, FIGURES[name].caption, png, npz)
+
+
+_VIEW = (22, 35)
+_BACK = (22, 215)
+_PORTRAIT_CAP = ("Level sets of h̃ on the unit sphere |Π| = 1 (the orbits of the conservative rigid body, "
+                 "𝕀 = diag(1, 2, 3)), coloured by h̃, separatrices (levels of the saddles) in red, equilibria "
+                 "computed from h̃ (red: minima, blue: maxima, white crosses: saddles; hollow: hidden side). ")
+
+
+@register("surf", "Figure surf: phase portrait of the rigid body, h (no Lévy shift)",
+          _PORTRAIT_CAP + "Unshifted Hamiltonian h = ½Π·𝕀⁻¹Π: centres at ±e1, ±e3, saddles at ±e2 joined by four "
+          "heteroclinic orbits.", requires=("mechanics.rigid_body", "mechanics.equilibria"))
+def surf(ctx):
+    return _portrait(ctx, "surf", s_matrix(), [_VIEW], "Figure surf: level sets of h on the momentum sphere")
+
+
+@register("surf2", "Figure surf2: phase portrait with the Lévy shift of s¹³ = 25 (σ = 0.05)",
+          _PORTRAIT_CAP + "Isotropic noise σ = 0.05 and s¹³ = −s³¹ = 25: in the rp convention c = (0, −0.0625, 0) "
+          "(the paper's printed sign gives +0.0625 Π₂; --convention paper draws that one). The reflection "
+          "symmetry is broken; pairs of homoclinic orbits (figures of eight) form around the Π₂ poles.",
+          requires=("mechanics.rigid_body", "mechanics.equilibria"))
+def surf2(ctx):
+    return _portrait(ctx, "surf2", s_matrix(s13=25.0), [_VIEW],
+                     "Figure surf2: level sets of h̃, s¹³ = 25, σ = 0.05")
+
+
+@register("surf3", "Figure surf3: the shifted phase portrait of surf2 seen from the opposite side",
+          _PORTRAIT_CAP + "Same h̃ as surf2, seen from the opposite side of the sphere: the second figure-of-eight "
+          "pair of homoclinic orbits is rotated by π/2.", requires=("mechanics.rigid_body", "mechanics.equilibria"))
+def surf3(ctx):
+    return _portrait(ctx, "surf3", s_matrix(s13=25.0), [_BACK],
+                     "Figure surf3: level sets of h̃, s¹³ = 25, opposite side")
+
+
+@register("surf4", "Figures surf4 and surf5: anisotropic Lévy shift s¹² = −50, s¹³ = 25, s²³ = 25 (view 1)",
+          _PORTRAIT_CAP + "σ = 0.05, s¹² = −50, s¹³ = 25, s²³ = 25: c = (0.0625, −0.0625, −0.125) in the rp "
+          "convention; all fixed points move and no discrete symmetry is left.",
+          requires=("mechanics.rigid_body", "mechanics.equilibria"))
+def surf4(ctx):
+    return _portrait(ctx, "surf4", s_matrix(s12=-50.0, s13=25.0, s23=25.0), [_VIEW],
+                     "Figure surf4: level sets of h̃, s¹² = −50, s¹³ = s²³ = 25")
+
+
+@register("surf5", "Figure surf5: anisotropic Lévy shift s¹² = −50, s¹³ = 25, s²³ = 25 (view 2)",
+          _PORTRAIT_CAP + "Same h̃ as surf4 seen from the opposite side.",
+          requires=("mechanics.rigid_body", "mechanics.equilibria"))
+def surf5(ctx):
+    return _portrait(ctx, "surf5", s_matrix(s12=-50.0, s13=25.0, s23=25.0), [_BACK],
+                     "Figure surf5: level sets of h̃, s¹² = −50, s¹³ = s²³ = 25, opposite side")
