@@ -79,6 +79,7 @@ __all__ = [
     "expected_area_rate",
     "sample_coloured_noise",
     "coloured_noise_limit_path",
+    "iter_coloured_noise",
 ]
 
 # Hermite Lévy-area coefficients (see module docstring).
@@ -387,8 +388,8 @@ def lift_area_rate(A, D, substep, *, hermite: bool = True):
 # ------------------------------------------------------------------------------ numba kernel
 @numba.njit(cache=True)
 def _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc, area, ygrid, binc, barea):  # pragma: no cover
-    """Advance ``y`` (P, n) over S coarse steps of ``msub`` sub-steps each (z: (S, msub, P, n+m))."""
-    S, msub, P, k = z.shape
+    """Advance ``y`` (P, n) over S coarse steps of ``msub`` sub-steps each (z: (P, S, msub, n+m))."""
+    P, S, msub, k = z.shape
     n = y.shape[1]
     m = k - n
     w = np.empty(k)
@@ -415,7 +416,7 @@ def _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc, area, ygrid, binc, b
                 for i in range(k):
                     acc = 0.0
                     for j in range(k):
-                        acc += L[i, j] * z[s, q, p, j]
+                        acc += L[i, j] * z[p, s, q, j]
                     w[i] = acc
                 for i in range(n):
                     acc = w[i]
@@ -459,6 +460,11 @@ def _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc, area, ygrid, binc, b
                 binc[p, s, i] = BX[i]
         for i in range(n):
             y[p, i] = y0[i]
+
+
+def _path_major(z):
+    """Normals are drawn time-major (chunk-independent stream); the kernel reads them path-major."""
+    return np.ascontiguousarray(z.transpose(2, 0, 1, 3))
 
 
 # ------------------------------------------------------------------------------- sampler
@@ -591,7 +597,7 @@ def sample_coloured_noise(A, D, eps, times, *, rng, batch_shape=(), y0="stationa
             cache[key] = _substep_factor(A, D, h / (msub * eps ** 2))
         Phi, L = cache[key]
         delta = h / (msub * eps ** 2)
-        z = rng.standard_normal((hi - lo, msub, P, n + m))
+        z = _path_major(rng.standard_normal((hi - lo, msub, P, n + m)))
         _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc[:, lo:hi], area[:, lo:hi], ygrid[:, lo:hi],
                         binc[:, lo:hi], barea[:, lo:hi])
     yall = np.concatenate([ystart[:, None, :], ygrid], axis=1)
@@ -634,3 +640,72 @@ def coloured_noise_limit_path(limit, brownian: RoughPath) -> RoughPath:
     area = M @ brownian.areas @ M.T
     base = RoughPath(inc, area, times=brownian.times, x0=brownian.x0 @ M.T, kind=brownian.kind, check=False)
     return base.perturb(limit.levy_perturbation)
+
+
+def iter_coloured_noise(A, D, eps, h, n_steps, *, rng, n_paths=1, y0="stationary", substeps=None,
+                        max_substep: float = 0.5, chunk_steps=None):
+    r"""Stream the lift of ``B^ε`` (and of ``B``) in time chunks, in constant memory.
+
+    Same law, sub-stepping and area construction as :func:`sample_coloured_noise` on the uniform
+    grid ``h·(0, …, n_steps)``; random numbers are drawn in time-major order, so the output does
+    not depend on ``chunk_steps`` (and equals :func:`sample_coloured_noise` with the same seed).
+
+    Parameters
+    ----------
+    A, D, eps : as in :func:`sample_coloured_noise`
+    h : float
+        Grid step.
+    n_steps : int
+    rng : numpy.random.Generator
+    n_paths : int
+    y0 : "stationary" or array_like ``(n_paths, n)`` / ``(n,)``
+    substeps, max_substep : as in :func:`sample_coloured_noise`
+    chunk_steps : int, optional
+        Grid steps per chunk (default: about 2·10⁶ random numbers per chunk).
+
+    Yields
+    ------
+    inc : ndarray ``(n_paths, S, n)``
+        Increments of ``B^ε``.
+    area : ndarray ``(n_paths, S, n, n)``
+        Step areas of ``B^ε`` (geometric).
+    b_inc, b_area : ndarrays ``(n_paths, S, m)``, ``(n_paths, S, m, m)``
+        The coupled Brownian ``B`` and its piecewise-linear (sub-step Chen) areas.
+    y : ndarray ``(n_paths, S, n)``
+        ``y`` at the end of each step.
+    """
+    A, D = _check_AD(A, D)
+    eps = _check_eps(eps)
+    rng = check_rng(rng)
+    h = float(h)
+    if not math.isfinite(h) or h <= 0:
+        raise ValueError(f"h must be a finite step > 0, got {h!r}.")
+    n_steps = check_positive_int(n_steps, "n_steps")
+    P = check_positive_int(n_paths, "n_paths")
+    lim = coloured_noise_limit(A, D)
+    n, m = D.shape
+    if isinstance(y0, str):
+        if y0 != "stationary":
+            raise ValueError(f"y0 must be 'stationary' or an array of shape (n_paths, {n}), got {y0!r}.")
+        y = rng.standard_normal((P, n)) @ np.linalg.cholesky(lim.Sigma).T
+    else:
+        y = np.array(np.broadcast_to(as_float_array(y0, "y0", last_dims=(n,)), (P, n)))
+    msub = _resolve_substeps(A, eps, h, substeps, max_substep)
+    Phi, L = _substep_factor(A, D, h / (msub * eps ** 2))
+    delta = h / (msub * eps ** 2)
+    Ainv = np.linalg.inv(A)
+    if chunk_steps is None:
+        chunk_steps = max(1, int(2_000_000 // (P * msub * (n + m))))
+    chunk_steps = check_positive_int(chunk_steps, "chunk_steps")
+    done = 0
+    while done < n_steps:
+        S = min(chunk_steps, n_steps - done)
+        z = _path_major(rng.standard_normal((S, msub, P, n + m)))
+        inc = np.empty((P, S, n))
+        area = np.empty((P, S, n, n))
+        yg = np.empty((P, S, n))
+        binc = np.empty((P, S, m))
+        barea = np.empty((P, S, m, m))
+        _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc, area, yg, binc, barea)
+        done += S
+        yield inc, area, binc, barea, yg

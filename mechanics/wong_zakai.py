@@ -1,0 +1,541 @@
+r"""The Wong–Zakai anomaly: mechanics driven by coloured noise and its white-noise limit.
+
+Rigid body (paper eq. (srbcoloured), **no added drift**): with :math:`\Omega = \mathbb I^{-1}\Pi`,
+
+.. math::
+
+    d\Pi = \Pi\times\Omega\,dt + \vartheta\,\Pi\times(\Pi\times\Omega)\,dt
+          + \sum_i \Pi\times\xi_i\, dB^{\varepsilon,i}, \qquad \xi_i = \sigma e_i,
+
+driven by the (smooth) coloured noise ``B^ε = ∫ y/ε dt`` of :mod:`roughpaths.coloured_noise`.
+
+Limit (Friz–Oberhauser, ``CONVENTIONS.md``). ``B^ε`` converges as a rough path to
+``(MB, M BB^{Strat} Mᵀ + N(t−s))`` with ``M = A⁻¹D`` and ``N = Alt(ΣA⁻ᵀ)`` (**B^ε coordinates**).
+Driving the fields :math:`V_i(\Pi) = \Pi\times\xi_i` by ``MB`` is driving the fields
+:math:`\Pi\times\xi'_k` by ``B`` with ``ξ'_k = Σ_i M_{ik} ξ_i = σ M[:, k]`` (the columns of ``σA⁻¹D``);
+the perturbation ``N`` adds the drift :math:`\tfrac12\sum_{ij}N^{ij}[V_i,V_j](\Pi) = \Pi\times c` with
+
+.. math:: c = \tfrac12\sum_{i,j} N^{ij}\,\xi_i\times\xi_j = \sigma^2 (N_{23}, -N_{13}, N_{12})
+
+(the Lévy torque, built from the *original* ``ξ_i = σe_i`` because ``N`` lives in B^ε coordinates;
+equivalently ``s_B = M⁻¹NM⁻ᵀ`` paired with the ``ξ'_k``). The limit is therefore
+
+.. math::
+
+    d\Pi = \Pi\times(\Omega + c)\,dt + \vartheta\,\Pi\times(\Pi\times\Omega)\,dt
+          + \sum_k \Pi\times\xi'_k\circ dB^k :
+
+the torque enters the conservative part only. The dissipation of (srbcoloured) is built from
+``h``, not ``h̃``, and Friz–Oberhauser does not touch the drift ``V_0``, so the limit is *not* the
+paper's (srblevy) (whose dissipation uses ``h̃``) — :func:`rigid_body_wong_zakai_limit` exposes both
+(``dissipation_shift``) and the tests tell them apart.
+
+Planar example (paper eq. (2dexample)): ``dx = Qx dt + P(x) y/ε dt`` with ``A = αI + γJ``,
+``D = √δ I``. Fields ``V_1 = (0, x_1)``, ``V_2 = (x_2, 0)`` (columns of ``P``), ``[V_1, V_2] = Sx``,
+``S = diag(1, −1)``. ``M = A⁻¹D = √(δ/(α²+γ²)) R`` with ``R = (αI − γJ)/√(α²+γ²)`` a rotation, so
+``MB = √(δ/(α²+γ²)) W`` with ``W = RB`` a Brownian motion (the paper's scaling is right) and the limit
+is ``dX = (Q + N_{12}S)X dt + √(δ/(α²+γ²)) P(X)∘dW`` with ``N_{12} = δγ/(2α(α²+γ²))``.
+
+Integrators. Both systems are integrated with a Casimir-preserving Strang splitting on the
+coadjoint orbit: half a drift step (Lie midpoint), the exact noise rotation by the step's level-2
+log-signature ``η = Σ ξ_i X^i + ½ Σ L^{ij} ξ_i×ξ_j`` (``L`` the step Lévy area), half a drift step.
+Each grid step of the coloured driver carries the exact Chen-summed area of ``B^ε``, so steps of
+order ``ε²`` suffice (the paper used steps far below ``ε²``); see ``benchmarks/bench_coloured_paper_scale.py``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+import scipy.linalg as sla
+
+from roughpaths._validation import as_float_array, check_positive_int, check_rng
+from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
+from roughpaths.rough_path import RoughPath
+
+__all__ = [
+    "levy_torque",
+    "RigidBodyWongZakai",
+    "rigid_body_wong_zakai_limit",
+    "integrate_rigid_body",
+    "simulate_wong_zakai_rigid_body",
+    "PlanarExample",
+    "planar_example",
+    "planar_limit_moments",
+    "simulate_planar_coloured",
+]
+
+
+def levy_torque(s, xi) -> np.ndarray:
+    r"""Lévy torque :math:`c = \tfrac12\sum_{i,j}s^{ij}\,\xi_i\times\xi_j` (rough-path sign), shape ``(3,)``.
+
+    Parameters
+    ----------
+    s : array_like ``(m, m)``, antisymmetric perturbation in the coordinates of the driver of ``ξ``.
+    xi : array_like ``(m, 3)``, noise vectors (rows).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 1.0, -1.0
+    >>> levy_torque(s, 2.0 * np.eye(3))      # σ² (s23, -s13, s12)
+    array([ 0., -4.,  0.])
+    """
+    s = as_float_array(s, "s", ndim=2)
+    xi = as_float_array(xi, "xi", ndim=2, last_dims=(s.shape[0], 3))
+    if s.shape[0] != s.shape[1]:
+        raise ValueError(f"s must be square, got shape {s.shape}.")
+    cr = np.cross(xi[:, None, :], xi[None, :, :])
+    return 0.5 * np.einsum("ij,ijk->k", s, cr)
+
+
+@dataclass(frozen=True)
+class RigidBodyWongZakai:
+    r"""Coloured rigid body (srbcoloured) and its white-noise limit.
+
+    Attributes
+    ----------
+    limit : ColouredNoiseLimit
+        ``Σ``, ``M = A⁻¹D``, ``N`` (B^ε coordinates).
+    sigma : float
+    coloured_xi : ndarray ``(n, 3)``
+        ``σ e_i``: noise vectors of the coloured system (driven by ``B^ε``; here ``n = 3``).
+    limit_xi : ndarray ``(m, 3)``
+        ``σ M[:, k]`` (rows): noise vectors of the limit, driven by the Brownian ``B``.
+    torque : ndarray ``(3,)``
+        ``c = ½ Σ N^{ij} ξ_i×ξ_j`` with ``ξ_i = σe_i``.
+    perturbation_B : ndarray ``(m, m)`` or None
+        ``M⁻¹ N M⁻ᵀ`` (``M`` square invertible): the same perturbation in ``B`` coordinates, i.e.
+        ``levy_torque(perturbation_B, limit_xi) == torque``.
+    """
+
+    limit: ColouredNoiseLimit
+    sigma: float
+    coloured_xi: np.ndarray
+    limit_xi: np.ndarray
+    torque: np.ndarray
+    perturbation_B: np.ndarray | None
+
+
+def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
+    r"""Noise vectors and Lévy torque of the white-noise limit of the coloured rigid body.
+
+    Parameters
+    ----------
+    A : array_like ``(3, 3)``
+    D : array_like ``(3, m)``
+    sigma : float
+        Noise amplitude of (srbcoloured): ``ξ_i = σ e_i``.
+
+    Examples
+    --------
+    The paper's case ``A = kI + Λ`` (``Λ13 = 1``), ``k = 0.05``, ``σ = 0.05``:
+
+    >>> from roughpaths.coloured_noise import paper_coloured_noise_matrices
+    >>> wz = rigid_body_wong_zakai_limit(*paper_coloured_noise_matrices(0.05), 0.05)
+    >>> wz.torque.round(6)                       # σ² (N23, -N13, N12)
+    array([ 0.      , -0.024938,  0.      ])
+    >>> wz.limit_xi.round(4)[1]                  # σ A⁻¹D e_2 = σ/k e_2
+    array([0., 1., 0.])
+    """
+    lim = coloured_noise_limit(A, D)
+    if lim.A.shape[0] != 3:
+        raise ValueError(f"the rigid body needs 3-dimensional coloured noise (A of shape (3, 3)), got "
+                         f"A of shape {lim.A.shape}.")
+    sg = float(sigma)
+    if not math.isfinite(sg) or sg < 0:
+        raise ValueError(f"sigma must be a finite number >= 0, got {sigma!r}.")
+    cxi = sg * np.eye(3)
+    lxi = (sg * lim.scaling).T.copy()
+    c = levy_torque(lim.levy_perturbation, cxi)
+    M = lim.scaling
+    sB = None
+    if M.shape[0] == M.shape[1] and np.linalg.cond(M) < 1e12:
+        Mi = np.linalg.inv(M)
+        sB = Mi @ lim.levy_perturbation @ Mi.T
+        sB = 0.5 * (sB - sB.T)
+    return RigidBodyWongZakai(limit=lim, sigma=sg, coloured_xi=cxi, limit_xi=lxi, torque=c, perturbation_B=sB)
+
+
+# ------------------------------------------------------------------------------------ kernels
+@numba.njit(cache=True, inline="always")
+def _rot(s0, s1, s2, m0, m1, m2):  # pragma: no cover
+    # m × s flow: exp(-[s]×) m = m - a s×m + b s×(s×m)
+    t2 = s0 * s0 + s1 * s1 + s2 * s2
+    if t2 < 1e-8:
+        a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
+        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+    else:
+        t = math.sqrt(t2)
+        a = math.sin(t) / t
+        hh = math.sin(0.5 * t)
+        b = 2.0 * hh * hh / t2
+    c0 = s1 * m2 - s2 * m1
+    c1 = s2 * m0 - s0 * m2
+    c2 = s0 * m1 - s1 * m0
+    d0 = s1 * c2 - s2 * c1
+    d1 = s2 * c0 - s0 * c2
+    d2 = s0 * c1 - s1 * c0
+    return m0 - a * c0 + b * d0, m1 - a * c1 + b * d1, m2 - a * c2 + b * d2
+
+
+@numba.njit(cache=True, inline="always")
+def _cay(s0, s1, s2, m0, m1, m2):  # pragma: no cover
+    # Cayley approximation of exp(-[s]×) m (orthogonal: |m| exact, error O(|s|³))
+    k0, k1, k2 = 0.5 * s0, 0.5 * s1, 0.5 * s2
+    f = 2.0 / (1.0 + k0 * k0 + k1 * k1 + k2 * k2)
+    c0 = k1 * m2 - k2 * m1
+    c1 = k2 * m0 - k0 * m2
+    c2 = k0 * m1 - k1 * m0
+    d0 = k1 * c2 - k2 * c1
+    d1 = k2 * c0 - k0 * c2
+    d2 = k0 * c1 - k1 * c0
+    return m0 + f * (d0 - c0), m1 + f * (d1 - c1), m2 + f * (d2 - c2)
+
+
+@numba.njit(cache=True, inline="always")
+def _wdrift(iinv, cc, cd, theta, m0, m1, m2):  # pragma: no cover
+    # rotation velocity of Π×(IΠ + cc) + θ Π×(Π×(IΠ + cd)) = Π × w
+    g0 = iinv[0] * m0 + cd[0]
+    g1 = iinv[1] * m1 + cd[1]
+    g2 = iinv[2] * m2 + cd[2]
+    v0 = m1 * g2 - m2 * g1
+    v1 = m2 * g0 - m0 * g2
+    v2 = m0 * g1 - m1 * g0
+    return (iinv[0] * m0 + cc[0] + theta * v0, iinv[1] * m1 + cc[1] + theta * v1,
+            iinv[2] * m2 + cc[2] + theta * v2)
+
+
+@numba.njit(cache=True)
+def _rb_kernel(Pi, inc, area, dts, iinv, xi, cc, cd, theta, save_every, k0, out, osave):  # pragma: no cover
+    """Strang step: half drift (Lie midpoint, Cayley map), noise rotation by η (exact, Rodrigues), half drift."""
+    P, S, m = inc.shape
+    xx = np.zeros((m, m, 3))
+    for i in range(m):
+        for j in range(m):
+            xx[i, j, 0] = xi[i, 1] * xi[j, 2] - xi[i, 2] * xi[j, 1]
+            xx[i, j, 1] = xi[i, 2] * xi[j, 0] - xi[i, 0] * xi[j, 2]
+            xx[i, j, 2] = xi[i, 0] * xi[j, 1] - xi[i, 1] * xi[j, 0]
+    for p in range(P):
+        m0, m1, m2 = Pi[p, 0], Pi[p, 1], Pi[p, 2]
+        for s in range(S):
+            hh = 0.5 * dts[s]
+            for half in range(2):
+                if half == 1:
+                    # noise rotation by the level-2 log-signature
+                    e0 = 0.0
+                    e1 = 0.0
+                    e2 = 0.0
+                    for i in range(m):
+                        x = inc[p, s, i]
+                        e0 += xi[i, 0] * x
+                        e1 += xi[i, 1] * x
+                        e2 += xi[i, 2] * x
+                        for j in range(m):
+                            lv = 0.25 * (area[p, s, i, j] - area[p, s, j, i])  # ½ · Lévy area
+                            e0 += lv * xx[i, j, 0]
+                            e1 += lv * xx[i, j, 1]
+                            e2 += lv * xx[i, j, 2]
+                    m0, m1, m2 = _rot(e0, e1, e2, m0, m1, m2)
+                w0, w1, w2 = _wdrift(iinv, cc, cd, theta, m0, m1, m2)
+                q0, q1, q2 = _cay(0.5 * hh * w0, 0.5 * hh * w1, 0.5 * hh * w2, m0, m1, m2)
+                w0, w1, w2 = _wdrift(iinv, cc, cd, theta, q0, q1, q2)
+                m0, m1, m2 = _cay(hh * w0, hh * w1, hh * w2, m0, m1, m2)
+            k = k0 + s + 1
+            if k % save_every == 0:
+                j = k // save_every - osave
+                if j >= 0 and j < out.shape[1]:
+                    out[p, j, 0] = m0
+                    out[p, j, 1] = m1
+                    out[p, j, 2] = m2
+        Pi[p, 0], Pi[p, 1], Pi[p, 2] = m0, m1, m2
+
+
+def _inertia_inverse(inertia):
+    I = as_float_array(inertia, "inertia")
+    if I.shape == (3, 3):
+        if np.max(np.abs(I - np.diag(np.diag(I)))) > 0:
+            raise ValueError("inertia must be diagonal (principal axes) here; rotate the body frame first.")
+        I = np.diag(I)
+    if I.shape != (3,) or np.any(I <= 0):
+        raise ValueError(f"inertia must be 3 positive principal moments, got {np.asarray(inertia)!r}.")
+    return 1.0 / I
+
+
+def _vec3(v, name):
+    if v is None:
+        return np.zeros(3)
+    return as_float_array(v, name, ndim=1, last_dims=(3,))
+
+
+def integrate_rigid_body(driver: RoughPath, Pi0, inertia, xi, theta=0.0, *, torque=None, dissipation_shift=None,
+                         save_every: int = 1):
+    r"""Integrate ``dΠ = Π×(Ω + c)dt + θΠ×(Π×(Ω + c_d))dt + Σ Π×ξ_i dX^i`` on a level-2 rough path.
+
+    Casimir-preserving Strang splitting (module docstring) using the increments and Lévy areas of
+    ``driver``; |Π| is conserved to round-off. With ``torque = dissipation_shift = c`` this is the
+    rough-path-correct (srblevy) model; with ``dissipation_shift = 0`` it is the limit of (srbcoloured).
+
+    Parameters
+    ----------
+    driver : RoughPath
+        Level-2 geometric path, dimension ``m``, batch ``(...)``.
+    Pi0 : array_like ``(3,)`` or ``(..., 3)``
+    inertia : array_like ``(3,)`` principal moments
+    xi : array_like ``(m, 3)``
+    theta : float
+    torque, dissipation_shift : array_like ``(3,)``, optional
+        ``c`` in the conservative and ``c_d`` in the dissipative term (default 0).
+    save_every : int
+
+    Returns
+    -------
+    times : ndarray ``(K,)``
+    states : ndarray ``(..., K, 3)``
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from roughpaths import RoughPath
+    >>> X = RoughPath.from_path(np.zeros((11, 3)), times=np.linspace(0, 1, 11))
+    >>> t, Pi = integrate_rigid_body(X, [0.0, 0.0, 1.0], [1.0, 2.0, 3.0], np.eye(3), 1.0)
+    >>> Pi[..., -1, :]                      # e3 is an equilibrium
+    array([0., 0., 1.])
+    """
+    if not isinstance(driver, RoughPath) or driver.level != 2:
+        raise TypeError("driver must be a level-2 roughpaths.RoughPath (its step Lévy areas are used).")
+    xi = as_float_array(xi, "xi", ndim=2, last_dims=(driver.dim, 3))
+    iinv = _inertia_inverse(inertia)
+    save_every = check_positive_int(save_every, "save_every")
+    batch = driver.batch_shape
+    P0 = as_float_array(Pi0, "Pi0", last_dims=(3,))
+    Pi = np.array(np.broadcast_to(P0, batch + (3,)).reshape(-1, 3))
+    P = Pi.shape[0]
+    N, m = driver.n_steps, driver.dim
+    inc = driver.increments.reshape(P, N, m)
+    area = driver.areas.reshape(P, N, m, m)
+    K = N // save_every + 1
+    out = np.empty((P, K, 3))
+    out[:, 0] = Pi
+    _rb_kernel(Pi, np.ascontiguousarray(inc), np.ascontiguousarray(area), driver.dt, iinv, xi,
+               _vec3(torque, "torque"), _vec3(dissipation_shift, "dissipation_shift"), float(theta),
+               save_every, 0, out, 0)
+    return driver.times[::save_every][:K], out.reshape(batch + (K, 3))
+
+
+def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0), theta=1.0, Pi0=(0.0, 0.0, 1.0),
+                                   T=1.0, h=None, n_paths=1, rng, substeps=None, save_every=1,
+                                   systems=("coloured", "limit", "no_torque"), chunk_steps=None):
+    r"""Coloured rigid body (srbcoloured) and its limits, coupled through the same Brownian motion.
+
+    Streams the exact coloured noise (:func:`roughpaths.coloured_noise.iter_coloured_noise`) in time
+    chunks (constant memory) and integrates, on the same draws:
+
+    * ``"coloured"``: (srbcoloured), ``ξ_i = σe_i`` driven by the level-2 lift of ``B^ε``;
+    * ``"limit"``: the white-noise limit, ``ξ'_k = σ(A⁻¹D)[:, k]`` driven by ``B`` with the Lévy torque
+      ``c`` in the conservative part only (exact limit);
+    * ``"no_torque"``: the same without the torque (plain Stratonovich Wong–Zakai guess);
+    * ``"srblevy"``: torque in both parts (dissipation from ``h̃``, the paper's (srblevy) model).
+
+    The limit systems use ``B``'s piecewise-linear lift over the sub-steps (its Lévy area is the
+    conditional expectation given the sub-step increments).
+
+    Parameters
+    ----------
+    A, D : array_like ``(3, 3)``, ``(3, m)``
+    eps, sigma : float
+    inertia, theta, Pi0 : rigid body data (``Pi0`` shape ``(3,)``)
+    T : float
+        Final time.
+    h : float, optional
+        Grid step (default ``ε²/(2‖A‖₂)``: the Chen-summed area makes steps of order ``ε²`` enough).
+    n_paths : int
+    rng : numpy.random.Generator
+    substeps : int, optional
+        Exact OU sub-steps per grid step (default: resolve ``ε²/‖A‖`` to ``0.5``).
+    save_every : int
+    systems : tuple of str
+    chunk_steps : int, optional
+
+    Returns
+    -------
+    dict
+        ``"times"`` ``(K,)``, ``"h"``, ``"n_steps"``, per system the saved states ``(n_paths, K, 3)``,
+        and ``"final"``: per system the states at ``T``, ``(n_paths, 3)``.
+    """
+    wz = rigid_body_wong_zakai_limit(A, D, sigma)
+    rng = check_rng(rng)
+    known = ("coloured", "limit", "no_torque", "srblevy")
+    for name in systems:
+        if name not in known:
+            raise ValueError(f"unknown system {name!r}; choose from {known}.")
+    nrm = float(np.linalg.norm(wz.limit.A, 2))
+    if h is None:
+        h = eps ** 2 / (2.0 * nrm)
+    n_steps = max(1, int(round(T / h)))
+    h = T / n_steps
+    save_every = check_positive_int(save_every, "save_every")
+    n_paths = check_positive_int(n_paths, "n_paths")
+    iinv = _inertia_inverse(inertia)
+    P0 = as_float_array(Pi0, "Pi0", ndim=1, last_dims=(3,))
+    K = n_steps // save_every + 1
+    zero = np.zeros(3)
+    cfg = {
+        "coloured": (wz.coloured_xi, zero, zero, False),
+        "limit": (wz.limit_xi, wz.torque, zero, True),
+        "no_torque": (wz.limit_xi, zero, zero, True),
+        "srblevy": (wz.limit_xi, wz.torque, wz.torque, True),
+    }
+    state = {k: np.tile(P0, (n_paths, 1)) for k in systems}
+    out = {k: np.empty((n_paths, K, 3)) for k in systems}
+    for k in systems:
+        out[k][:, 0] = P0
+    done = 0
+    for inc, area, binc, barea, _ in iter_coloured_noise(wz.limit.A, wz.limit.D, eps, h, n_steps, rng=rng,
+                                                         n_paths=n_paths, substeps=substeps,
+                                                         chunk_steps=chunk_steps):
+        S = inc.shape[1]
+        dts = np.full(S, h)
+        for k in systems:
+            xi, cc, cd, use_b = cfg[k]
+            _rb_kernel(state[k], binc if use_b else inc, barea if use_b else area, dts, iinv, xi, cc, cd,
+                       float(theta), save_every, done, out[k], 0)
+        done += S
+    res = {"times": np.arange(K) * h * save_every, "h": h, "n_steps": n_steps}
+    res.update(out)
+    res["final"] = state
+    return res
+
+
+# -------------------------------------------------------------------------------- planar example
+@dataclass(frozen=True)
+class PlanarExample:
+    r"""The paper's planar example (2dexample) and its homogenised limit.
+
+    Attributes
+    ----------
+    alpha, gamma, delta, lam, mu : float
+    A, D : ndarray ``(2, 2)``
+        ``αI + γJ`` (``J = [[0, 1], [−1, 0]]``) and ``√δ I``.
+    limit : ColouredNoiseLimit
+    N12 : float
+        ``N[0, 1]`` computed from ``Alt(ΣA⁻ᵀ)``; equals ``δγ/(2α(α²+γ²))`` (:attr:`paper_constant`).
+    paper_constant : float
+        ``δγ/(2α(α²+γ²))`` (the paper's formula).
+    limit_scale : float
+        ``√(δ/(α²+γ²))``: ``A⁻¹D = limit_scale · R`` with ``R`` a rotation.
+    drift : ndarray ``(2, 2)``
+        ``Q + N12 S``, ``S = diag(1, −1) = [V_1, V_2]``.
+    noise_matrices : ndarray ``(2, 2, 2)``
+        ``E_1, E_2`` with ``V_i(x) = E_i x`` (columns of ``P(x)``).
+    """
+
+    alpha: float
+    gamma: float
+    delta: float
+    lam: float
+    mu: float
+    A: np.ndarray
+    D: np.ndarray
+    limit: ColouredNoiseLimit
+    N12: float
+    paper_constant: float
+    limit_scale: float
+    drift: np.ndarray
+    noise_matrices: np.ndarray
+
+
+def planar_example(alpha=1.0, gamma=1.0, delta=1.0, lam=0.0, mu=0.0) -> PlanarExample:
+    r"""Build the planar example ``dx = Qx dt + P(x) y/ε dt``, ``dy = −ε⁻²(αI + γJ)y dt + ε⁻¹√δ dB``.
+
+    Examples
+    --------
+    >>> ex = planar_example(alpha=1.0, gamma=2.0, delta=3.0)
+    >>> round(ex.N12, 12) == round(ex.paper_constant, 12) == round(3 * 2 / (2 * 1 * 5), 12)
+    True
+    """
+    vals = []
+    for name, v in (("alpha", alpha), ("gamma", gamma), ("delta", delta), ("lam", lam), ("mu", mu)):
+        f = float(v)
+        if not math.isfinite(f):
+            raise ValueError(f"{name} must be finite, got {v!r}.")
+        vals.append(f)
+    alpha, gamma, delta, lam, mu = vals
+    if alpha <= 0 or delta <= 0:
+        raise ValueError(f"alpha and delta must be > 0 (alpha is the OU damping, delta the noise variance), "
+                         f"got alpha={alpha!r}, delta={delta!r}.")
+    J = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    A = alpha * np.eye(2) + gamma * J
+    D = math.sqrt(delta) * np.eye(2)
+    lim = coloured_noise_limit(A, D)
+    N12 = float(lim.levy_perturbation[0, 1])
+    E = np.array([[[0.0, 0.0], [1.0, 0.0]], [[0.0, 1.0], [0.0, 0.0]]])
+    S = np.diag([1.0, -1.0])
+    return PlanarExample(alpha=alpha, gamma=gamma, delta=delta, lam=lam, mu=mu, A=A, D=D, limit=lim, N12=N12,
+                         paper_constant=delta * gamma / (2 * alpha * (alpha ** 2 + gamma ** 2)),
+                         limit_scale=math.sqrt(delta / (alpha ** 2 + gamma ** 2)),
+                         drift=np.diag([lam, mu]) + N12 * S, noise_matrices=E)
+
+
+def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
+    r"""Exact ``E[X_T]`` and ``E[X_T X_Tᵀ]`` of the limit ``dX = (Q + N12 S)X dt + Σ_k G_k X∘dB^k``.
+
+    ``G_k = Σ_i M_{ik} E_i`` (``M = A⁻¹D``). Itô drift ``B = Q + N12 S + ½ Σ_k G_k²``;
+    ``E[X_T] = e^{BT}x0``; ``vec E[XXᵀ]`` solves ``d/dt vec P = (I⊗B + B⊗I + Σ_k G_k⊗G_k) vec P``.
+    ``torque=False`` drops ``N12 S`` (the plain Stratonovich guess).
+    """
+    x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
+    M = ex.limit.scaling
+    G = np.einsum("ik,iab->kab", M, ex.noise_matrices)
+    B = (ex.drift if torque else np.diag([ex.lam, ex.mu])) + 0.5 * np.einsum("kab,kbc->ac", G, G)
+    mean = sla.expm(B * T) @ x0
+    I2 = np.eye(2)
+    L = np.kron(I2, B) + np.kron(B, I2) + sum(np.kron(g, g) for g in G)
+    P = (sla.expm(L * T) @ np.outer(x0, x0).reshape(-1)).reshape(2, 2)
+    return mean, P
+
+
+def _expm2_traceless(a, b, c):
+    """expm([[a, b], [c, -a]]) batched (entries arrays)."""
+    q = a * a + b * c
+    r = np.sqrt(np.abs(q))
+    small = r < 1e-6
+    rs = np.where(small, 1.0, r)
+    ch = np.where(q >= 0, np.cosh(rs), np.cos(rs))
+    sh = np.where(q >= 0, np.sinh(rs), np.sin(rs)) / rs
+    ch = np.where(small, 1.0 + q / 2 + q * q / 24, ch)
+    sh = np.where(small, 1.0 + q / 6 + q * q / 120, sh)
+    return ch + sh * a, sh * b, sh * c, ch - sh * a
+
+
+def simulate_planar_coloured(ex: PlanarExample, eps, x0, T, *, n_paths, rng, h=None, substeps=None,
+                             chunk_steps=None):
+    r"""``X_T`` of the coloured planar system, ``n_paths`` samples, shape ``(n_paths, 2)``.
+
+    Strang splitting ``e^{Qh/2} · exp(X^1E_1 + X^2E_2 + L^{12}S) · e^{Qh/2}`` per grid step, where
+    ``exp(...)`` is the exact log-ODE step of the linear fields on the step's level-2 data of ``B^ε``
+    (increment ``X``, Lévy area ``L``). Default grid step ``h = ε²/(2‖A‖)``.
+    """
+    rng = check_rng(rng)
+    x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
+    nrm = float(np.linalg.norm(ex.A, 2))
+    if h is None:
+        h = eps ** 2 / (2.0 * nrm)
+    n_steps = max(1, int(round(T / h)))
+    h = T / n_steps
+    n_paths = check_positive_int(n_paths, "n_paths")
+    x = np.tile(x0, (n_paths, 1))
+    eq = np.exp(np.array([ex.lam, ex.mu]) * h / 2)
+    for inc, area, _, _, _ in iter_coloured_noise(ex.A, ex.D, eps, h, n_steps, rng=rng, n_paths=n_paths,
+                                                  substeps=substeps, chunk_steps=chunk_steps):
+        L12 = 0.5 * (area[..., 0, 1] - area[..., 1, 0])
+        e11, e12, e21, e22 = _expm2_traceless(L12, inc[..., 1], inc[..., 0])
+        for s in range(inc.shape[1]):
+            x = x * eq
+            x = np.stack([e11[:, s] * x[:, 0] + e12[:, s] * x[:, 1], e21[:, s] * x[:, 0] + e22[:, s] * x[:, 1]],
+                         axis=-1)
+            x = x * eq
+    return x
