@@ -177,8 +177,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all") -> Solu
             if not np.all(np.isfinite(y)):
                 bad = np.argwhere(~np.all(np.isfinite(y), axis=-1))
                 where = f" (first bad batch index {tuple(int(i) for i in bad[0])})" if bad.size else ""
-                raise ValueError(f"the solution became non-finite at step {k} (t = {times[k + 1]!r}, "
-                                 f"step from t = {times[k]!r}){where}; the vector fields may blow up "
+                raise ValueError(f"the solution became non-finite at step {k} (t = {float(times[k + 1]):.6g}, "
+                                 f"step from t = {float(times[k]):.6g}){where}; the vector fields may blow up "
                                  f"there, or the step is too large: refine the driver's grid.")
             if save_mask[k + 1]:
                 out[..., slot, :] = y
