@@ -24,7 +24,10 @@ import numpy as np
 
 from .report import FigureResult, Task
 
-__all__ = ["FIGURES", "register", "orthographic_basis", "sphere_image", "plot_sphere_portrait"]
+__all__ = [
+    "FIGURES", "register", "orthographic_basis", "sphere_image", "project", "projected_density",
+    "plot_sphere_portrait", "plot_density", "plot_trajectory_3d", "plot_projected_trajectory",
+]
 
 #: name -> Task, in report order
 FIGURES: dict[str, Task] = {}
@@ -164,20 +167,39 @@ def _whole_sphere_values(func, n=120):
     return np.asarray(func(pts), dtype=np.float64)
 
 
-def sphere_quadrature(n: int = 400):
-    """Midpoint quadrature on the unit sphere: points ``(M, 3)`` and area weights ``(M,)`` (sum 4π).
+def projected_density(density_fn, xe, ye, *, axes=(0, 1), hemisphere=1.0, sub=4):
+    """Density, per unit area of the projection plane, of a density on the unit sphere seen in a plane.
 
-    Used only to *draw* a predicted density in a projection (binning weights), never as the
-    library's quadrature of the Gibbs measure.
+    A point ``(x, y)`` of the plane ``(Π_a, Π_b)`` lifts to the hemisphere ``sign(Π_c) = hemisphere``
+    with ``|Π_c| = sqrt(1 - x² - y²)``; the area element is ``dS = dx dy / |Π_c|``. The density is
+    normalised on that hemisphere (the basin a trajectory explores) and averaged over each bin of the
+    edges ``xe, ye`` (``sub × sub`` midpoints per bin), so it compares with a histogram directly.
     """
-    th_edges = np.linspace(0, np.pi, n + 1)
-    ph_edges = np.linspace(0, 2 * np.pi, 2 * n + 1)
-    th = 0.5 * (th_edges[1:] + th_edges[:-1])
-    ph = 0.5 * (ph_edges[1:] + ph_edges[:-1])
-    T, P = np.meshgrid(th, ph, indexing="ij")
-    w = (np.cos(th_edges[:-1]) - np.cos(th_edges[1:]))[:, None] * np.diff(ph_edges)[None, :]
-    pts = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], axis=-1)
-    return pts.reshape(-1, 3), w.reshape(-1)
+    other = [k for k in range(3) if k not in axes][0]
+    # normalisation on the hemisphere, on a fine grid of the unit disk
+    g = np.linspace(-1, 1, 801)
+    gc = 0.5 * (g[1:] + g[:-1])
+    X, Y = np.meshgrid(gc, gc, indexing="ij")
+    zn = _hemisphere_values(density_fn, X, Y, axes, other, hemisphere)
+    total = np.nansum(zn) * (g[1] - g[0]) ** 2
+    # bin averages
+    fx = np.concatenate([np.linspace(a, b, sub + 1)[:-1] + (b - a) / (2 * sub) for a, b in zip(xe[:-1], xe[1:])])
+    fy = np.concatenate([np.linspace(a, b, sub + 1)[:-1] + (b - a) / (2 * sub) for a, b in zip(ye[:-1], ye[1:])])
+    Xf, Yf = np.meshgrid(fx, fy, indexing="ij")
+    q = np.nan_to_num(_hemisphere_values(density_fn, Xf, Yf, axes, other, hemisphere))
+    q = q.reshape(len(xe) - 1, sub, len(ye) - 1, sub).mean(axis=(1, 3))
+    return q / total if total > 0 else q
+
+
+def _hemisphere_values(density_fn, X, Y, axes, other, hemisphere):
+    r2 = X**2 + Y**2
+    inside = r2 < 1.0
+    Z = np.sqrt(np.where(inside, 1.0 - r2, 1.0))
+    P = np.zeros(X.shape + (3,))
+    P[..., axes[0]], P[..., axes[1]], P[..., other] = X, Y, np.sign(hemisphere) * Z
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = np.asarray(density_fn(P), dtype=np.float64) / Z
+    return np.where(inside & (Z > 1e-6), v, np.nan)
 
 
 def plot_density(ax, fig, xy, *, bins, extent, density_fn=None, hemisphere=None, axes=(0, 1),
@@ -200,27 +222,19 @@ def plot_density(ax, fig, xy, *, bins, extent, density_fn=None, hemisphere=None,
     cb.set_label("time density (per unit area)")
     pred = None
     if density_fn is not None:
-        pts, w = sphere_quadrature(500)
-        other = [k for k in range(3) if k not in axes][0]
-        if hemisphere is not None:
-            keep = np.sign(pts[:, other]) == np.sign(hemisphere)
-        else:
-            keep = np.ones(len(pts), bool)
-        p = np.asarray(density_fn(pts), dtype=np.float64) * w
-        p = p / p.sum()
-        pred, _, _ = np.histogram2d(pts[keep, axes[0]], pts[keep, axes[1]], bins=[xe, ye], weights=p[keep])
-        pred = pred / cell
+        pred = projected_density(density_fn, xe, ye, axes=axes, hemisphere=hemisphere)
         xc, yc = 0.5 * (xe[1:] + xe[:-1]), 0.5 * (ye[1:] + ye[:-1])
-        top = pred.max()
+        top = np.nanmax(pred) if np.any(np.isfinite(pred)) else 0.0
         if top > 0:
-            cs = ax.contour(xc, yc, pred.T, levels=top * np.array([0.1, 0.3, 0.5, 0.7, 0.9]), colors="cyan",
-                            linewidths=0.9)
-            cs.collections[0].set_label("Gibbs prediction") if hasattr(cs, "collections") else None
+            ax.contour(xc, yc, np.nan_to_num(pred).T, levels=top * np.array([0.1, 0.3, 0.5, 0.7, 0.9]),
+                       colors="cyan", linewidths=0.9)
             ax.plot([], [], color="cyan", lw=0.9, label="Gibbs prediction (10..90% of max)")
     if start is not None:
         ax.plot(start[0], start[1], "o", color="red", ms=7, mec="white", label="Π(0)")
     for (px, py), style, lab in marks:
         ax.plot(px, py, ls="none", label=lab, **style)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
     ax.set_xlabel(AXIS_LABELS[axes[0]])
     ax.set_ylabel(AXIS_LABELS[axes[1]])
     if title:
@@ -249,9 +263,35 @@ def plot_trajectory_3d(ax, traj, *, start=None, title="", max_points=30_000, tim
     ax.set_ylim(-1, 1)
     ax.set_zlim(-1, 1)
     ax.set_box_aspect((1, 1, 1))
+    for setter in (ax.set_xticks, ax.set_yticks, ax.set_zticks):
+        setter([-1, 0, 1])
     ax.set_xlabel(AXIS_LABELS[0])
     ax.set_ylabel(AXIS_LABELS[1])
     ax.set_zlabel(AXIS_LABELS[2])
+    if title:
+        ax.set_title(title, fontsize=10)
+    return lc
+
+
+def plot_projected_trajectory(ax, fig, traj, times, *, axes=(0, 1), start=None, title="", max_points=40_000):
+    """The trajectory projected on the plane ``(Π_a, Π_b)``, coloured by time, with a colour bar."""
+    from matplotlib.collections import LineCollection
+
+    step = max(len(traj) // max_points, 1)
+    p = traj[::step][:, list(axes)]
+    segs = np.stack([p[:-1], p[1:]], axis=1)
+    lc = LineCollection(segs, cmap="plasma", linewidths=0.5)
+    lc.set_array(np.asarray(times)[::step][:-1])
+    ax.add_collection(lc)
+    ax.autoscale()
+    ax.set_aspect("equal", adjustable="datalim")
+    if start is not None:
+        ax.plot(start[axes[0]], start[axes[1]], "o", color="red", ms=7, mec="white", label="Π(0)", zorder=5)
+        ax.legend(loc="upper left", fontsize=7)
+    cb = fig.colorbar(lc, ax=ax, fraction=0.046, pad=0.04)
+    cb.set_label("time t")
+    ax.set_xlabel(AXIS_LABELS[axes[0]])
+    ax.set_ylabel(AXIS_LABELS[axes[1]])
     if title:
         ax.set_title(title, fontsize=10)
     return lc
@@ -347,9 +387,10 @@ def _extent(center, half=0.32):
 @register("fig1", "Figure 1: the dissipative stochastic rigid body and its Gibbs measure (s = 0)",
           "Simulation of the rough-path rigid body with θ = 1, σ = 0.05, 𝕀 = diag(1, 2, 3), Π(0) = (0, 0, 1) "
           "(red dot), s = 0, on one long Stratonovich Brownian path (Lie–Heun coadjoint scheme with the step "
-          "Lévy areas). Left: the trajectory stays on the unit sphere (coloured by time). Right: time-density "
-          "of (Π₁, Π₂) after a burn-in, with the Gibbs prediction ∝ exp(−2θh̃/σ²) on the upper hemisphere "
-          "binned the same way (cyan contours at 10..90 % of its maximum).", requires=_RB)
+          "Lévy areas). Left: the trajectory stays on the unit sphere (coloured by time); middle: its projection on "
+          "(Π₁, Π₂). Right: time-density "
+          "of (Π₁, Π₂) after a burn-in, with the Gibbs prediction ∝ exp(−2θh̃/σ²) on the upper hemisphere, "
+          "projected on the plane and bin-averaged like the data (cyan contours at 10..90 % of its maximum).", requires=_RB)
 def fig1(ctx) -> FigureResult:
     body = _body(ctx)
     T = ctx.size("fig1.T", tiny=20.0, default=2_000.0, full=20_000.0)
@@ -360,13 +401,15 @@ def fig1(ctx) -> FigureResult:
     keep = times >= 0.1 * T
     xy = traj[keep][:, :2]
     mean_pred = _conditional_mean(g, 1.0)
-    fig = _new_figure(figsize=(12.5, 5.4))
-    ax3 = fig.add_subplot(1, 2, 1, projection="3d")
+    fig = _new_figure(figsize=(18, 5.8), layout="constrained")
+    ax3 = fig.add_subplot(1, 3, 1, projection="3d")
     lc = plot_trajectory_3d(ax3, traj, start=PI0, times=times, title="trajectory on the sphere |Π| = 1")
-    cb = fig.colorbar(lc, ax=ax3, fraction=0.03, pad=0.08)
+    cb = fig.colorbar(lc, ax=ax3, fraction=0.035, pad=0.12, orientation="horizontal")
     cb.set_label("time t")
-    ax3.view_init(elev=30, azim=-60)
-    ax = fig.add_subplot(1, 2, 2)
+    ax3.view_init(elev=28, azim=-55)
+    plot_projected_trajectory(fig.add_subplot(1, 3, 2), fig, traj, times, start=PI0,
+                              title="the same trajectory projected on (Π₁, Π₂)")
+    ax = fig.add_subplot(1, 3, 3)
     H, pred, edges = plot_density(
         ax, fig, xy, bins=70, extent=_extent((0.0, 0.0)), density_fn=g.density, hemisphere=1.0, start=PI0[:2],
         marks=[((mean_pred[0], mean_pred[1]), dict(marker="x", color="cyan", ms=9, mew=2), "Gibbs mean"),
@@ -393,7 +436,7 @@ def fig2(ctx) -> FigureResult:
     T = ctx.size("fig2.T", tiny=20.0, default=1_000.0, full=20_000.0)
     dt = ctx.size("fig2.dt", tiny=0.01, default=0.005, full=0.001)
     save = max(1, int(round(0.05 / dt)))
-    fig = _new_figure(figsize=(12.5, 10.5))
+    fig = _new_figure(figsize=(12.5, 10.5), layout="constrained")
     data = {}
     for k, s in enumerate(FIG2_S):
         body = _body(ctx, s=s)
@@ -408,7 +451,7 @@ def fig2(ctx) -> FigureResult:
         eq = min(stable, key=lambda e: np.linalg.norm(e.point - PI0)).point if stable else mean_pred
         ax = fig.add_subplot(2, 2, k + 1)
         H, pred, edges = plot_density(
-            ax, fig, xy, bins=70, extent=_extent((round(eq[0], 1), round(eq[1], 1)), 0.36), density_fn=g.density,
+            ax, fig, xy, bins=70, extent=_extent((round(eq[0], 1), round(eq[1], 1)), 0.42), density_fn=g.density,
             hemisphere=hemi, start=PI0[:2],
             marks=[((mean_pred[0], mean_pred[1]), dict(marker="x", color="cyan", ms=9, mew=2), "Gibbs mean"),
                    ((xy[:, 0].mean(), xy[:, 1].mean()), dict(marker="+", color="lime", ms=11, mew=2), "time average"),
@@ -420,7 +463,6 @@ def fig2(ctx) -> FigureResult:
     data.update(times=times, dt=dt, T=T)
     fig.suptitle(f"Figure 2: one Brownian path, four Lévy areas (convention '{ctx.convention}', T = {T:g}, "
                  f"dt = {dt:g})", fontsize=11)
-    fig.tight_layout()
     png, npz = _save(ctx, "fig2", fig, data)
     return FigureResult("fig2", FIGURES["fig2"].title, FIGURES["fig2"].caption, png, npz)
 
