@@ -216,3 +216,72 @@ def pvar_level2(inc, areas, q):
             prev_all[b, j] = arg
         out[b] = W[n]
     return out, prev_all
+
+
+@numba.njit(cache=True)
+def holder_level1_pruned(paths, times, alpha, block):
+    r"""``sup_{i<j} |P_j - P_i|^2 / (t_j - t_i)^{2α}`` per path, with branch-and-bound.
+
+    For a start ``i``, end points ``j`` are visited in blocks of ``block`` consecutive indices.
+    A block (resp. every later point) is skipped when
+    ``reach(P_i, box)^2 / (t_j0 - t_i)^{2α} <= best``, where ``box`` is the bounding box of the
+    block (resp. of all points from ``j0`` on) and ``j0`` the first index visited in it: every
+    skipped quotient has a numerator at most ``reach^2`` and a denominator at least
+    ``(t_j0 - t_i)^{2α}``, so the supremum is unchanged.
+    """
+    nb, npts, d = paths.shape
+    out = np.zeros(nb)
+    two_alpha = 2.0 * alpha
+    nblk = (npts + block - 1) // block
+    blo = np.empty((nblk, d))
+    bhi = np.empty((nblk, d))
+    slo = np.empty((npts, d))
+    shi = np.empty((npts, d))
+    for b in range(nb):
+        P = paths[b]
+        for m in range(nblk):
+            for c in range(d):
+                blo[m, c] = np.inf
+                bhi[m, c] = -np.inf
+        for i in range(npts - 1, -1, -1):
+            m = i // block
+            for c in range(d):
+                v = P[i, c]
+                if v < blo[m, c]:
+                    blo[m, c] = v
+                if v > bhi[m, c]:
+                    bhi[m, c] = v
+                if i == npts - 1:
+                    slo[i, c] = v
+                    shi[i, c] = v
+                else:
+                    slo[i, c] = v if v < slo[i + 1, c] else slo[i + 1, c]
+                    shi[i, c] = v if v > shi[i + 1, c] else shi[i + 1, c]
+        best = 0.0
+        for i in range(npts - 1):
+            j = i + 1
+            while j < npts:
+                m = j // block
+                end = (m + 1) * block
+                if end > npts:
+                    end = npts
+                w = (times[j] - times[i]) ** two_alpha
+                if best > 0.0:
+                    r = _box_reach(P[i], slo[j], shi[j], d)
+                    if r * r / w <= best:
+                        break
+                    r = _box_reach(P[i], blo[m], bhi[m], d)
+                    if r * r / w <= best:
+                        j = end
+                        continue
+                for jj in range(j, end):
+                    s = 0.0
+                    for c in range(d):
+                        z = P[jj, c] - P[i, c]
+                        s += z * z
+                    q = s / (times[jj] - times[i]) ** two_alpha
+                    if q > best:
+                        best = q
+                j = end
+        out[b] = best
+    return out
