@@ -239,81 +239,133 @@ def _w3(q, lin, minv, theta, m0, m1, m2):
             g2 + theta * (minv[2, 0] * v0 + minv[2, 1] * v1 + minv[2, 2] * v2))
 
 
+@numba.njit(cache=True, inline="always")
+def _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_iter):
+    """One coadjoint step on so(3)*; returns the new state and a convergence flag."""
+    w0, w1, w2 = _w3(q, lin, minv, theta, m0, m1, m2)
+    s0, s1, s2 = w0 * dt + e0, w1 * dt + e1, w2 * dt + e2
+    if code == 1:
+        p0, p1, p2 = _rod(s0, s1, s2, m0, m1, m2)
+        v0, v1, v2 = _w3(q, lin, minv, theta, p0, p1, p2)
+        s0 = 0.5 * (w0 + v0) * dt + e0
+        s1 = 0.5 * (w1 + v1) * dt + e1
+        s2 = 0.5 * (w2 + v2) * dt + e2
+    elif code == 2:
+        # chord Jacobian J = I - dt/2 Dw(mu) L(mu), L(mu) d = ad*_d mu = mu × d
+        g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0]
+        g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1]
+        g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2]
+        L = np.empty((3, 3))
+        L[0, 0], L[0, 1], L[0, 2] = 0.0, -m2, m1
+        L[1, 0], L[1, 1], L[1, 2] = m2, 0.0, -m0
+        L[2, 0], L[2, 1], L[2, 2] = -m1, m0, 0.0
+        Dw = q.copy()
+        if theta != 0.0:
+            # d(mu × g) = -hat(g) dmu + hat(mu) q dmu
+            A = np.empty((3, 3))
+            A[0, 0], A[0, 1], A[0, 2] = 0.0, g2, -g1
+            A[1, 0], A[1, 1], A[1, 2] = -g2, 0.0, g0
+            A[2, 0], A[2, 1], A[2, 2] = g1, -g0, 0.0
+            Dw = Dw + theta * (minv @ (A + L @ q))
+        Ji = np.linalg.inv(np.eye(3) - 0.5 * dt * (Dw @ L))
+        ok = False
+        for it in range(max_iter):
+            n0, n1, n2 = _rod(s0, s1, s2, m0, m1, m2)
+            u0, u1, u2 = _w3(q, lin, minv, theta, 0.5 * (m0 + n0), 0.5 * (m1 + n1), 0.5 * (m2 + n2))
+            r0 = s0 - u0 * dt - e0
+            r1 = s1 - u1 * dt - e1
+            r2 = s2 - u2 * dt - e2
+            d0 = Ji[0, 0] * r0 + Ji[0, 1] * r1 + Ji[0, 2] * r2
+            d1 = Ji[1, 0] * r0 + Ji[1, 1] * r1 + Ji[1, 2] * r2
+            d2 = Ji[2, 0] * r0 + Ji[2, 1] * r1 + Ji[2, 2] * r2
+            s0 -= d0
+            s1 -= d1
+            s2 -= d2
+            err = max(abs(d0), abs(d1), abs(d2))
+            if not (err == err):
+                break
+            if err <= tol * (1.0 + max(abs(s0), abs(s1), abs(s2))):
+                ok = True
+                break
+        if not ok:
+            return m0, m1, m2, False
+    n0, n1, n2 = _rod(s0, s1, s2, m0, m1, m2)
+    return n0, n1, n2, True
+
+
 @numba.njit(cache=True)
 def _so3_kernel(mu, eta, dts, q, lin, minv, theta, code, tol, max_iter, save_every, phase, out, k0):
     """Advance mu (B, 3) in place over eta (B, K, 3); store every save_every-th state into out.
 
-    ``phase`` is the global index of the first step of this chunk; a state after global step j+1 is
-    stored at out[:, (j+1)//save_every - k0] when (j+1) % save_every == 0. Returns -1, or
-    (global step, path) encoded as step * B + path when the chord iteration fails.
+    ``phase`` is the global index of the first step of this chunk; the state after global step j
+    is stored at out[:, j // save_every - k0] when j % save_every == 0. Returns -1, or
+    (global step) * B + path when the chord iteration fails.
     """
     nb = mu.shape[0]
     nk = eta.shape[1]
     for p in range(nb):
         m0, m1, m2 = mu[p, 0], mu[p, 1], mu[p, 2]
         for k in range(nk):
-            dt = dts[k]
-            e0, e1, e2 = eta[p, k, 0], eta[p, k, 1], eta[p, k, 2]
-            w0, w1, w2 = _w3(q, lin, minv, theta, m0, m1, m2)
-            s0, s1, s2 = w0 * dt + e0, w1 * dt + e1, w2 * dt + e2
-            if code == 1:
-                p0, p1, p2 = _rod(s0, s1, s2, m0, m1, m2)
-                v0, v1, v2 = _w3(q, lin, minv, theta, p0, p1, p2)
-                s0 = 0.5 * (w0 + v0) * dt + e0
-                s1 = 0.5 * (w1 + v1) * dt + e1
-                s2 = 0.5 * (w2 + v2) * dt + e2
-            elif code == 2:
-                # chord Jacobian J = I - dt/2 Dw(mu) L(mu), L(mu) d = mu × d  (ad*_d mu)
-                g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0]
-                g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1]
-                g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2]
-                L = np.empty((3, 3))
-                L[0, 0], L[0, 1], L[0, 2] = 0.0, -m2, m1
-                L[1, 0], L[1, 1], L[1, 2] = m2, 0.0, -m0
-                L[2, 0], L[2, 1], L[2, 2] = -m1, m0, 0.0
-                Dw = np.empty((3, 3))
-                for a in range(3):
-                    for b in range(3):
-                        Dw[a, b] = q[a, b]
-                if theta != 0.0:
-                    # d(mu × g) = -g× dmu + mu × (q dmu) ; Ag[j,k] s.t. ad*_g mu = Ag mu: (mu×g) = -hat(g) mu
-                    A = np.empty((3, 3))
-                    A[0, 0], A[0, 1], A[0, 2] = 0.0, g2, -g1
-                    A[1, 0], A[1, 1], A[1, 2] = -g2, 0.0, g0
-                    A[2, 0], A[2, 1], A[2, 2] = g1, -g0, 0.0
-                    D = A + L @ q
-                    Dw = Dw + theta * (minv @ D)
-                J = np.eye(3) - 0.5 * dt * (Dw @ L)
-                Ji = np.linalg.inv(J)
-                ok = False
-                for it in range(max_iter):
-                    n0, n1, n2 = _rod(s0, s1, s2, m0, m1, m2)
-                    u0, u1, u2 = _w3(q, lin, minv, theta, 0.5 * (m0 + n0), 0.5 * (m1 + n1), 0.5 * (m2 + n2))
-                    r0 = s0 - u0 * dt - e0
-                    r1 = s1 - u1 * dt - e1
-                    r2 = s2 - u2 * dt - e2
-                    d0 = Ji[0, 0] * r0 + Ji[0, 1] * r1 + Ji[0, 2] * r2
-                    d1 = Ji[1, 0] * r0 + Ji[1, 1] * r1 + Ji[1, 2] * r2
-                    d2 = Ji[2, 0] * r0 + Ji[2, 1] * r1 + Ji[2, 2] * r2
-                    s0 -= d0
-                    s1 -= d1
-                    s2 -= d2
-                    sc = 1.0 + max(abs(s0), abs(s1), abs(s2))
-                    err = max(abs(d0), abs(d1), abs(d2))
-                    if not (err == err):
-                        break
-                    if err <= tol * sc:
-                        ok = True
-                        break
-                if not ok:
-                    mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
-                    return (phase + k) * nb + p
-            m0, m1, m2 = _rod(s0, s1, s2, m0, m1, m2)
+            m0, m1, m2, ok = _so3_step(m0, m1, m2, eta[p, k, 0], eta[p, k, 1], eta[p, k, 2], dts[k], q, lin,
+                                       minv, theta, code, tol, max_iter)
+            if not ok:
+                mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
+                return (phase + k) * nb + p
             j = phase + k + 1
             if j % save_every == 0:
                 r = j // save_every - k0
                 out[p, r, 0], out[p, r, 1], out[p, r, 2] = m0, m1, m2
         mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
+    return -1
+
+
+@numba.njit(cache=True)
+def _so3_brownian_kernel(mu, rng, n_steps, dt, xi, brk, with_area, q, lin, minv, theta, code, tol, max_iter,
+                         save_every, out):
+    """Fused Brownian driver + coadjoint step on so(3)* (no noise arrays are materialised).
+
+    Draw order per step and path (step-major, so independent of any chunking in time): the m
+    increments N(0, dt), then (with the area) the m space-time areas H ~ N(0, dt/12) and the
+    m(m-1)/2 residuals lambda_ij ~ N(0, dt^2/12), i < j lexicographic; the step Lévy area is
+    A_ij = H_i dW_j - dW_i H_j + lambda_ij (Davie's moment-matched area, exact second moments).
+    Returns -1 or step * B + path of a chord failure.
+    """
+    nb = mu.shape[0]
+    m = xi.shape[0]
+    sq = math.sqrt(dt)
+    sh = math.sqrt(dt / 12.0)
+    sl = dt / math.sqrt(12.0)
+    dw = np.empty(m)
+    hh = np.empty(m)
+    for k in range(n_steps):
+        for p in range(nb):
+            for i in range(m):
+                dw[i] = sq * rng.standard_normal()
+            e0 = 0.0
+            e1 = 0.0
+            e2 = 0.0
+            for i in range(m):
+                e0 += dw[i] * xi[i, 0]
+                e1 += dw[i] * xi[i, 1]
+                e2 += dw[i] * xi[i, 2]
+            if with_area:
+                for i in range(m):
+                    hh[i] = sh * rng.standard_normal()
+                for i in range(m):
+                    for j in range(i + 1, m):
+                        a = hh[i] * dw[j] - dw[i] * hh[j] + sl * rng.standard_normal()
+                        # ½ Σ_{ij} A^{ij}[ξ_i, ξ_j] = Σ_{i<j} A^{ij}[ξ_i, ξ_j]
+                        e0 += a * brk[i, j, 0]
+                        e1 += a * brk[i, j, 1]
+                        e2 += a * brk[i, j, 2]
+            m0, m1, m2, ok = _so3_step(mu[p, 0], mu[p, 1], mu[p, 2], e0, e1, e2, dt, q, lin, minv, theta, code,
+                                       tol, max_iter)
+            if not ok:
+                return k * nb + p
+            mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
+            if (k + 1) % save_every == 0:
+                r = (k + 1) // save_every
+                out[p, r, 0], out[p, r, 1], out[p, r, 2] = m0, m1, m2
     return -1
 
 
@@ -323,24 +375,30 @@ def _fast_so3(system):
             and system.dim == 3)
 
 
+def _so3_args(system, method):
+    h = system.hamiltonian
+    minv = np.eye(3) if system._metric_inv is None else system._metric_inv
+    lin = np.ascontiguousarray(h.linear + system._shift)
+    tol = float(getattr(method, "tol", 1e-13))
+    max_iter = int(getattr(method, "max_iter", 1))
+    return (np.ascontiguousarray(h.q), lin, np.ascontiguousarray(minv), system.theta, method.code, tol, max_iter)
+
+
+def _chord_failure(res, nb, times, dts, method):
+    step, path = divmod(int(res), nb)
+    return ChordConvergenceError(
+        f"implicit midpoint: the chord iteration did not converge at step {step} (t = {times[step]:.6g}, "
+        f"dt = {dts:.3g}) for path {path}: tolerance {method.tol:g} not reached after max_iter = "
+        f"{method.max_iter} iterations. Reduce dt (or use LieHeun), or raise max_iter / tol.")
+
+
 def _run_chunk(system, method, mu, eta, dts, t0_index, times, save_every, out, k0):
     """Advance ``mu`` (B, n) over the chunk ``eta`` (B, K, n); fill ``out`` (B, nsave, n)."""
     if _fast_so3(system):
-        h = system.hamiltonian
-        minv = np.eye(3) if system._metric_inv is None else system._metric_inv
-        lin = np.ascontiguousarray(h.linear + system._shift)
-        tol = getattr(method, "tol", 1e-13)
-        max_iter = getattr(method, "max_iter", 1)
-        res = _so3_kernel(mu, np.ascontiguousarray(eta), np.ascontiguousarray(dts), np.ascontiguousarray(h.q),
-                          lin, np.ascontiguousarray(minv), system.theta, method.code, float(tol), int(max_iter),
+        res = _so3_kernel(mu, np.ascontiguousarray(eta), np.ascontiguousarray(dts), *_so3_args(system, method),
                           save_every, t0_index, out, k0)
         if res >= 0:
-            step, path = divmod(int(res), mu.shape[0])
-            raise ChordConvergenceError(
-                f"implicit midpoint: the chord iteration did not converge at step {step} (t = "
-                f"{times[step]:.6g}, dt = {dts[step - t0_index]:.3g}) for path {path}: tolerance {tol:g} not "
-                f"reached after max_iter = {max_iter} iterations. Reduce dt (or use LieHeun), or raise "
-                f"max_iter / tol.")
+            raise _chord_failure(res, mu.shape[0], times, float(dts[int(res) // mu.shape[0] - t0_index]), method)
         return
     for k in range(eta.shape[1]):
         j = t0_index + k
@@ -440,37 +498,41 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
 
 
 # ---------------------------------------------------------------------- Brownian streaming
-def _brownian_chunk(rng, batch, k, dt, m, levy_area):
-    """Increments (batch, k, m) and Lévy areas (batch, k, m, m) of Stratonovich Brownian motion.
+def _brownian_chunk(rng, batch, k, dt, m, levy_area, substeps):
+    """Increments (batch, k, m) and Lévy areas (batch, k, m, m) (or None) of Stratonovich Brownian motion.
 
-    Uses ``roughpaths.brownian.brownian_increments_and_areas`` when available; otherwise increments
-    ~ N(0, dt) and the moment-matched area :math:`A_{ij} = H_i W_j - W_i H_j + \\lambda_{ij}`
-    (space-time area :math:`H\\sim N(0, dt/12)`, :math:`\\lambda_{ij}\\sim N(0, dt^2/12)`), which has the
-    exact covariance of Lévy's area.
+    ``substeps == 1`` with the Davie area (or no area): drawn here in the same order as the fused
+    numba kernel (step-major; per step and path: ``dW`` (m), ``H`` (m), ``lambda`` (m(m-1)/2)), so
+    both implementations give the same paths for the same seed, and the stream does not depend on
+    the chunking in time. Area :math:`A_{ij} = H_i dW_j - dW_i H_j + \lambda_{ij}` with
+    :math:`H\sim N(0, dt/12)`, :math:`\lambda_{ij}\sim N(0, dt^2/12)` (Davie's moment-matched area;
+    exact second moments). Otherwise ``roughpaths.brownian.brownian_increments_and_areas``.
     """
-    gen = _external_brownian()
-    if gen is not None:
-        return gen(rng, k, dt, m, batch_shape=(batch,), levy_area=levy_area)
-    dw = rng.standard_normal((batch, k, m)) * math.sqrt(dt)
-    if not levy_area or m < 2:
-        return dw, None
-    h = rng.standard_normal((batch, k, m)) * math.sqrt(dt / 12.0)
-    a = h[..., :, None] * dw[..., None, :]
-    a = a - np.swapaxes(a, -1, -2)
-    iu = np.triu_indices(m, 1)
-    lam = rng.standard_normal((batch, k, len(iu[0]))) * (dt / math.sqrt(12.0))
-    a[..., iu[0], iu[1]] += lam
-    a[..., iu[1], iu[0]] -= lam
-    return dw, a
-
-
-def _external_brownian():
-    return None
+    method = None if not levy_area else ("davie" if levy_area is True else levy_area)
+    if method is None or m < 2:
+        z = rng.standard_normal((k, batch, m))
+        return np.swapaxes(z, 0, 1) * math.sqrt(dt), None
+    if method == "davie" and substeps == 1:
+        npair = m * (m - 1) // 2
+        z = np.swapaxes(rng.standard_normal((k, batch, 2 * m + npair)), 0, 1)
+        dw = z[..., :m] * math.sqrt(dt)
+        h = z[..., m:2 * m] * math.sqrt(dt / 12.0)
+        a = h[..., :, None] * dw[..., None, :]
+        a = a - np.swapaxes(a, -1, -2)
+        iu = np.triu_indices(m, 1)
+        lam = z[..., 2 * m:] * (dt / math.sqrt(12.0))
+        a[..., iu[0], iu[1]] += lam
+        a[..., iu[1], iu[0]] -= lam
+        return dw, a
+    from roughpaths.brownian import brownian_increments_and_areas
+    dw, xx = brownian_increments_and_areas(rng, k, dt, m, batch_shape=(batch,), levy_area=method,
+                                           substeps=substeps)
+    return dw, 0.5 * (xx - np.swapaxes(xx, -1, -2))
 
 
 def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rng, *, n_paths=None,
-                      method=LieHeun(), levy_area: bool = True, save_every: int = 1, chunk_steps=None,
-                      orbit=None):
+                      method=LieHeun(), levy_area=True, area_substeps: int = 1, save_every: int = 1,
+                      chunk_steps=None, orbit=None):
     r"""Simulate on Stratonovich Brownian motion, generated chunk by chunk (memory independent of ``n_steps``).
 
     Parameters
@@ -484,8 +546,15 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
     n_paths : int, optional
         Number of paths ``P`` (default: ``mu0``'s batch size, or 1).
     method : LieEuler() | LieHeun() | ImplicitMidpoint(...)
-    levy_area : bool
-        Include the step Lévy area in :math:`\sigma_n` (strong order 1). ``False`` drops it (order ½).
+    levy_area : bool or {"davie", "foster"}
+        Include the step Lévy area in :math:`\sigma_n`. ``True`` means ``"davie"`` (every second
+        moment of (W, A) exact); ``False`` drops the area (then the scheme is only order ½ even
+        against its own driver). The area is sampled (``roughpaths.brownian``), so the scheme has
+        strong order 1 with respect to the sampled rough path and weak order 1 for Brownian motion;
+        no sampler using finitely many Gaussians per step beats strong order ½ against *the*
+        Brownian path (Clark–Cameron), only its constant (``area_substeps``) improves.
+    area_substeps : int
+        Substeps per step for the area sampler (default 1: cheapest, exact second moments).
     save_every : int
         Keep every ``save_every``-th state.
     chunk_steps : int, optional
@@ -504,8 +573,9 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
     dt = float(dt)
     n_steps = check_positive_int(n_steps, "n_steps")
     save_every = check_positive_int(save_every, "save_every")
-    if not isinstance(levy_area, (bool, np.bool_)):
-        raise TypeError(f"levy_area must be True or False, got {levy_area!r}.")
+    if not (isinstance(levy_area, (bool, np.bool_)) or levy_area in ("davie", "foster")):
+        raise ValueError(f"levy_area must be True, False, 'davie' or 'foster', got {levy_area!r}.")
+    area_substeps = check_positive_int(area_substeps, "area_substeps")
     mu0 = as_float_array(mu0, "mu0", last_dims=(system.dim,) if isinstance(system, LiePoissonSystem) else None)
     if mu0.ndim > 2:
         raise ValueError(f"mu0 must have shape (n,) or (n_paths, n), got {mu0.shape}.")
@@ -522,12 +592,20 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
     out = np.empty((n_paths, nsave, n))
     out[:, 0] = mu
     times = np.arange(n_steps + 1) * dt
-    start = 0
-    while start < n_steps:
-        k = min(chunk_steps, n_steps - start)
-        dw, areas = _brownian_chunk(rng, n_paths, k, dt, m, levy_area)
-        eta = system.stochastic_velocity(dw, areas if levy_area else None)
-        _run_chunk(system, method, mu, eta, np.full(k, dt), start, times, save_every, out, 0)
-        start += k
+    if _fast_so3(system) and (levy_area is True or levy_area is False or levy_area == "davie") and area_substeps == 1:
+        with_area = bool(levy_area)
+        res = _so3_brownian_kernel(mu, rng, n_steps, dt, np.ascontiguousarray(system.xi),
+                                   np.ascontiguousarray(system.xi_brackets), with_area, *_so3_args(system, method),
+                                   save_every, out)
+        if res >= 0:
+            raise _chord_failure(res, n_paths, times, dt, method)
+    else:
+        start = 0
+        while start < n_steps:
+            k = min(chunk_steps, n_steps - start)
+            dw, areas = _brownian_chunk(rng, n_paths, k, dt, m, levy_area, area_substeps)
+            eta = system.stochastic_velocity(dw, areas)
+            _run_chunk(system, method, mu, eta, np.full(k, dt), start, times, save_every, out, 0)
+            start += k
     _check_finite_state(mu, n_steps)
     return times[::save_every][:nsave], out

@@ -417,14 +417,20 @@ class LiePoissonSystem:
         return np.broadcast_to(jac, mu.shape[:-1] + jac.shape)
 
     def vector_fields(self):
-        r"""The fields in the form the generic RDE solvers accept.
+        r"""The fields in the form :func:`roughpaths.solve.solve` accepts.
 
-        Returns a :class:`LiePoissonVectorFields` (drift, noise and their Jacobians as batch-first
-        callables). The drift contains the Lévy torque of ``s`` — drive it with ``X``; the
-        uncorrected system (``with_s(0)``) driven by ``X.perturb(s)`` is the same RDE
-        (Proposition 2.1).
+        Returns a ``roughpaths.vector_fields.LinearVectorFields`` with the noise matrices
+        :math:`B_i` (:math:`V_i(\mu) = B_i\mu = \mathrm{ad}^*_{\xi_i}\mu`) and the (non-linear) drift
+        :meth:`drift` with its Jacobian; if that module is unavailable, a
+        :class:`LiePoissonVectorFields` with the same callables. The drift contains the Lévy torque
+        of ``s`` — drive it with ``X``; the uncorrected system (``with_s(0)``) driven by
+        ``X.perturb(s)`` is the same RDE (Proposition 2.1).
         """
-        return LiePoissonVectorFields(self)
+        try:
+            from roughpaths.vector_fields import LinearVectorFields
+        except ImportError:  # pragma: no cover - roughpaths without the RDE layer
+            return LiePoissonVectorFields(self)
+        return LinearVectorFields(self._noise_matrices, drift=self.drift, drift_jacobian=self.drift_jacobian)
 
     # ------------------------------------------------------------------ log-signature → algebra
     def stochastic_velocity(self, increments, levy_areas=None) -> np.ndarray:
