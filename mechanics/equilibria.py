@@ -571,24 +571,30 @@ def _project_to_level(x, A, c, r, level, iters=4):
 
 # ------------------------------------------------------------------------------------ heavy top
 def lagrange_top_sleeping_stability(I1, I3, omega3, mgl):
-    r"""The sleeping Lagrange top: stability of the upright spin ``Π = (0, 0, I3 ω3)``, ``Γ = e3``.
+    r"""The sleeping Lagrange top: linear stability of ``Π = (0, 0, I3 ω3)``, ``Γ = e3``.
 
-    For a symmetric top (``I1 = I2``) with the centre of mass on the symmetry axis at height
-    ``ℓ`` above the fixed point (``χ = M g ℓ e3``, ``h = ½Π·𝕀⁻¹Π + χ·Γ`` with ``Γ`` the direction
-    of gravity's *opposite* in the body frame), the upright spin is linearly stable iff
-    ``Π3² > 4 I1 M g ℓ`` (the classical fast-top criterion, ``Π3 = I3 ω3``). The linearised
-    transverse motion has frequencies ``(Π3 ± √(Π3² − 4 I1 M g ℓ)) / (2 I1)``.
+    Symmetric top ``𝕀 = diag(I1, I1, I3)``, ``h = ½Π·𝕀⁻¹Π + χ·Γ`` with ``χ = M g ℓ e3`` (centre of
+    mass on the symmetry axis at distance ``ℓ``), Lie–Poisson equations on se(3)* in the
+    ``CONVENTIONS.md`` form ``Π̇ = Π × Ω + Γ × χ``, ``Γ̇ = Γ × Ω``. The upright spin is an equilibrium
+    for every ``ω3``; it is linearly (and, by energy–Casimir, nonlinearly) stable iff
+    ``Π3² > 4 I1 M g ℓ`` (the fast-top criterion). The body-frame linearisation has the eigenvalues
+    ``± √(4 I1 M g ℓ − Π3²) / (2 I1)`` (each twice) plus two zeros along the Casimir directions.
 
     Returns
     -------
-    dict with ``stable`` (bool), ``margin`` (``Π3² − 4 I1 M g ℓ``) and ``frequencies`` (complex, 2).
+    dict with ``stable`` (bool), ``margin`` ``Π3² − 4 I1 M g ℓ`` and ``eigenvalues`` (complex, 6).
+
+    Examples
+    --------
+    >>> lagrange_top_sleeping_stability(1.0, 2.0, 2.0, 1.0)["stable"]
+    True
     """
     I1 = float(I1)
     I3 = float(I3)
-    if I1 <= 0 or I3 <= 0:
+    if not (I1 > 0 and I3 > 0):
         raise ValueError(f"I1 and I3 must be > 0, got I1={I1!r}, I3={I3!r}.")
     p3 = I3 * float(omega3)
     margin = p3 * p3 - 4.0 * I1 * float(mgl)
-    root = np.sqrt(complex(margin))
-    freqs = np.array([(p3 + root) / (2 * I1), (p3 - root) / (2 * I1)])
-    return {"stable": bool(margin > 0), "margin": margin, "frequencies": freqs}
+    lam = np.sqrt(complex(-margin)) / (2.0 * I1)
+    return {"stable": bool(margin > 0), "margin": margin,
+            "eigenvalues": np.array([lam, lam, -lam, -lam, 0.0, 0.0], dtype=complex)}
