@@ -7,8 +7,10 @@ that is itself Lyndon: ``P(w) = [P(u), P(v)] = P(u)⊗P(v) - P(v)⊗P(u)``. This
 
 ``P(w) = w + (words lexicographically larger than w)``, so the coefficients of the Lyndon words
 in a Lie element ``L = sum_v c_v P(v)`` are a unit-triangular transform of the coordinates
-``c``; :func:`lyndon_projection` inverts it exactly (this is what ``iisignature.logsig`` returns
-by default, unlike its method ``"S"``, which reads the Lyndon-word coefficients off directly).
+``c``; :func:`lyndon_projection` inverts it exactly, giving the coordinates ``iisignature.logsig``
+returns (default method). The transform is the identity for small depths (e.g. ``d = 2, m <= 4``)
+but not in general (``d = 3, m = 3``: ``P(132) = 132 - 213 + 231 - 312`` contains the Lyndon word 132
+only, while ``P(123)`` also contains ``132``).
 """
 
 from __future__ import annotations
