@@ -6,6 +6,15 @@ Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """
 
 from .level2 import level2_exp, level2_inv, level2_log, level2_mul
+from .norms import (
+    area_holder_seminorm,
+    area_p_variation,
+    holder_distance,
+    holder_seminorm,
+    p_variation,
+    rough_path_holder_norm,
+    rough_path_p_variation,
+)
 from .rough_path import RoughPath, chen_defect
 
 __version__ = "0.1.0"
@@ -17,4 +26,11 @@ __all__ = [
     "level2_inv",
     "level2_exp",
     "level2_log",
+    "holder_seminorm",
+    "area_holder_seminorm",
+    "rough_path_holder_norm",
+    "p_variation",
+    "area_p_variation",
+    "rough_path_p_variation",
+    "holder_distance",
 ]
