@@ -240,6 +240,8 @@ class Context:
     scale: str = "default"
     progress: Progress = field(default_factory=lambda: Progress(enabled=False))
     sizes: dict = field(default_factory=dict)
+    #: results shared between tasks (e.g. one coloured-noise run behind Figures 4 and 5)
+    cache: dict = field(default_factory=dict)
 
     def rng(self, name: str) -> np.random.Generator:
         """Generator seeded by ``(seed, name)``: a task's numbers do not depend on which others ran."""
