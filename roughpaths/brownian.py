@@ -397,7 +397,9 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
       it had the Brownian conditional law given its increment, which it has only on average. The
       fine Lévy-area variance comes out too large: measured (d = 3, 2·10⁵ paths) by +7 % for
       ``factor = 3``, +11 % for 4, +18 % for 8 (repeated halving is worse: +12 % at 4, +21 % at 8).
-      The fine increments keep the bridge covariance to sampling error (< 1 %). A few
+      The fine increments keep the bridge covariance to sampling error (< 1 %), but explain too
+      little of the coarse area: the polygon through the refined points has Lévy-area variance
+      9 % (factor 4) / 5 % (factor 16) below the Brownian ``(1 - 1/m) h²/4``. A few
       preconditioned Crank–Nicolson Metropolis sweeps on the increments (target: the bridge
       conditioned on the coarse area under the Davie model) remove this bias (40 sweeps: +0.8 %
       at ``factor = 8``), but cost ~40 times more; not done here.
