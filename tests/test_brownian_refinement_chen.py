@@ -102,7 +102,7 @@ def test_refined_polygon_area_explains_coarse_area_iisignature_oracle(m, tol_cor
     resid = np.mean((L - a_poly) ** 2) / (h * h / (4 * m))
     assert 0.95 < resid < resid_hi
     # a transposed area convention would anti-correlate
-    assert np.corrcoef(-a_poly, L)[0, 1] < -0.8
+    assert np.corrcoef(-a_poly, L)[0, 1] < -0.6
 
 
 @pytest.mark.parametrize("factor, bound", [(3, 0.10), (4, 0.15)])
