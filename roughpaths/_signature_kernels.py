@@ -149,21 +149,11 @@ def sig2_kernel(x, nchunks):
 
 
 @njit(cache=True)
-def _sig_chunk(x, b, lo, hi, d, m, offsets, s):
-    """``s <- `` signature of points ``lo..hi`` of path ``b`` (reversed layout), Horner-Chen form.
-
-    Per segment with increment ``D``, ``s <- s ⊗ exp(D)`` level by level from the top (so lower
-    levels are still the old ones): ``s_k += (((D/k + s_1) ⊗ D/(k-1) + s_2) ⊗ ... + s_{k-1}) ⊗ D``,
-    folded as ``B_1 = D/k``, ``B_{j+1} = (B_j + s_j) ⊗ D/(k-j)``, ``s_k += (B_{k-1} + s_{k-1}) ⊗ D``.
-    About ``d^m (1 + 2/(d-1))`` flops per point, no allocation inside the loop: one scratch
-    buffer holds the two ping-pong halves (integer offsets only; swapping array references
-    inside the loop would cost reference counting on every step).
-    """
+def _sig_chunk_generic(x, b, lo, hi, d, m, offsets, s):
     half = d ** (m - 1)
     buf = np.empty(2 * half)
     delta = np.empty(d)
-    for i in range(s.shape[0]):
-        s[i] = 0.0
+    scaled = np.empty(d)
     for k in range(lo + 1, hi + 1):
         for i in range(d):
             delta[i] = x[b, k, i] - x[b, k - 1, i]
@@ -177,26 +167,121 @@ def _sig_chunk(x, b, lo, hi, d, m, offsets, s):
             for j in range(1, lev - 1):
                 f = 1.0 / (lev - j)
                 o = offsets[j]
-                for p in range(size):
-                    buf[cur + p] += s[o + p]
                 for q in range(d):
-                    dq = delta[q] * f
-                    base = nxt + q * size
-                    for p in range(size):
-                        buf[base + p] = buf[cur + p] * dq
+                    scaled[q] = delta[q] * f
+                for p in range(size):
+                    t = buf[cur + p] + s[o + p]
+                    for q in range(d):
+                        buf[nxt + q * size + p] = t * scaled[q]
                 size *= d
                 cur, nxt = nxt, cur
             o = offsets[lev - 1]
-            for p in range(size):
-                buf[cur + p] += s[o + p]
             ok = offsets[lev]
-            for q in range(d):
-                dq = delta[q]
-                base = ok + q * size
-                for p in range(size):
-                    s[base + p] += buf[cur + p] * dq
+            for p in range(size):
+                t = buf[cur + p] + s[o + p]
+                for q in range(d):
+                    s[ok + q * size + p] += t * delta[q]
         for i in range(d):
             s[i] += delta[i]
+
+
+@njit(cache=True)
+def _sig_chunk_d2(x, b, lo, hi, m, offsets, s):
+    half = 2 ** (m - 1)
+    buf = np.empty(2 * half)
+    for k in range(lo + 1, hi + 1):
+        d0 = x[b, k, 0] - x[b, k - 1, 0]
+        d1 = x[b, k, 1] - x[b, k - 1, 1]
+        for lev in range(m, 1, -1):
+            inv = 1.0 / lev
+            buf[0] = d0 * inv
+            buf[1] = d1 * inv
+            size = 2
+            cur = 0
+            nxt = half
+            for j in range(1, lev - 1):
+                f = 1.0 / (lev - j)
+                o = offsets[j]
+                e0 = d0 * f
+                e1 = d1 * f
+                for p in range(size):
+                    t = buf[cur + p] + s[o + p]
+                    buf[nxt + p] = t * e0
+                    buf[nxt + size + p] = t * e1
+                size *= 2
+                cur, nxt = nxt, cur
+            o = offsets[lev - 1]
+            ok = offsets[lev]
+            for p in range(size):
+                t = buf[cur + p] + s[o + p]
+                s[ok + p] += t * d0
+                s[ok + size + p] += t * d1
+        s[0] += d0
+        s[1] += d1
+
+
+@njit(cache=True)
+def _sig_chunk_d3(x, b, lo, hi, m, offsets, s):
+    half = 3 ** (m - 1)
+    buf = np.empty(2 * half)
+    for k in range(lo + 1, hi + 1):
+        d0 = x[b, k, 0] - x[b, k - 1, 0]
+        d1 = x[b, k, 1] - x[b, k - 1, 1]
+        d2 = x[b, k, 2] - x[b, k - 1, 2]
+        for lev in range(m, 1, -1):
+            inv = 1.0 / lev
+            buf[0] = d0 * inv
+            buf[1] = d1 * inv
+            buf[2] = d2 * inv
+            size = 3
+            cur = 0
+            nxt = half
+            for j in range(1, lev - 1):
+                f = 1.0 / (lev - j)
+                o = offsets[j]
+                e0 = d0 * f
+                e1 = d1 * f
+                e2 = d2 * f
+                for p in range(size):
+                    t = buf[cur + p] + s[o + p]
+                    buf[nxt + p] = t * e0
+                    buf[nxt + size + p] = t * e1
+                    buf[nxt + 2 * size + p] = t * e2
+                size *= 3
+                cur, nxt = nxt, cur
+            o = offsets[lev - 1]
+            ok = offsets[lev]
+            for p in range(size):
+                t = buf[cur + p] + s[o + p]
+                s[ok + p] += t * d0
+                s[ok + size + p] += t * d1
+                s[ok + 2 * size + p] += t * d2
+        s[0] += d0
+        s[1] += d1
+        s[2] += d2
+
+
+@njit(cache=True)
+def _sig_chunk(x, b, lo, hi, d, m, offsets, s):
+    """``s <- `` signature of points ``lo..hi`` of path ``b`` (reversed layout), Horner-Chen form.
+
+    Per segment with increment ``D``, ``s <- s ⊗ exp(D)`` level by level from the top (so lower
+    levels are still the old ones): ``s_k += (((D/k + s_1) ⊗ D/(k-1) + s_2) ⊗ ... + s_{k-1}) ⊗ D``,
+    folded as ``B_1 = D/k``, ``B_{j+1} = (B_j + s_j) ⊗ D/(k-j)``, ``s_k += (B_{k-1} + s_{k-1}) ⊗ D``
+    (each ``B_j + s_j`` formed once and multiplied by all ``d`` letters in the same pass).
+    About ``d^m (1 + 2/(d-1))`` flops per point and no allocation inside the loop: one scratch
+    buffer holds two ping-pong halves addressed by integer offsets (swapping array references in
+    the loop would cost reference counting on every step). ``d = 2, 3`` have the letter loop
+    unrolled (about 2x faster than the generic loop).
+    """
+    for i in range(s.shape[0]):
+        s[i] = 0.0
+    if d == 2:
+        _sig_chunk_d2(x, b, lo, hi, m, offsets, s)
+    elif d == 3:
+        _sig_chunk_d3(x, b, lo, hi, m, offsets, s)
+    else:
+        _sig_chunk_generic(x, b, lo, hi, d, m, offsets, s)
 
 
 @njit(cache=True)
