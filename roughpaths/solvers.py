@@ -122,6 +122,8 @@ class Davie(Solver):
     smooth_order = 2.0
 
     def step(self, fields, y, t, dt, dX, dXX):
+        if getattr(fields, "is_linear", False):
+            return self._linear_step(fields, y, dt, dX, dXX)
         V = fields.fields(y)
         J = fields.jacobians(y)
         noise = (V @ dX[..., None])[..., 0]
@@ -132,6 +134,19 @@ class Davie(Solver):
         f1 = fields.drift(y + f0 * dt + noise)
         cross = np.einsum("...iab,...b,...i->...a", J, f0, dX)     # Σ_i X^i DV_i·V_0
         return y + 0.5 * dt * (f0 + f1) + noise + second + 0.5 * dt * cross
+
+    @staticmethod
+    def _linear_step(fields, y, dt, dX, dXX):
+        # same formula for V_i(y) = M_i y, V_0(y) = A y: DV_j·V_i = M_j M_i y, DV_i·V_0 = M_i A y
+        Mx, G2 = fields._linear_parts(dX, dXX)                     # Σ x^i M_i, Σ XX^{ij} M_j M_i
+        noise = (Mx @ y[..., None])[..., 0]
+        out = y + noise + (G2 @ y[..., None])[..., 0]
+        A = fields.drift_matrix
+        if fields.has_drift:
+            f0 = y @ A.T
+            f1 = (y + f0 * dt + noise) @ A.T
+            out = out + 0.5 * dt * (f0 + f1) + 0.5 * dt * (Mx @ f0[..., None])[..., 0]
+        return out
 
 
 class LogODE(Solver):

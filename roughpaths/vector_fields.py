@@ -389,17 +389,23 @@ class LinearVectorFields(VectorFields):
         MjMi = np.einsum("jab,ibc->ijac", M, M)
         return MjMi - np.swapaxes(MjMi, 0, 1)
 
-    def _logode_generator(self, dt, dX, L):
-        r"""``G = A_0 h + Σ_i x^i M_i + Σ_ij L^{ij} M_j M_i`` for a batch of steps, shape ``(..., e, e)``."""
+    def _linear_parts(self, dX, L):
+        r"""``(Σ_i x^i M_i, Σ_ij L^{ij} M_j M_i)`` for a batch of steps, each of shape ``(..., e, e)``."""
         d, e = self.dim_noise, self.dim_state
-        cache = self.__dict__.get("_gen_cache")
+        cache = getattr(self, "_gen_cache", None)
         if cache is None:
             M = self.matrices
             cache = (M.reshape(d, e * e), np.einsum("jab,ibc->ijac", M, M).reshape(d * d, e * e))
             self._gen_cache = cache
         Mflat, MMflat = cache
-        G = dX @ Mflat + L.reshape(L.shape[:-2] + (d * d,)) @ MMflat
-        G = G.reshape(G.shape[:-1] + (e, e))
+        Mx = (dX @ Mflat).reshape(dX.shape[:-1] + (e, e))
+        G2 = (L.reshape(L.shape[:-2] + (d * d,)) @ MMflat).reshape(L.shape[:-2] + (e, e))
+        return Mx, G2
+
+    def _logode_generator(self, dt, dX, L):
+        r"""``G = A_0 h + Σ_i x^i M_i + Σ_ij L^{ij} M_j M_i`` for a batch of steps, shape ``(..., e, e)``."""
+        Mx, G2 = self._linear_parts(dX, L)
+        G = Mx + G2
         if self._drift is not None:
             G = G + dt * self._drift.matrix
         return G
