@@ -41,8 +41,9 @@ counting each pair ``i < j`` once), and its variance is :math:`h^2/4 - h^2/(12 m
 moment of ``(W, A)`` is then exact, also conditionally on ``W``
 (:math:`\mathrm{Var}(A_{ij}\mid W) = h^2/12 + h(W_i^2 + W_j^2)/12`), and so is the
 conditional mean; the residual law error is in the fourth and higher cumulants and decays like
-``1/m`` (for d = 2 and the default ``m = 8`` the excess kurtosis is 1.96 against the exact 2,
-and a Kolmogorov–Smirnov test with 4·10⁵ samples cannot tell it from the exact law). Its
+``1/m`` (d = 2, measured with 2·10⁶ samples: excess kurtosis 1.36 for ``m = 1`` and 2.00 for the
+default ``m = 8``, exact value 2; a Kolmogorov–Smirnov test with 4·10⁵ samples cannot tell the
+``m = 8`` law from the exact one). Its
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
 component (the added Gaussian is independent of the path).
 
