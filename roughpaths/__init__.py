@@ -16,6 +16,20 @@ from .norms import (
     rough_path_p_variation,
 )
 from .rough_path import RoughPath, chen_defect
+from .signature import logsignature, rough_path_signature, signature
+from .tensor_algebra import (
+    from_level2,
+    from_lyndon_coordinates,
+    logsigdim,
+    lyndon_basis,
+    lyndon_coordinates,
+    sigdim,
+    tensor_exp,
+    tensor_inverse,
+    tensor_log,
+    tensor_product,
+    to_level2,
+)
 
 __version__ = "0.1.0"
 
@@ -33,4 +47,18 @@ __all__ = [
     "area_p_variation",
     "rough_path_p_variation",
     "holder_distance",
+    "signature",
+    "logsignature",
+    "rough_path_signature",
+    "sigdim",
+    "logsigdim",
+    "tensor_product",
+    "tensor_inverse",
+    "tensor_exp",
+    "tensor_log",
+    "to_level2",
+    "from_level2",
+    "lyndon_basis",
+    "lyndon_coordinates",
+    "from_lyndon_coordinates",
 ]
