@@ -5,6 +5,7 @@ Conventions are fixed once, in ``CONVENTIONS.md`` of the project: the area ``XX[
 Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """
 
+from .brownian import DEFAULT_SUBSTEPS, brownian_increments_and_areas, brownian_rough_path, refine
 from .level2 import level2_exp, level2_inv, level2_log, level2_mul
 from .norms import (
     area_holder_seminorm,
@@ -36,6 +37,10 @@ __version__ = "0.1.0"
 __all__ = [
     "RoughPath",
     "chen_defect",
+    "brownian_rough_path",
+    "brownian_increments_and_areas",
+    "refine",
+    "DEFAULT_SUBSTEPS",
     "level2_mul",
     "level2_inv",
     "level2_exp",
