@@ -499,7 +499,7 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
 
 # ---------------------------------------------------------------------- Brownian streaming
 def _brownian_chunk(rng, batch, k, dt, m, levy_area, substeps):
-    """Increments (batch, k, m) and Lévy areas (batch, k, m, m) (or None) of Stratonovich Brownian motion.
+    r"""Increments (batch, k, m) and Lévy areas (batch, k, m, m) (or None) of Stratonovich Brownian motion.
 
     ``substeps == 1`` with the Davie area (or no area): drawn here in the same order as the fused
     numba kernel (step-major; per step and path: ``dW`` (m), ``H`` (m), ``lambda`` (m(m-1)/2)), so
