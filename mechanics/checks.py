@@ -245,7 +245,7 @@ def check_casimir(ctx) -> CheckResult:
     from mechanics.rigid_body import rigid_body
 
     n = ctx.size("casimir.steps", tiny=1_000, default=10_000, full=100_000)
-    P = ctx.size("casimir.paths", tiny=16, default=256, full=1_000)
+    P = ctx.size("casimir.paths", tiny=16, default=64, full=1_000)
     body = rigid_body(INERTIA, sigma=0.5, s=_s(s13=25.0), theta=THETA)
     _, out = simulate_brownian(body, E3, 0.01, n, ctx.rng("casimir"), n_paths=P, save_every=n)
     err = float(np.max(np.abs(np.linalg.norm(out, axis=-1) - 1.0)))
@@ -437,7 +437,7 @@ def check_wong_zakai(ctx) -> CheckResult:
 
     A, D = paper_coloured_noise_matrices(0.05)
     P = ctx.size("wz.paths", tiny=100, default=1_000, full=4_000)
-    eps = ctx.size("wz.eps", tiny=0.05, default=0.02, full=0.01)
+    eps = ctx.size("wz.eps", tiny=0.02, default=0.02, full=0.01)
     T = 2.0
     r = simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, inertia=INERTIA, theta=THETA, Pi0=E3, T=T, n_paths=P,
                                        rng=ctx.rng("wong_zakai"), save_every=10**9,
