@@ -346,8 +346,10 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     n_paths = check_positive_int(n_paths, "n_paths")
     if mu0.ndim not in (1, 2) or (mu0.ndim == 2 and mu0.shape[0] != n_paths):
         raise ValueError(f"mu0 must have shape ({n},) or (n_paths, {n}) = ({n_paths}, {n}), got {mu0.shape}.")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
         raise TypeError(f"seed must be a non-negative integer, got {seed!r}.")
+    if seed < 0:
+        raise ValueError(f"seed must be a non-negative integer (SeedSequence entropy), got {seed!r}.")
     if levy_area not in (None, "davie", "foster"):
         raise ValueError(f"levy_area must be None, 'davie' or 'foster', got {levy_area!r}.")
     if not callable(observable):
