@@ -137,6 +137,26 @@ class GibbsMeasure:
         self._kappa = self.radius ** 2 * float(a[-1] - a[0]) + self.radius * float(np.linalg.norm(self._c))
         self._q: _Quadrature | None = None
 
+    @classmethod
+    def from_system(cls, system, *, radius=1.0, rtol=1e-10, max_nodes=40_000_000) -> "GibbsMeasure":
+        """The Gibbs law of a rigid-body system (``mechanics.rigid_body.rigid_body``) with isotropic noise.
+
+        Uses ``system.inertia``, ``system.theta``, ``σ`` from ``system.xi = σ I`` (anything else
+        raises: Theorem 3.1 needs isotropic noise) and ``c = system.torque_velocity`` (the shift
+        actually in its ``h̃``; for ``convention="paper"`` that is the flipped one).
+        """
+        for attr in ("inertia", "xi", "theta", "torque_velocity"):
+            if not hasattr(system, attr):
+                raise TypeError(f"system must be a rigid body (mechanics.rigid_body.rigid_body), it has no .{attr}.")
+        xi = np.asarray(system.xi, dtype=np.float64)
+        sigma = float(xi[0, 0]) if xi.shape == (3, 3) else 0.0
+        if xi.shape != (3, 3) or not np.allclose(xi, sigma * np.eye(3), rtol=0, atol=1e-14 * max(abs(sigma), 1e-300)) \
+                or sigma == 0.0:
+            raise ValueError("the Gibbs density exp(-2θh̃/σ²) needs isotropic noise xi = σ·I with σ != 0; "
+                             f"this system has xi of shape {xi.shape}.")
+        return cls(system.inertia, system.torque_velocity, sigma=abs(sigma), theta=system.theta, radius=radius,
+                   rtol=rtol, max_nodes=max_nodes)
+
     # ------------------------------------------------------------------ the density
     def energy(self, Pi) -> np.ndarray:
         """``h̃(Π)`` for ``Π`` of shape ``(..., 3)``."""

@@ -266,3 +266,15 @@ def test_bad_levy_matrix():
         isotropic_levy_shift(0.1, np.ones((3, 3)))
     with pytest.raises(ValueError, match="convention"):
         isotropic_levy_shift(0.1, np.zeros((3, 3)), convention="ito")
+
+
+def test_sleeping_top_is_an_equilibrium_of_the_library_heavy_top():
+    ht = pytest.importorskip("mechanics.heavy_top")
+    I1, I3, mgl = 1.0, 2.0, 1.0
+    for om3 in (0.9, 2.0):
+        top = ht.heavy_top([I1, I1, I3], [0.0, 0.0, mgl])
+        mu = np.array([0.0, 0.0, I3 * om3, 0.0, 0.0, 1.0])
+        assert np.allclose(top.drift(mu), 0.0, atol=1e-14)
+        ev = np.sort_complex(np.linalg.eigvals(top.drift_jacobian(mu)))
+        out = lagrange_top_sleeping_stability(I1, I3, om3, mgl)
+        assert np.allclose(ev, np.sort_complex(out["eigenvalues"]), atol=1e-10)

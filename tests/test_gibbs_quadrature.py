@@ -138,3 +138,17 @@ def test_bad_input():
         GibbsMeasure([[1.0, 0.2, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]], beta=1.0)
     with pytest.raises(ValueError, match="max_nodes"):
         GibbsMeasure([1.0, 2.0, 3.0], beta=1e7).mean
+
+
+def test_from_system():
+    from mechanics.rigid_body import rigid_body
+
+    s = np.zeros((3, 3))
+    s[0, 2], s[2, 0] = 1.0, -1.0
+    g = GibbsMeasure.from_system(rigid_body([1.0, 2.0, 3.0], sigma=0.5, s=s, theta=1.0))
+    ref = GibbsMeasure([1.0, 2.0, 3.0], [0.0, -0.25, 0.0], beta=8.0)
+    assert np.allclose(g.mean, ref.mean, atol=1e-14)
+    gp = GibbsMeasure.from_system(rigid_body([1.0, 2.0, 3.0], sigma=0.5, s=s, theta=1.0, convention="paper"))
+    assert np.allclose(gp.mean, -ref.mean, atol=1e-14)     # flipped torque c -> -c: mirrored law
+    with pytest.raises(ValueError, match="isotropic"):
+        GibbsMeasure.from_system(rigid_body([1.0, 2.0, 3.0], xi=np.diag([0.1, 0.2, 0.3]), theta=1.0))
