@@ -62,6 +62,7 @@ import numbers
 import numpy as np
 
 from ._validation import as_float_array, check_positive_int, check_rng, check_times
+from ._brownian_kernels import _step_areas
 from .level2 import outer
 from .rough_path import RoughPath
 
@@ -72,7 +73,8 @@ DEFAULT_SUBSTEPS = 8
 
 _LEVY_METHODS = ("davie", "foster")
 _KINDS = ("stratonovich", "ito")
-# Rows (steps) processed per chunk, sized so temporaries stay around 100 MB.
+# Rows (steps) per chunk of random draws: chunk = _CHUNK_FLOATS // (4 m d + d²) (buffers ~16 MB).
+# The chunking fixes which normals go to which step: changing it changes the samples of a seed.
 _CHUNK_FLOATS = 1 << 22
 
 
@@ -156,26 +158,45 @@ def _antisym_normal(rng: np.random.Generator, shape: tuple, d: int) -> np.ndarra
     return out
 
 
-def _sample_levy_areas(rng, dW: np.ndarray, dt: np.ndarray, method: str, m: int) -> np.ndarray:
-    """Lévy areas ``(R, d, d)`` for rows ``dW (R, d)`` with step sizes ``dt (R,)``."""
+def _sample_areas(rng, dW: np.ndarray, dt: np.ndarray, method: str, m: int, ito: bool,
+                  out: np.ndarray) -> None:
+    """Step areas for rows ``dW (R, d)`` with step sizes ``dt (R,)``, written into ``out (R, d, d)``.
+
+    Draws, chunk by chunk, the bridge normals ``(c, m, d)`` (only if ``m > 1``), the space-time
+    normals ``(c, m, d)`` and, for ``"davie"``, ``(c, d(d-1)/2)`` normals, in this order, then
+    calls the fused numba kernel (:func:`roughpaths._brownian_kernels._step_areas`). The chunk
+    size and the draw order are those of the original numpy implementation, so a seed gives the
+    same random numbers as before; the areas agree with it to round-off.
+    """
     R, d = dW.shape
-    out = np.empty((R, d, d))
+    P = d * (d - 1) // 2
+    davie = method == "davie" and P > 0
     chunk = max(1, _CHUNK_FLOATS // (m * d * 4 + d * d))
+    c0 = min(chunk, R)
+    zbuf = np.empty(c0 * m * d) if m > 1 else None
+    hbuf = np.empty(c0 * m * d)
+    lbuf = np.empty(c0 * P) if davie else None
+    no_z = np.empty((0, 1, d))
+    no_lam = np.empty((0, max(P, 1)))
     for lo in range(0, R, chunk):
         hi = min(R, lo + chunk)
-        W, h = dW[lo:hi], dt[lo:hi]
-        sq = np.sqrt(h / m)[:, None, None]
-        if m == 1:
-            w = W[:, None, :]
-        else:  # Brownian bridge with the step's increment: subtract the mean of iid substeps
-            z = rng.standard_normal((hi - lo, m, d)) * sq
-            w = z - z.mean(axis=1, keepdims=True) + W[:, None, :] / m
-        H = rng.standard_normal((hi - lo, m, d)) * (sq / np.sqrt(12.0))
-        A = _levy_area_from_substeps(w, H)
-        if method == "davie":
-            A += _antisym_normal(rng, (hi - lo,), d) * (h / np.sqrt(12.0 * m))[:, None, None]
-        out[lo:hi] = A
-    return out
+        n = hi - lo
+        if m > 1:
+            z = zbuf[:n * m * d]
+            rng.standard_normal(out=z)
+            z = z.reshape(n, m, d)
+        else:
+            z = no_z
+        zeta = hbuf[:n * m * d]
+        rng.standard_normal(out=zeta)
+        zeta = zeta.reshape(n, m, d)
+        if davie:
+            lam = lbuf[:n * P]
+            rng.standard_normal(out=lam)
+            lam = lam.reshape(n, P)
+        else:
+            lam = no_lam
+        _step_areas(dW[lo:hi], dt[lo:hi], z, zeta, lam, m, davie, ito, out[lo:hi])
 
 
 # ---------------------------------------------------------------------------- public API
@@ -248,11 +269,9 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     if method is None:
         return dW, None
     rows = dW.reshape(-1, dim)
-    hrows = np.broadcast_to(h, batch_shape + (n_steps,)).reshape(-1)
-    A = _sample_levy_areas(rng, rows, hrows, method, m).reshape(shape + (dim,))
-    areas = A + 0.5 * outer(dW, dW)
-    if kind == "ito":
-        areas[..., np.arange(dim), np.arange(dim)] -= 0.5 * h[:, None]
+    hrows = np.ascontiguousarray(np.broadcast_to(h, batch_shape + (n_steps,)).reshape(-1))
+    areas = np.empty(shape + (dim,))
+    _sample_areas(rng, rows, hrows, method, m, kind == "ito", areas.reshape(-1, dim, dim))
     return dW, areas
 
 
