@@ -456,7 +456,7 @@ def fig2(ctx) -> FigureResult:
             marks=[((mean_pred[0], mean_pred[1]), dict(marker="x", color="cyan", ms=9, mew=2), "Gibbs mean"),
                    ((xy[:, 0].mean(), xy[:, 1].mean()), dict(marker="+", color="lime", ms=11, mew=2), "time average"),
                    ((eq[0], eq[1]), dict(marker="D", mfc="none", mec="white", ms=8, mew=1.5), "stable equilibrium")],
-            title=f"{s_label(s)}:  c = ({', '.join(f'{v:+.4g}' for v in body.torque_velocity)})")
+            title=f"{s_label(s)}:  c = ({', '.join(f'{v + 0.0:+.4g}' for v in body.torque_velocity)})")
         data.update({f"s_{k}": s, f"trajectory_{k}": traj, f"histogram_{k}": H, f"gibbs_binned_{k}": pred,
                      f"x_edges_{k}": edges[0], f"y_edges_{k}": edges[1], f"gibbs_mean_{k}": mean_pred,
                      f"equilibrium_{k}": eq, f"c_{k}": body.torque_velocity})
@@ -485,7 +485,7 @@ def _portrait(ctx, name, s, views, title):
                                   title=f"view: elevation {elev}°, azimuth {azim}°")
     cb = fig.colorbar(im, ax=fig.axes, fraction=0.03, pad=0.02)
     cb.set_label(r"$\tilde h(\Pi) = \frac{1}{2}\Pi\cdot\mathbb{I}^{-1}\Pi + c\cdot\Pi$")
-    fig.suptitle(f"{title}\nc = ({', '.join(f'{v:+.4g}' for v in c)}), convention '{ctx.convention}'", fontsize=11)
+    fig.suptitle(f"{title}\nc = ({', '.join(f'{v + 0.0:+.4g}' for v in c)}), convention '{ctx.convention}'", fontsize=11)
     data = dict(c=c, s=s, levels=ls.levels, separatrix=ls.separatrix,
                 equilibria=np.array([e.point for e in ls.equilibria]),
                 equilibrium_kinds=np.array([e.kind for e in ls.equilibria]),
@@ -638,7 +638,7 @@ def fig5(ctx) -> FigureResult:
     c = run["wz"].torque
     H1, f1 = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["limit"][0], res["times"], T, "limit with torque")
     H2, f2 = _wz_row(fig, [gs[1, 0], gs[1, 1], gs[1, 2]], res["no_torque"][0], res["times"], T, "limit, no torque")
-    fig.suptitle(f"Figure 5: white-noise limit, noise σA⁻¹D, torque c = ({', '.join(f'{v:+.4g}' for v in c)}), "
+    fig.suptitle(f"Figure 5: white-noise limit, noise σA⁻¹D, torque c = ({', '.join(f'{v + 0.0:+.4g}' for v in c)}), "
                  f"N¹³ = {run['wz'].limit.N[0, 2]:.4g}, T = {T:g}", fontsize=11)
     png, npz = _save(ctx, "fig5", fig, dict(times=res["times"], limit=res["limit"][0], no_torque=res["no_torque"][0],
                                             srblevy=res["srblevy"][0], torque=c, N=run["wz"].limit.N,
