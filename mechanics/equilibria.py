@@ -510,7 +510,7 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
     A = as_inverse_inertia(inertia)
     c = _as_c(c)
     r = _check_radius(radius)
-    eqs = rigid_body_equilibria(A_to_inertia(A), c, radius=r, theta=theta)
+    eqs = rigid_body_equilibria(_inertia_from_inverse(A), c, radius=r, theta=theta)
     emin, emax = eqs[0].energy, eqs[-1].energy
     if np.ndim(levels) == 0:
         n = int(levels)
@@ -549,8 +549,7 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
                      energy_range=(emin, emax))
 
 
-def A_to_inertia(A):
-    """Inverse of :func:`as_inverse_inertia` for a 3×3 ``𝕀⁻¹`` (helper; returns 𝕀)."""
+def _inertia_from_inverse(A):
     return np.linalg.inv(A)
 
 
