@@ -136,8 +136,8 @@ def check_on_orbit(system: LiePoissonSystem, mu, orbit, *, rtol: float = 1e-10, 
         k = idx[-1]
         names = system.algebra.casimir_names
         label = names[k] if k < len(names) else f"Casimir {k}"
-        raise ValueError(f"{name} is off the coadjoint orbit: {label} = {cas[idx]!r} at batch index "
-                         f"{tuple(int(i) for i in idx[:-1])}, expected {target[idx]!r} (relative error "
+        raise ValueError(f"{name} is off the coadjoint orbit: {label} = {float(cas[idx])!r} at batch index "
+                         f"{tuple(int(i) for i in idx[:-1])}, expected {float(target[idx])!r} (relative error "
                          f"{err[idx]:.3g} > {rtol:g}). A Casimir-preserving method keeps the orbit of the "
                          f"initial state; project {name} onto the orbit (e.g. normalise |Pi|) or pass the "
                          f"orbit it lies on.")

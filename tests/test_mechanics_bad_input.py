@@ -1,0 +1,141 @@
+"""Bad input to the mechanics layer raises a clear error (never a silent wrong answer, NaN or hang).
+
+Covers: non-symmetric / non-positive inertia, wrong ξ shapes, s not antisymmetric or of the wrong size,
+θ < 0 (and non-finite, non-numeric), unknown convention, states off the orbit for a Casimir-preserving
+run, a chord iteration that fails to converge (the message names the step), level-1 or non-geometric
+drivers, dimension mismatches, bad rng / dt / n_steps / save_every.
+"""
+
+import numpy as np
+import pytest
+
+from mechanics.heavy_top import heavy_top
+from mechanics.integrators import (ChordConvergenceError, ImplicitMidpoint, LieHeun, coadjoint_step,
+                                   simulate, simulate_brownian)
+from mechanics.lie_algebra import so3
+from mechanics.lie_poisson import LiePoissonSystem
+from mechanics.rigid_body import rigid_body
+from roughpaths import RoughPath
+
+I3 = [1.0, 2.0, 3.0]
+
+
+@pytest.mark.parametrize("inertia, match", [
+    ([[1.0, 0.5, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]], "symmetric"),
+    ([1.0, -2.0, 3.0], "positive definite"),
+    ([1.0, 0.0, 3.0], "positive definite"),
+    (np.eye(2), "3x3"),
+    ([1.0, np.nan, 3.0], "non-finite"),
+])
+def test_bad_inertia(inertia, match):
+    with pytest.raises(ValueError, match=match):
+        rigid_body(inertia, sigma=0.1)
+
+
+@pytest.mark.parametrize("xi", [np.ones(3), np.ones((3, 4)), np.ones((0, 3)), np.ones((2, 3, 3))])
+def test_bad_xi_shape(xi):
+    with pytest.raises(ValueError, match="xi must have shape"):
+        rigid_body(I3, xi=xi)
+    with pytest.raises(ValueError, match="xi must have shape"):
+        LiePoissonSystem(so3(), np.diag(I3), xi)
+
+
+def test_heavy_top_bad_xi_and_chi():
+    with pytest.raises(ValueError, match=r"\(m, 3\).*\(m, 6\)"):
+        heavy_top(I3, [0, 0, 1.0], xi=np.ones((2, 4)))
+    with pytest.raises(ValueError, match="chi"):
+        heavy_top(I3, [0, 1.0], sigma=0.1)
+
+
+def test_bad_s():
+    with pytest.raises(ValueError, match="antisymmetric"):
+        rigid_body(I3, sigma=0.1, s=np.ones((3, 3)))
+    with pytest.raises(ValueError, match="3x3"):
+        rigid_body(I3, sigma=0.1, s=[[0.0, 1.0], [-1.0, 0.0]])
+
+
+@pytest.mark.parametrize("theta, exc", [(-0.1, ValueError), (np.inf, ValueError), (float("nan"), ValueError),
+                                        ("1", TypeError), (True, TypeError)])
+def test_bad_theta(theta, exc):
+    with pytest.raises(exc, match="theta"):
+        rigid_body(I3, sigma=0.1, theta=theta)
+
+
+def test_bad_convention_sigma_and_both_noise_args():
+    with pytest.raises(ValueError, match="convention"):
+        rigid_body(I3, sigma=0.1, convention="Paper")
+    with pytest.raises(ValueError, match="not both"):
+        rigid_body(I3, xi=np.eye(3), sigma=0.1)
+    with pytest.raises(ValueError, match="sigma"):
+        rigid_body(I3, sigma=-0.1)
+
+
+def test_bad_hamiltonian_and_algebra():
+    with pytest.raises(TypeError, match="hamiltonian_gradient"):
+        LiePoissonSystem(so3(), lambda mu: mu @ mu, np.eye(3))
+    with pytest.raises(TypeError, match="LieAlgebra"):
+        LiePoissonSystem("so3", np.diag(I3), np.eye(3))
+
+
+def test_off_orbit_states_rejected(rng):
+    rb = rigid_body(I3, sigma=0.1, theta=1.0)
+    X = RoughPath.from_path(np.zeros((11, 3)))
+    with pytest.raises(ValueError, match=r"off the coadjoint orbit: \|mu\|\^2 = 4.0"):
+        simulate(rb, [0.0, 0.0, 2.0], X, orbit=[1.0])
+    with pytest.raises(ValueError, match="batch index \\(1,\\)"):
+        simulate_brownian(rb, [[0.0, 0.0, 1.0], [0.0, 0.0, 1.1]], 0.01, 10, rng, orbit=1.0)
+    top = heavy_top(I3, [0, 0, 1.0], sigma=0.1)
+    with pytest.raises(ValueError, match="Pi.Gamma"):
+        simulate(top, [1.0, 0, 0, 1.0, 0, 0], X, orbit=[1.0, 0.0])
+    simulate(top, [0.0, 1.0, 0, 1.0, 0, 0], X, orbit=[1.0, 0.0])      # on the orbit: accepted
+
+
+def test_chord_non_convergence_names_the_step(rng):
+    rb = rigid_body(I3, sigma=0.5, theta=50.0)
+    with pytest.raises(ChordConvergenceError, match=r"did not converge at step 0 .*max_iter = 1"):
+        simulate_brownian(rb, [0.0, 0.6, 0.8], 0.05, 5, rng, method=ImplicitMidpoint(tol=1e-15, max_iter=1))
+    X = RoughPath.from_path(np.cumsum(rng.standard_normal((3, 21, 3)) * 0.1, axis=1), times=np.linspace(0, 1, 21))
+    with pytest.raises(ChordConvergenceError, match="step 0"):
+        simulate(rb, [0.0, 0.6, 0.8], X, ImplicitMidpoint(tol=1e-15, max_iter=1))
+    generic = LiePoissonSystem(so3(), lambda m: 0.5 * np.sum(m * m / I3, -1), 0.5 * np.eye(3), theta=50.0,
+                               hamiltonian_gradient=lambda m: m / np.asarray(I3))
+    with pytest.raises(ChordConvergenceError, match=r"step 7 \(t = 0.35"):
+        coadjoint_step(generic, np.array([0.0, 0.6, 0.8]), 0.05, np.zeros(3), ImplicitMidpoint(tol=1e-15, max_iter=1),
+                       step_index=7, t=0.35)
+    with pytest.raises(ValueError, match="tol"):
+        ImplicitMidpoint(tol=-1.0)
+    with pytest.raises(ValueError, match="max_iter"):
+        ImplicitMidpoint(max_iter=0)
+
+
+def test_bad_drivers_and_shapes(rng):
+    rb = rigid_body(I3, sigma=0.1)
+    vals = np.cumsum(rng.standard_normal((11, 3)), axis=0)
+    X = RoughPath.from_path(vals)
+    with pytest.raises(ValueError, match="level-1"):
+        simulate(rb, [0, 0, 1.0], X.to_level1())
+    ito = RoughPath(X.increments, X.areas - 0.05 * np.eye(3), times=X.times, kind="ito")
+    with pytest.raises(ValueError, match="geometric"):
+        simulate(rb, [0, 0, 1.0], ito)
+    with pytest.raises(ValueError, match="dimension 2"):
+        simulate(rb, [0, 0, 1.0], RoughPath.from_path(vals[:, :2]))
+    with pytest.raises(ValueError, match="mu0 must have trailing shape"):
+        simulate(rb, [0, 1.0], X)
+    with pytest.raises(TypeError, match="RoughPath"):
+        simulate(rb, [0, 0, 1.0], vals)
+    with pytest.raises(TypeError, match="method"):
+        simulate(rb, [0, 0, 1.0], X, method="heun")
+    with pytest.raises(ValueError, match="save_every"):
+        simulate(rb, [0, 0, 1.0], X, save_every=0)
+    with pytest.raises(TypeError, match="Generator"):
+        simulate_brownian(rb, [0, 0, 1.0], 0.01, 10, 42)
+    with pytest.raises(ValueError, match="dt"):
+        simulate_brownian(rb, [0, 0, 1.0], -0.01, 10, rng)
+    with pytest.raises(ValueError, match="n_steps"):
+        simulate_brownian(rb, [0, 0, 1.0], 0.01, 0, rng)
+    with pytest.raises(ValueError, match="levy_area"):
+        simulate_brownian(rb, [0, 0, 1.0], 0.01, 10, rng, levy_area="exact")
+    with pytest.raises(ValueError, match="non-finite"):
+        simulate_brownian(rb, [0, np.nan, 1.0], 0.01, 10, rng)
+    with pytest.raises(ValueError, match="broadcast"):
+        simulate(rb, np.ones((4, 3)), RoughPath.from_path(np.stack([vals, vals, vals])))

@@ -1,0 +1,105 @@
+"""Proposition 2.1 (with the sign of CONVENTIONS.md): perturbing the area is a drift.
+
+Claim: for every geometric rough path X and antisymmetric s, the Lie–Poisson RDE
+dμ = ad*_{∇h} μ dt + ad*_{ξ_i} μ dX̃^i driven by X̃ = X.perturb(s) (area XX + s(t-s)) and the corrected
+RDE dμ = ad*_{∇h + ℓ} μ dt + ad*_{ξ_i} μ dX^i, ℓ = +½ s^{ij}[ξ_i, ξ_j], driven by X coincide pathwise.
+
+Checked three ways: (i) the coadjoint integrators, step by step (σ_n gains exactly ℓ Δt); (ii) the
+generic solver ``roughpaths.solve`` (LogODE, exact step by step), uncorrected fields on X̃ against the corrected drift on X;
+(iii) across the two families: coadjoint scheme (corrected, X) against Davie (uncorrected, X̃) on a
+fine grid. The paper's printed sign (convention="paper", ℓ → -ℓ) fails (ii)/(iii). The identity is
+about the undamped equation: with θ > 0 the perturbed driver yields double-bracket dissipation
+built from h, not h̃, so the two models differ (asserted too).
+"""
+
+import numpy as np
+import pytest
+
+from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate
+from mechanics.lie_algebra import sl2r, so3
+from mechanics.lie_poisson import LiePoissonSystem
+from mechanics.rigid_body import rigid_body
+from roughpaths import RoughPath
+
+S = np.array([[0.0, 1.5, -2.0], [-1.5, 0.0, 0.7], [2.0, -0.7, 0.0]])
+
+
+def _driver(rng, n=400, paths=6, scale=0.05):
+    vals = np.cumsum(rng.standard_normal((paths, n + 1, 3)) * scale, axis=1)
+    # a non-zero Lévy area per step: use a finer path and restrict (Chen areas)
+    fine = RoughPath.from_path(vals, times=np.linspace(0.0, 1.0, n + 1))
+    return fine.restrict(fine.times[::4])
+
+
+@pytest.mark.parametrize("method", [LieEuler(), LieHeun(), ImplicitMidpoint()], ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("algebra", [so3, sl2r], ids=["so3", "sl2r"])
+def test_integrators_perturbed_path_equals_corrected_system(method, algebra, rng):
+    X = _driver(rng)
+    scale = 1.0 if algebra is so3 else 0.3          # sl(2, R) orbits are non-compact: stay small
+    xi = scale * (0.8 * np.eye(3) + 0.2 * rng.standard_normal((3, 3)))
+    plain = LiePoissonSystem(algebra(), np.diag([1.0, 2.0, 3.0]), xi)
+    corrected = plain.with_s(S)
+    mu0 = scale * rng.standard_normal(3)
+    _, a = simulate(plain, mu0, X.perturb(S), method)
+    _, b = simulate(corrected, mu0, X, method)
+    np.testing.assert_allclose(a, b, atol=1e-12)
+    _, c = simulate(plain, mu0, X, method)          # without the correction: genuinely different
+    assert np.max(np.abs(c - b)) > 1e-3 * scale
+
+
+def test_levy_velocity_closed_form():
+    """ℓ = ½ s^{ij} ξ_i × ξ_j, for ξ_i = σ e_i: σ² (s23, -s13, s12) (CONVENTIONS.md)."""
+    rb = rigid_body([1.0, 2.0, 3.0], sigma=0.05, s=S)
+    naive = 0.5 * sum(S[i, j] * np.cross(0.05 * np.eye(3)[i], 0.05 * np.eye(3)[j]) for i in range(3) for j in range(3))
+    np.testing.assert_allclose(rb.levy_velocity, naive, atol=1e-15)
+    np.testing.assert_allclose(rb.levy_velocity, 0.05 ** 2 * np.array([S[1, 2], -S[0, 2], S[0, 1]]), atol=1e-15)
+    assert np.allclose(rigid_body([1.0, 2.0, 3.0], sigma=0.05, s=S, convention="paper").torque_velocity,
+                       -rb.levy_velocity)
+
+
+def _fields_drift(system):
+    return system.vector_fields()
+
+
+def test_generic_solver_perturbed_path_equals_friz_oberhauser_drift(rng):
+    solve_mod = pytest.importorskip("roughpaths.solve")
+    solvers = pytest.importorskip("roughpaths.solvers")
+    X = _driver(rng)
+    rb0 = rigid_body([1.0, 2.0, 3.0], sigma=0.7)
+    rb = rb0.with_s(S)
+    mu0 = np.array([0.0, 0.6, 0.8])
+    a = solve_mod.solve(rb0.vector_fields(), X.perturb(S), mu0, solvers.LogODE()).final
+    b = solve_mod.solve(rb.vector_fields(), X, mu0, solvers.LogODE()).final
+    np.testing.assert_allclose(a, b, atol=1e-12)
+    # the generic solver's own Friz–Oberhauser drift is our Lévy torque ad*_ℓ μ
+    fo = rb0.vector_fields().friz_oberhauser_drift(S)
+    np.testing.assert_allclose(fo(mu0), so3().ad_star(rb.levy_velocity, mu0), atol=1e-14)
+    paper_sys = rigid_body([1.0, 2.0, 3.0], sigma=0.7, s=S, convention="paper")
+    c = solve_mod.solve(paper_sys.vector_fields(), X, mu0, solvers.LogODE()).final
+    assert np.max(np.abs(c - a)) > 1e-2
+
+
+def test_coadjoint_scheme_agrees_with_generic_solver(rng):
+    """Independent families, fine grid: coadjoint (corrected, X) vs Davie (uncorrected, X.perturb(s))."""
+    solve_mod = pytest.importorskip("roughpaths.solve")
+    solvers = pytest.importorskip("roughpaths.solvers")
+    vals = np.cumsum(rng.standard_normal((4, 4001, 3)) * np.sqrt(1 / 4000), axis=1)
+    X = RoughPath.from_path(vals, times=np.linspace(0.0, 1.0, 4001))
+    rb0 = rigid_body([1.0, 2.0, 3.0], sigma=0.7)
+    mu0 = np.array([0.0, 0.6, 0.8])
+    a = solve_mod.solve(rb0.vector_fields(), X.perturb(S), mu0, solvers.Davie()).final
+    _, b = simulate(rb0.with_s(S), mu0, X, LieHeun(), save_every=4000)
+    _, c = simulate(rigid_body([1.0, 2.0, 3.0], sigma=0.7, s=S, convention="paper"), mu0, X, LieHeun(),
+                    save_every=4000)
+    err, wrong = np.max(np.abs(a - b[:, -1])), np.max(np.abs(a - c[:, -1]))
+    assert err < 5e-3, err
+    assert wrong > 20 * err, (err, wrong)
+
+
+def test_dissipative_models_differ(rng):
+    """With θ > 0: driving the h-dissipated body by X̃ is not the h̃-dissipated body on X (Theorem 3.1's model)."""
+    X = _driver(rng)
+    rb0 = rigid_body([1.0, 2.0, 3.0], sigma=0.7, theta=1.0)
+    _, a = simulate(rb0, [0.0, 0.6, 0.8], X.perturb(S), LieHeun())
+    _, b = simulate(rb0.with_s(S), [0.0, 0.6, 0.8], X, LieHeun())
+    assert np.max(np.abs(a - b)) > 1e-4
