@@ -207,7 +207,7 @@ def coloured_noise_limit(A, D) -> ColouredNoiseLimit:
 
     >>> from roughpaths.coloured_noise import coloured_noise_limit, paper_coloured_noise_matrices
     >>> lim = coloured_noise_limit(*paper_coloured_noise_matrices(k=0.05))
-    >>> round(lim.N[0, 2], 4), round(lim.unnormalised_area_rate[0, 2], 3)
+    >>> round(float(lim.N[0, 2]), 4), round(float(lim.unnormalised_area_rate[0, 2]), 3)
     (9.9751, 19.95)
     """
     A, D = _check_AD(A, D)
