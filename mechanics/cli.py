@@ -355,6 +355,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. `levy-area-paper --list | head`: not an error of the user's
+        try:
+            sys.stdout = open(os.devnull, "w")
+        except OSError:
+            pass
+        return 0
     except SystemExit as exc:  # --help / --version from argparse
         return int(exc.code or 0)
     except OSError as exc:  # e.g. disk full or the folder removed while writing

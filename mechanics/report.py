@@ -183,6 +183,13 @@ def _summary(checks: list[CheckResult]) -> dict:
     return counts
 
 
+_CONVENTION_NOTE = (
+    "The checks test the library's rough-path-correct mathematics whatever the convention; where a check "
+    "says so, the paper's printed variant is shown to fail. The convention option changes the figures only "
+    "(the Lévy torque's sign in Figures 2 and surf2..surf5)."
+)
+
+
 def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult],
                     out_dir: Path) -> str:
     """The Markdown report (figures referenced by relative path)."""
@@ -197,6 +204,8 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
         "",
         f"Checks: **{counts[PASS]} passed**, {counts[FAIL]} failed, {counts[ERROR]} errors, "
         f"{counts[SKIPPED]} skipped.",
+        "",
+        _CONVENTION_NOTE,
         "",
         "## Theorem and proposition checks",
         "",
@@ -274,6 +283,7 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
         f"<b>{e(meta.scale)}</b> · total time <b>{meta.total_seconds:.1f} s</b></p>",
         f"<p class='summary'>Checks: <b>{counts[PASS]} passed</b>, {counts[FAIL]} failed, "
         f"{counts[ERROR]} errors, {counts[SKIPPED]} skipped.</p>",
+        f"<p>{e(_CONVENTION_NOTE)}</p>",
         "<h2>Theorem and proposition checks</h2>",
         "<table><tr><th>check</th><th>claim</th><th>predicted</th><th>measured</th><th>tolerance</th>"
         "<th>result</th><th>time (s)</th></tr>",
