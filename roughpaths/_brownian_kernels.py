@@ -8,7 +8,8 @@ One call turns pre-drawn standard normals into the level-2 step areas of a chunk
 * space-time Lévy areas ``H_k = √(δ/12) ζ_k``;
 * the Chen sum of the conditional means,
   ``A = Σ_k (H_k⊗w_k - w_k⊗H_k) + Alt Σ_{k<l} w_k⊗w_l = g - gᵀ`` with
-  ``g = Σ_k (H_k + ½ S_k) ⊗ w_k``, ``S_k = Σ_{l<k} w_l`` (the exclusive running sum);
+  ``g = Σ_k (H_k + ½ S_k) ⊗ w_k``, ``S_k = Σ_{l<k} w_l`` (the exclusive running sum),
+  accumulated for the pairs ``i < j`` only;
 * for Davie's method, the independent antisymmetric Gaussian ``λ_{ij} h/√(12 m)`` (``i < j``,
   in ``numpy.triu_indices`` order);
 * the symmetric part ``½ W⊗W`` and, for Itô, ``-½ h I``.
@@ -54,6 +55,7 @@ def _step_areas(dW, h, z, zeta, lam, m, davie, ito, out):
         Receives ``A + ½ W⊗W (- ½ h I)``.
     """
     R, d = dW.shape
+    P = d * (d - 1) // 2
     nblk = (R + _BLOCK - 1) // _BLOCK
     inv_m = 1.0 / m
     inv_s12 = 1.0 / np.sqrt(12.0)
@@ -61,11 +63,11 @@ def _step_areas(dW, h, z, zeta, lam, m, davie, ito, out):
     for blk in prange(nblk):
         lo = blk * _BLOCK
         hi = min(R, lo + _BLOCK)
-        zbar = np.empty(d)
-        s = np.empty(d)
+        shift = np.zeros(d)      # √δ z̄ - W/m, so that w_k = √δ z_k - shift
+        s = np.empty(d)          # S_k = Σ_{l<k} w_l
         w = np.empty(d)
-        a = np.empty(d)
-        g = np.empty((d, d))
+        a = np.empty(d)          # H_k + ½ S_k
+        A = np.empty(P)          # Lévy area, pairs i < j in triu order
         for r in range(lo, hi):
             hr = h[r]
             sq = np.sqrt(hr * inv_m)
@@ -75,37 +77,34 @@ def _step_areas(dW, h, z, zeta, lam, m, davie, ito, out):
                     acc = 0.0
                     for k in range(m):
                         acc += z[r, k, j]
-                    zbar[j] = acc * inv_m
-            for i in range(d):
-                s[i] = 0.0
-                for j in range(d):
-                    g[i, j] = 0.0
+                    shift[j] = sq * acc * inv_m - dW[r, j] * inv_m
+            for j in range(d):
+                s[j] = 0.0
+            for p in range(P):
+                A[p] = 0.0
             for k in range(m):
-                for j in range(d):
-                    if m > 1:
-                        w[j] = sq * (z[r, k, j] - zbar[j]) + dW[r, j] * inv_m
-                    else:
-                        w[j] = dW[r, j]
-                    a[j] = sH * zeta[r, k, j] + 0.5 * s[j]
-                for i in range(d):
-                    ai = a[i]
+                if m > 1:
                     for j in range(d):
-                        g[i, j] += ai * w[j]
+                        w[j] = sq * z[r, k, j] - shift[j]
+                else:
+                    for j in range(d):
+                        w[j] = dW[r, j]
                 for j in range(d):
+                    a[j] = sH * zeta[r, k, j] + 0.5 * s[j]
                     s[j] += w[j]
+                p = 0
+                for i in range(d):         # (g - gᵀ)_{ij}, g = Σ_k a_k ⊗ w_k
+                    for j in range(i + 1, d):
+                        A[p] += a[i] * w[j] - a[j] * w[i]
+                        p += 1
+            c = hr * lam_scale
+            p = 0
             for i in range(d):
                 Wi = dW[r, i]
-                for j in range(d):
-                    out[r, i, j] = (g[i, j] - g[j, i]) + 0.5 * Wi * dW[r, j]
-            if davie:
-                c = hr * lam_scale
-                p = 0
-                for i in range(d):
-                    for j in range(i + 1, d):
-                        v = lam[r, p] * c
-                        out[r, i, j] += v
-                        out[r, j, i] -= v
-                        p += 1
-            if ito:
-                for i in range(d):
-                    out[r, i, i] -= 0.5 * hr
+                out[r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
+                for j in range(i + 1, d):
+                    v = A[p] + (lam[r, p] * c if davie else 0.0)
+                    sym = 0.5 * Wi * dW[r, j]
+                    out[r, i, j] = sym + v
+                    out[r, j, i] = sym - v
+                    p += 1
