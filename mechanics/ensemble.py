@@ -130,8 +130,11 @@ def moment_observable(x) -> np.ndarray:
     """``(x, x_i x_j for i ≤ j)``: first and second moments; ``(..., n)`` → ``(..., n + n(n+1)/2)``."""
     x = np.asarray(x, dtype=np.float64)
     n = x.shape[-1]
-    iu = np.triu_indices(n)
-    return np.concatenate([x, (x[..., :, None] * x[..., None, :])[..., iu[0], iu[1]]], axis=-1)
+    i, j = np.triu_indices(n)
+    out = np.empty(x.shape[:-1] + (n + len(i),))
+    out[..., :n] = x
+    np.multiply(x[..., i], x[..., j], out=out[..., n:])
+    return out
 
 
 def split_moment_features(values, n: int):
@@ -232,6 +235,16 @@ def _draw_block(gens, k, dt, m, levy_area):
     return dW, areas
 
 
+def _observable_sum(observable, window):
+    """``Σ_t observable(window[:, t])`` per path, ``(c, T, n) → (c, p)``; BLAS fast path for the moments."""
+    if observable is moment_observable:
+        n = window.shape[-1]
+        i, j = np.triu_indices(n)
+        second = np.matmul(np.swapaxes(window, 1, 2), window)        # (c, n, n) = Σ_t x xᵀ
+        return np.concatenate([window.sum(axis=1), second[:, i, j]], axis=-1)
+    return np.asarray(observable(window)).sum(axis=1)
+
+
 def _run_chunk(spec: _Spec, first: int, last: int):
     """Simulate paths ``first .. last-1``; return their statistics (picklable)."""
     from roughpaths.rough_path import RoughPath
@@ -262,10 +275,13 @@ def _run_chunk(spec: _Spec, first: int, last: int):
         X = RoughPath(dW, areas, times=times, kind="geometric", check=False)
         _, states = simulate(system, mu, X, spec.method)            # (c, k+1, n)
         idx = step + np.arange(1, k + 1)                             # global step numbers of states[:, 1:]
-        sel = (idx > spec.burn_in) & (idx % spec.average_every == 0)
-        if np.any(sel):
-            acc += np.asarray(spec.observable(states[:, 1:][:, sel])).sum(axis=1)
-            n_avg += int(sel.sum())
+        # averaged steps: idx > burn_in and idx % average_every == 0, as a strided slice (no copy)
+        first_ok = max(spec.burn_in + 1, step + 1)
+        first_ok += (-first_ok) % spec.average_every
+        if first_ok <= step + k:
+            window = states[:, 1 + first_ok - step - 1::spec.average_every]
+            acc += _observable_sum(spec.observable, window)
+            n_avg += window.shape[1]
         if spec.record_every is not None:
             for j in np.nonzero(idx % spec.record_every == 0)[0]:
                 snaps.append(RunningMoments(p).update(np.asarray(spec.observable(states[:, j + 1]))))

@@ -100,10 +100,23 @@ def test_statistics_match_a_direct_simulation():
     assert np.allclose(res.snapshot_times, [0.0, 0.45, 0.9])
     for t_idx, snap in zip((0, 45, 90), res.snapshots):
         assert np.allclose(snap.mean, f[:, t_idx].mean(0), atol=1e-13)
+    # strided time averages: steps n > burn with n % 4 == 0, across block boundaries
+    res4 = run_ensemble(RB, [0.0, 0.0, 1.0], dt=dt, n_steps=n_steps, n_paths=n_paths, seed=7,
+                        burn_in=burn + 1, average_every=4, chunk_size=4, block_steps=25)
+    steps = [n for n in range(1, n_steps + 1) if n > burn + 1 and n % 4 == 0]
+    assert np.allclose(res4.time_average.mean, f[:, steps].mean(axis=1).mean(0), atol=1e-13)
+    # a user observable goes through the generic path
+    res_e = run_ensemble(RB, [0.0, 0.0, 1.0], dt=dt, n_steps=n_steps, n_paths=n_paths, seed=7,
+                         burn_in=burn, observable=_energy_like, chunk_size=4, block_steps=25)
+    assert np.allclose(res_e.time_average.mean, _energy_like(traj[:, burn + 1:]).mean(axis=1).mean(0), atol=1e-13)
     mean, m2, se, se2 = res.moments("final")
     assert np.allclose(mean, traj[:, -1].mean(0), atol=1e-13)
     assert np.allclose(m2, np.einsum("pi,pj->ij", traj[:, -1], traj[:, -1]) / n_paths, atol=1e-13)
     assert np.allclose(se, traj[:, -1].std(0, ddof=1) / np.sqrt(n_paths), atol=1e-13)
+
+
+def _energy_like(x):
+    return np.stack([0.5 * (x[..., 0] ** 2 + x[..., 1] ** 2 / 2 + x[..., 2] ** 2 / 3), x[..., 2] ** 3], axis=-1)
 
 
 def test_per_path_initial_states():
