@@ -33,7 +33,7 @@ module-level function, not a lambda, as ``observable``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np

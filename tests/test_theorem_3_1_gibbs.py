@@ -18,7 +18,6 @@ paths never cross the equator (barrier ≈ 26/β), so the prediction there is th
 conditioned on the northern hemisphere, except for the unimodal s12 = −50, s13 = s23 = 25 case.
 """
 
-import math
 
 import numpy as np
 import pytest
