@@ -454,7 +454,7 @@ def check_wong_zakai(ctx) -> CheckResult:
     from roughpaths.coloured_noise import paper_coloured_noise_matrices
 
     A, D = paper_coloured_noise_matrices(0.05)
-    P = ctx.size("wz.paths", tiny=100, default=1_000, full=4_000)
+    P = ctx.size("wz.paths", tiny=600, default=1_000, full=4_000)
     eps = ctx.size("wz.eps", tiny=0.02, default=0.02, full=0.01)
     T = 2.0
     r = simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, inertia=INERTIA, theta=THETA, Pi0=E3, T=T, n_paths=P,

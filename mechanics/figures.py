@@ -441,7 +441,7 @@ def fig2(ctx) -> FigureResult:
     for k, s in enumerate(FIG2_S):
         body = _body(ctx, s=s)
         # the same seed for every panel: the same Brownian path (the paper's "identical realisation")
-        times, traj = _simulate_long(ctx, body, ctx.rng("fig2"), T, dt, f"fig2: {s_label(s)}".replace("$", ""), save)
+        times, traj = _simulate_long(ctx, body, ctx.rng("fig2"), T, dt, f"fig2: {s_label(s)}".replace("$^{", "").replace("}$", ""), save)
         g = _gibbs(body)
         keep = times >= 0.1 * T
         xy = traj[keep][:, :2]
