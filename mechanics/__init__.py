@@ -3,8 +3,77 @@
 Lie–Poisson / Euler–Poincaré equations with SALT noise, the Lévy-area correction, double-bracket
 dissipation, Casimir-preserving integrators, the stochastic rigid body and heavy top, Gibbs measures,
 and the coloured-noise Wong–Zakai anomaly, built on :mod:`roughpaths`.
+
+Conventions (``CONVENTIONS.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
+velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``h̃ = h + ⟨μ, ℓ⟩``; the
+paper's printed signs are available as ``convention="paper"``.
 """
+
+from .ensemble import (
+    EnsembleResult,
+    RunningMoments,
+    moment_observable,
+    path_generator,
+    run_ensemble,
+    split_moment_features,
+)
+from .equilibria import (
+    Equilibrium,
+    LevelSets,
+    isotropic_levy_shift,
+    lagrange_top_sleeping_stability,
+    modified_hamiltonian,
+    rigid_body_equilibria,
+    rigid_body_level_sets,
+    rigid_body_vector_field,
+)
+from .gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
+from .heavy_top import HeavyTop, heavy_top
+from .integrators import (
+    ChordConvergenceError,
+    ImplicitMidpoint,
+    LieEuler,
+    LieHeun,
+    check_on_orbit,
+    coadjoint_step,
+    simulate,
+    simulate_brownian,
+)
+from .lie_algebra import LieAlgebra, expm_batched, hat, se3, sl2r, so3, su2, vee
+from .lie_poisson import Hamiltonian, LiePoissonSystem, QuadraticHamiltonian, check_inertia, girsanov_shift
+from .rigid_body import RigidBody, isotropic_xi, rigid_body
+from .wong_zakai import (
+    PlanarExample,
+    RigidBodyWongZakai,
+    integrate_rigid_body,
+    levy_torque,
+    planar_example,
+    planar_limit_moments,
+    rigid_body_wong_zakai_limit,
+    simulate_planar_coloured,
+    simulate_wong_zakai_rigid_body,
+)
 
 __version__ = "0.1.0"
 
-__all__: list[str] = []
+__all__ = [
+    # Lie algebras
+    "LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee", "expm_batched",
+    # Lie–Poisson systems
+    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia",
+    "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
+    # integrators
+    "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
+    "simulate", "simulate_brownian", "check_on_orbit",
+    # equilibria, phase portraits, Gibbs measures
+    "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",
+    "modified_hamiltonian", "rigid_body_vector_field", "lagrange_top_sleeping_stability",
+    "GibbsMeasure", "gibbs_beta", "gibbs_moments",
+    # ensembles
+    "run_ensemble", "EnsembleResult", "RunningMoments", "moment_observable", "split_moment_features",
+    "path_generator",
+    # coloured noise and the Wong–Zakai anomaly
+    "levy_torque", "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "integrate_rigid_body",
+    "simulate_wong_zakai_rigid_body", "PlanarExample", "planar_example", "planar_limit_moments",
+    "simulate_planar_coloured",
+]
