@@ -3,5 +3,5 @@
 # e.g. ./test.sh -m slow  (the long statistical runs), ./test.sh -x -q tests/test_chen_identity.py
 set -euo pipefail
 cd "$(dirname "$0")"
-PY="$(tools/setup_env.sh test | tail -n 1)"
+PY="$(tools/setup_env.sh test,docs | tail -n 1)"
 exec "$PY" -m pytest "$@"
