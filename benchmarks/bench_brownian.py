@@ -21,20 +21,13 @@ The machine is shared: compare ratios within one run, not absolute times across 
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
 from roughpaths.brownian import _CHUNK_FLOATS, brownian_increments_and_areas
 
 
-def _median_time(fn, repeats: int) -> float:
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
+from _timing import median_time as _median_time
 
 
 def _numpy_reference(rng, n_steps, h, d, paths, m):

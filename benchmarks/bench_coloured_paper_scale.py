@@ -15,21 +15,16 @@ Run: python benchmarks/bench_coloured_paper_scale.py [--T 0.2] [--paths 64]
 """
 
 import argparse
-import time
 
 import numpy as np
 
+from _timing import median_time
 from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_coloured_noise
 from mechanics.wong_zakai import integrate_rigid_body, simulate_wong_zakai_rigid_body
 
 
 def timed(fn, repeat=3):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
+    return median_time(fn, repeat)
 
 
 def main():

@@ -45,13 +45,7 @@ def make_fields(sigma: float) -> LinearVectorFields:
     return LinearVectorFields(M, drift=A)
 
 
-def median_time(fn, repeats: int) -> float:
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
+from _timing import median_time
 
 
 def error_ladder(V, paths, n0, levels, seed):

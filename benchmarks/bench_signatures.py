@@ -22,19 +22,13 @@ import argparse
 import os
 import subprocess
 import sys
-import time
 
 import numpy as np
+from _timing import median_time as _median_time
 
 
 def median_time(fn, repeats: int) -> float:
-    fn()  # warm-up (compilation, caches)
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
+    return _median_time(fn, repeats, warmup=True)   # warm-up: compilation, caches
 
 
 def warm_start_seconds() -> tuple:
