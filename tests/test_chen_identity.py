@@ -16,19 +16,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from _oracles import naive_area
 from roughpaths.rough_path import RoughPath
 
 iisignature = pytest.importorskip("iisignature")
 
 
-def naive_area(inc, areas, i, j):
-    d = inc.shape[-1]
-    out = np.zeros((d, d))
-    for k in range(i, j):
-        out += areas[k]
-        for l in range(k + 1, j):
-            out += np.outer(inc[k], inc[l])
-    return out
 
 
 @st.composite

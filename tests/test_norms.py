@@ -24,19 +24,11 @@ from hypothesis import strategies as st
 from roughpaths.norms import (area_holder_seminorm, area_p_variation, holder_distance,
                               holder_seminorm, p_variation, rough_path_holder_norm,
                               rough_path_p_variation)
+from _oracles import naive_area
 from roughpaths.rough_path import RoughPath
 
 
 # ----------------------------------------------------------------------------- naive oracles
-def naive_area(inc, areas, i, j):
-    """XX over steps i..j-1 by the iterated-sum definition: Σ_k A_k + Σ_{k<l} ΔX_k ⊗ ΔX_l."""
-    d = inc.shape[-1]
-    out = np.zeros((d, d))
-    for k in range(i, j):
-        out += areas[k]
-        for l in range(k + 1, j):
-            out += np.outer(inc[k], inc[l])
-    return out
 
 
 def naive_holder(inc, areas, times, alpha):

@@ -1,0 +1,17 @@
+"""Naive reference implementations shared by several test modules (independent of the library)."""
+
+import numpy as np
+
+
+def naive_area(inc, areas, i, j):
+    """XX over steps i..j-1 by the iterated-sum definition: Σ_k A_k + Σ_{k<l} ΔX_k ⊗ ΔX_l.
+
+    ``inc`` has shape (N, d) and ``areas`` (N, d, d) (one path); a plain double loop, no Chen.
+    """
+    d = inc.shape[-1]
+    out = np.zeros((d, d))
+    for k in range(i, j):
+        out += areas[k]
+        for l in range(k + 1, j):
+            out += np.outer(inc[k], inc[l])
+    return out
