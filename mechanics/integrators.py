@@ -311,79 +311,195 @@ def _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_it
     return n0, n1, n2, True
 
 
-@numba.njit(cache=True)
-def _so3_kernel(mu, eta, dts, q, lin, minv, theta, code, tol, max_iter, save_every, phase, out, k0):
-    """Advance mu (B, 3) in place over eta (B, K, 3); store every save_every-th state into out.
+# Structure-of-arrays block kernels. The state lives in three contiguous rows m[0], m[1], m[2]
+# (one entry per path) and every step is a loop over paths whose body is pure arithmetic, so LLVM
+# vectorises it (SIMD over paths). All constants are unpacked into scalars before the loops (no
+# aliasing with the state rows, nothing recomputed per step). The Rodrigues factors use the Taylor
+# branch of `_rod` (exact in float64 for |sigma|² < 1e-2, no trig); paths whose |sigma|² exceeds it
+# keep their old state in the vector loop, are flagged, and are redone by the scalar exact step.
+_NCOEF = 30
+_FAST_BUFFER_BYTES = 1 << 19
 
-    ``phase`` is the global index of the first step of this chunk; the state after global step j
-    is stored at out[:, j // save_every - k0] when j % save_every == 0. Returns -1, or
-    (global step) * B + path when the chord iteration fails.
+
+def _so3_coefficients(system, method):
+    """Flat float64 vector of the constants of the so(3) kernels: Q (9), b (3), theta·M⁻¹ (9), spare."""
+    h = system.hamiltonian
+    minv = np.eye(3) if system._metric_inv is None else system._metric_inv
+    coef = np.zeros(_NCOEF)
+    coef[0:9] = np.asarray(h.q, dtype=np.float64).ravel()
+    coef[9:12] = h.linear + system._shift
+    coef[12:21] = (system.theta * np.asarray(minv, dtype=np.float64)).ravel()
+    return coef
+
+
+@numba.njit(cache=True)
+def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta):
+    """Advance every path of ``m`` (3, B) by one coadjoint step with stochastic velocities ``e`` (3, B).
+
+    ``code`` 0 (Lie–Euler) and 1 (Lie–Heun) run the vectorised loop; 2 (implicit midpoint) the scalar
+    chord solve. Returns -1, or the index of the first path whose chord iteration failed.
     """
-    nb = mu.shape[0]
-    nk = eta.shape[1]
-    for p in range(nb):
-        m0, m1, m2 = mu[p, 0], mu[p, 1], mu[p, 2]
-        for k in range(nk):
-            m0, m1, m2, ok = _so3_step(m0, m1, m2, eta[p, k, 0], eta[p, k, 1], eta[p, k, 2], dts[k], q, lin,
-                                       minv, theta, code, tol, max_iter)
+    nb = m.shape[1]
+    ma, mb, mc = m[0], m[1], m[2]
+    ea, eb, ec = e[0], e[1], e[2]
+    if code == 2:
+        for p in range(nb):
+            n0, n1, n2, ok = _so3_step(ma[p], mb[p], mc[p], ea[p], eb[p], ec[p], dt, q, lin, minv, theta, code,
+                                       tol, max_iter)
             if not ok:
-                mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
-                return (phase + k) * nb + p
-            j = phase + k + 1
-            if j % save_every == 0:
-                r = j // save_every - k0
-                out[p, r, 0], out[p, r, 1], out[p, r, 2] = m0, m1, m2
-        mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
+                return p
+            ma[p], mb[p], mc[p] = n0, n1, n2
+        return -1
+    q00, q01, q02, q10, q11, q12, q20, q21, q22 = (coef[0], coef[1], coef[2], coef[3], coef[4], coef[5],
+                                                   coef[6], coef[7], coef[8])
+    l0, l1, l2 = coef[9], coef[10], coef[11]
+    n00, n01, n02, n10, n11, n12, n20, n21, n22 = (coef[12], coef[13], coef[14], coef[15], coef[16],
+                                                   coef[17], coef[18], coef[19], coef[20])
+    hdt = 0.5 * dt
+    nbad = 0
+    for p in range(nb):
+        m0 = ma[p]
+        m1 = mb[p]
+        m2 = mc[p]
+        e0 = ea[p]
+        e1 = eb[p]
+        e2 = ec[p]
+        # w(mu) = g + theta M⁻¹ (mu × g), g = Q mu + b
+        g0 = q00 * m0 + q01 * m1 + q02 * m2 + l0
+        g1 = q10 * m0 + q11 * m1 + q12 * m2 + l1
+        g2 = q20 * m0 + q21 * m1 + q22 * m2 + l2
+        v0 = m1 * g2 - m2 * g1
+        v1 = m2 * g0 - m0 * g2
+        v2 = m0 * g1 - m1 * g0
+        w0 = g0 + n00 * v0 + n01 * v1 + n02 * v2
+        w1 = g1 + n10 * v0 + n11 * v1 + n12 * v2
+        w2 = g2 + n20 * v0 + n21 * v1 + n22 * v2
+        s0 = w0 * dt + e0
+        s1 = w1 * dt + e1
+        s2 = w2 * dt + e2
+        if code == 1:
+            # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
+            c0 = m1 * s2 - m2 * s1
+            c1 = m2 * s0 - m0 * s2
+            c2 = m0 * s1 - m1 * s0
+            y0 = m0 + c0 + 0.5 * (c1 * s2 - c2 * s1)
+            y1 = m1 + c1 + 0.5 * (c2 * s0 - c0 * s2)
+            y2 = m2 + c2 + 0.5 * (c0 * s1 - c1 * s0)
+            g0 = q00 * y0 + q01 * y1 + q02 * y2 + l0
+            g1 = q10 * y0 + q11 * y1 + q12 * y2 + l1
+            g2 = q20 * y0 + q21 * y1 + q22 * y2 + l2
+            v0 = y1 * g2 - y2 * g1
+            v1 = y2 * g0 - y0 * g2
+            v2 = y0 * g1 - y1 * g0
+            s0 = (w0 + g0 + n00 * v0 + n01 * v1 + n02 * v2) * hdt + e0
+            s1 = (w1 + g1 + n10 * v0 + n11 * v1 + n12 * v2) * hdt + e1
+            s2 = (w2 + g2 + n20 * v0 + n21 * v1 + n22 * v2) * hdt + e2
+        # exp(ad*_s) m = m - a s×m + b s×(s×m), Taylor to t^8 (exact in float64 for t² < 1e-2)
+        t2 = s0 * s0 + s1 * s1 + s2 * s2
+        big = t2 >= 1e-2
+        bad[p] = big
+        nbad += big
+        a = 1.0 - t2 * (1.0 / 6.0) * (1.0 - t2 * (1.0 / 20.0) * (1.0 - t2 * (1.0 / 42.0) * (1.0 - t2 * (1.0 / 72.0))))
+        b = 0.5 - t2 * (1.0 / 24.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0) * (1.0 - t2 * (1.0 / 90.0))))
+        c0 = s1 * m2 - s2 * m1
+        c1 = s2 * m0 - s0 * m2
+        c2 = s0 * m1 - s1 * m0
+        d0 = s1 * c2 - s2 * c1
+        d1 = s2 * c0 - s0 * c2
+        d2 = s0 * c1 - s1 * c0
+        ma[p] = m0 if big else m0 - a * c0 + b * d0
+        mb[p] = m1 if big else m1 - a * c1 + b * d1
+        mc[p] = m2 if big else m2 - a * c2 + b * d2
+    if nbad > 0:
+        for p in range(nb):
+            if bad[p]:
+                ma[p], mb[p], mc[p], _ = _so3_step(ma[p], mb[p], mc[p], ea[p], eb[p], ec[p], dt, q, lin, minv,
+                                                   theta, code, tol, max_iter)
     return -1
 
 
 @numba.njit(cache=True)
-def _so3_brownian_kernel(mu, rng, n_steps, dt, xi, brk, with_area, q, lin, minv, theta, code, tol, max_iter,
-                         save_every, out):
-    """Fused Brownian driver + coadjoint step on so(3)* (no noise arrays are materialised).
+def _so3_noise_velocity(zk, zt, e, xs, bs, pi, pj):
+    """Stochastic velocities e (3, B) of one step from its unit normals zk (B, w) (stream layout).
 
-    Draw order per step and path (step-major, so independent of any chunking in time): the m
-    increments N(0, dt), then (with the area) the m space-time areas H ~ N(0, dt/12) and the
-    m(m-1)/2 residuals lambda_ij ~ N(0, dt^2/12), i < j lexicographic; the step Lévy area is
-    A_ij = H_i dW_j - dW_i H_j + lambda_ij (Davie's moment-matched area, exact second moments).
-    Returns -1 or step * B + path of a chord failure.
+    ``xs`` (m, 3) = sqrt(dt) ξ; with the area (``w > m``) ``bs`` (npair, 3) = dt/√12 [ξ_i, ξ_j] for
+    the pairs ``pi < pj``: A_ij = dt/√12 (zH_i zW_j - zW_i zH_j + zλ_ij) (Davie's area, scaled).
     """
-    nb = mu.shape[0]
-    m = xi.shape[0]
-    sq = math.sqrt(dt)
-    sh = math.sqrt(dt / 12.0)
-    sl = dt / math.sqrt(12.0)
-    dw = np.empty(m)
-    hh = np.empty(m)
-    for k in range(n_steps):
+    nb, w = zk.shape
+    nm = xs.shape[0]
+    for p in range(nb):                      # transpose to rows, so the loops below vectorise
+        for c in range(w):
+            zt[c, p] = zk[p, c]
+    ea, eb, ec = e[0], e[1], e[2]
+    x0, x1, x2 = xs[0, 0], xs[0, 1], xs[0, 2]
+    z0 = zt[0]
+    for p in range(nb):
+        ea[p] = z0[p] * x0
+        eb[p] = z0[p] * x1
+        ec[p] = z0[p] * x2
+    for i in range(1, nm):
+        x0, x1, x2 = xs[i, 0], xs[i, 1], xs[i, 2]
+        zi = zt[i]
         for p in range(nb):
-            for i in range(m):
-                dw[i] = sq * rng.standard_normal()
-            e0 = 0.0
-            e1 = 0.0
-            e2 = 0.0
-            for i in range(m):
-                e0 += dw[i] * xi[i, 0]
-                e1 += dw[i] * xi[i, 1]
-                e2 += dw[i] * xi[i, 2]
-            if with_area:
-                for i in range(m):
-                    hh[i] = sh * rng.standard_normal()
-                for i in range(m):
-                    for j in range(i + 1, m):
-                        a = hh[i] * dw[j] - dw[i] * hh[j] + sl * rng.standard_normal()
-                        # ½ Σ_{ij} A^{ij}[ξ_i, ξ_j] = Σ_{i<j} A^{ij}[ξ_i, ξ_j]
-                        e0 += a * brk[i, j, 0]
-                        e1 += a * brk[i, j, 1]
-                        e2 += a * brk[i, j, 2]
-            m0, m1, m2, ok = _so3_step(mu[p, 0], mu[p, 1], mu[p, 2], e0, e1, e2, dt, q, lin, minv, theta, code,
-                                       tol, max_iter)
-            if not ok:
-                return k * nb + p
-            mu[p, 0], mu[p, 1], mu[p, 2] = m0, m1, m2
-            if (k + 1) % save_every == 0:
-                r = (k + 1) // save_every
-                out[p, r, 0], out[p, r, 1], out[p, r, 2] = m0, m1, m2
+            ea[p] += zi[p] * x0
+            eb[p] += zi[p] * x1
+            ec[p] += zi[p] * x2
+    if w > nm:
+        for r in range(bs.shape[0]):
+            i, j = pi[r], pj[r]
+            b0, b1, b2 = bs[r, 0], bs[r, 1], bs[r, 2]
+            wi, wj, hi, hj, lr = zt[i], zt[j], zt[nm + i], zt[nm + j], zt[2 * nm + r]
+            for p in range(nb):
+                a = hi[p] * wj[p] - wi[p] * hj[p] + lr[p]
+                ea[p] += a * b0
+                eb[p] += a * b1
+                ec[p] += a * b2
+
+
+@numba.njit(cache=True)
+def _so3_brownian_block(m, z, zt, e, bad, xs, bs, pi, pj, dt, coef, code, tol, max_iter, q, lin, minv, theta,
+                        save_every, phase, out):
+    """Advance m (3, B) over the unit normals z (k, B, w) of k steps; global step index of z[0] is ``phase``.
+
+    The state after global step j is stored at out[:, j // save_every] when j % save_every == 0.
+    Returns -1, or (global step) * B + path of a chord failure.
+    """
+    nb = m.shape[1]
+    for k in range(z.shape[0]):
+        _so3_noise_velocity(z[k], zt, e, xs, bs, pi, pj)
+        res = _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta)
+        if res >= 0:
+            return (phase + k) * nb + res
+        j = phase + k + 1
+        if j % save_every == 0:
+            r = j // save_every
+            for p in range(nb):
+                out[p, r, 0] = m[0, p]
+                out[p, r, 1] = m[1, p]
+                out[p, r, 2] = m[2, p]
+    return -1
+
+
+@numba.njit(cache=True)
+def _so3_eta_block(m, eta, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta, save_every, phase, out,
+                   k0):
+    """Advance m (3, B) over given stochastic velocities eta (B, K, 3) (see :func:`_so3_brownian_block`)."""
+    nb = m.shape[1]
+    for k in range(eta.shape[1]):
+        for p in range(nb):
+            e[0, p] = eta[p, k, 0]
+            e[1, p] = eta[p, k, 1]
+            e[2, p] = eta[p, k, 2]
+        res = _so3_block_step(m, e, dts[k], coef, code, tol, max_iter, bad, q, lin, minv, theta)
+        if res >= 0:
+            return (phase + k) * nb + res
+        j = phase + k + 1
+        if j % save_every == 0:
+            r = j // save_every - k0
+            for p in range(nb):
+                out[p, r, 0] = m[0, p]
+                out[p, r, 1] = m[1, p]
+                out[p, r, 2] = m[2, p]
     return -1
 
 
@@ -394,12 +510,14 @@ def _fast_so3(system):
 
 
 def _so3_args(system, method):
+    """Constants of the so(3) kernels: (coef, code, tol, max_iter, q, lin, minv, theta)."""
     h = system.hamiltonian
     minv = np.eye(3) if system._metric_inv is None else system._metric_inv
     lin = np.ascontiguousarray(h.linear + system._shift)
     tol = float(getattr(method, "tol", 1e-13))
     max_iter = int(getattr(method, "max_iter", 1))
-    return (np.ascontiguousarray(h.q), lin, np.ascontiguousarray(minv), system.theta, method.code, tol, max_iter)
+    return (_so3_coefficients(system, method), method.code, tol, max_iter, np.ascontiguousarray(h.q), lin,
+            np.ascontiguousarray(minv), system.theta)
 
 
 def _chord_failure(res, nb, times, dts, method):
@@ -413,10 +531,15 @@ def _chord_failure(res, nb, times, dts, method):
 def _run_chunk(system, method, mu, eta, dts, t0_index, times, save_every, out, k0):
     """Advance ``mu`` (B, n) over the chunk ``eta`` (B, K, n); fill ``out`` (B, nsave, n)."""
     if _fast_so3(system):
-        res = _so3_kernel(mu, np.ascontiguousarray(eta), np.ascontiguousarray(dts), *_so3_args(system, method),
-                          save_every, t0_index, out, k0)
+        coef, code, tol, max_iter, q, lin, minv, theta = _so3_args(system, method)
+        nb = mu.shape[0]
+        m = np.ascontiguousarray(mu.T)
+        res = _so3_eta_block(m, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64),
+                             np.empty((3, nb)), np.empty(nb, dtype=np.bool_), coef, code, tol, max_iter, q, lin,
+                             minv, theta, save_every, t0_index, out, k0)
+        mu[...] = m.T
         if res >= 0:
-            raise _chord_failure(res, mu.shape[0], times, float(dts[int(res) // mu.shape[0] - t0_index]), method)
+            raise _chord_failure(res, nb, times, float(dts[int(res) // nb - t0_index]), method)
         return
     for k in range(eta.shape[1]):
         j = t0_index + k
@@ -515,6 +638,124 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
     return times, out.reshape(batch + (nsave, n))
 
 
+# ---------------------------------------------------------------------- bulk standard normals
+# numpy's Generator.standard_normal (ziggurat, 256 layers) re-implemented over a buffer of raw
+# 64-bit outputs of the bit generator (``bit_generator.random_raw``): the same raw words give the
+# same normals, bit for bit, so paths agree with ``rng.standard_normal`` and the generator ends in
+# the same state, but the per-draw function-pointer calls disappear (about 3x faster per normal).
+# Used for bit generators whose ``next_double`` is ``(raw >> 11) * 2**-53`` (checked once per
+# process against ``standard_normal``); any other generator (e.g. MT19937) uses numpy directly.
+try:  # the ziggurat tables numpy uses (numba ships a copy for its own Generator support)
+    from numba.np.random._constants import fi_double as _ZIG_F
+    from numba.np.random._constants import ki_double as _ZIG_K
+    from numba.np.random._constants import wi_double as _ZIG_W
+    from numba.np.random._constants import ziggurat_nor_inv_r as _ZIG_INV_R
+    from numba.np.random._constants import ziggurat_nor_r as _ZIG_R
+except ImportError:  # pragma: no cover - another numba layout: fall back to numpy's sampler
+    _ZIG_K = None
+
+_RAW_BIT_GENERATORS = ("PCG64", "PCG64DXSM", "SFC64", "Philox")
+_RAW_OK: dict = {}
+
+
+@numba.njit(cache=True)
+def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
+    """Fill ``out[start:]`` from ``raw`` (uint64) with numpy's ziggurat; returns (raw consumed, next index).
+
+    Stops at the first attempt that would need more raw words than remain (that attempt is then
+    redone from its first word on the next call, so no word is skipped or reused).
+    """
+    n = out.size
+    nr = raw.size
+    pos = 0
+    i = start
+    m255 = np.uint64(255)
+    m52 = np.uint64(0x000FFFFFFFFFFFFF)
+    one = np.uint64(1)
+    s8 = np.uint64(8)
+    s11 = np.uint64(11)
+    scale = 1.0 / 9007199254740992.0
+    while i < n:
+        if pos >= nr:
+            break
+        first = pos
+        r = raw[pos]
+        pos += 1
+        idx = np.intp(r & m255)
+        r = r >> s8
+        rabs = (r >> one) & m52
+        x = float(rabs) * wi[idx]
+        if r & one:
+            x = -x
+        if rabs < ki[idx]:
+            out[i] = x
+            i += 1
+            continue
+        if idx == 0:
+            done = False
+            while True:
+                if pos + 2 > nr:
+                    break
+                xx = -inv_r * math.log1p(-(float(raw[pos] >> s11) * scale))
+                yy = -math.log1p(-(float(raw[pos + 1] >> s11) * scale))
+                pos += 2
+                if yy + yy > xx * xx:
+                    out[i] = -(r_tail + xx) if (rabs >> s8) & one else r_tail + xx
+                    done = True
+                    break
+            if not done:
+                pos = first
+                break
+            i += 1
+        else:
+            if pos + 1 > nr:
+                pos = first
+                break
+            u = float(raw[pos] >> s11) * scale
+            pos += 1
+            if (fi[idx - 1] - fi[idx]) * u + fi[idx] < math.exp(-0.5 * x * x):
+                out[i] = x
+                i += 1
+    return pos, i
+
+
+def _raw_normals_ok(rng) -> bool:
+    name = type(rng.bit_generator).__name__
+    if _ZIG_K is None or name not in _RAW_BIT_GENERATORS:
+        return False
+    if name not in _RAW_OK:                  # one-off self-check against numpy on a private generator
+        bg = type(rng.bit_generator)(12345)
+        ref = np.random.Generator(type(rng.bit_generator)(12345)).standard_normal(20_000)
+        got = np.empty(20_000)
+        _RAW_OK[name] = _fill_normals_raw(bg, got) and np.array_equal(got, ref)
+    return _RAW_OK[name]
+
+
+def _fill_normals_raw(bit_generator, out) -> bool:
+    """Fill ``out`` (C-contiguous float64) from ``bit_generator.random_raw``, requesting exactly the words used."""
+    flat = out.reshape(-1)
+    n = flat.size
+    i = 0
+    left = np.empty(0, dtype=np.uint64)
+    while i < n:
+        # every remaining normal needs >= 1 word and the pending attempt needs > len(left) words, so
+        # asking for n - i new words never over-draws: the generator ends where numpy's would
+        new = bit_generator.random_raw(n - i)
+        raw = new if left.size == 0 else np.concatenate([left, new])
+        used, i = _ziggurat_fill(raw, flat, i, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+        left = raw[used:]
+    return left.size == 0
+
+
+def _standard_normal_into(rng, out):
+    """``rng.standard_normal(out=out)``, same values and end state, faster for 64-bit bit generators."""
+    if _raw_normals_ok(rng):
+        if _fill_normals_raw(rng.bit_generator, out):
+            return
+        raise RuntimeError("internal error: the raw-word normal sampler over-drew the bit generator.")
+    rng.standard_normal(out=out)
+
+
 # ---------------------------------------------------------------------- Brownian streaming
 def _brownian_chunk(rng, batch, k, dt, m, levy_area, substeps):
     r"""Increments (batch, k, m) and Lévy areas (batch, k, m, m) (or None) of Stratonovich Brownian motion.
@@ -546,6 +787,42 @@ def _brownian_chunk(rng, batch, k, dt, m, levy_area, substeps):
     dw, xx = brownian_increments_and_areas(rng, k, dt, m, batch_shape=(batch,), levy_area=method,
                                            substeps=substeps)
     return dw, 0.5 * (xx - np.swapaxes(xx, -1, -2))
+
+
+def _so3_brownian(system, method, mu, rng, n_steps, dt, with_area, chunk_steps, save_every, out, times):
+    """Fast path of :func:`simulate_brownian` (so(3), quadratic h, Davie area or none); updates ``mu`` (P, 3).
+
+    The unit normals of ``chunk_steps`` steps are drawn in bulk into one reused buffer of shape
+    ``(k, P, w)`` (``rng.standard_normal(out=...)``, C order: step-major, then path, then the w draws
+    of the path: dW (m), and with the area H (m) and lambda (m(m-1)/2)); the numba kernel only does
+    arithmetic. C order makes the stream independent of the chunking in time.
+    """
+    nb, nm = mu.shape[0], system.n_noise
+    coef, code, tol, max_iter, q, lin, minv, theta = _so3_args(system, method)
+    pi, pj = np.triu_indices(nm, 1)
+    with_area = with_area and pi.size > 0
+    w = 2 * nm + pi.size if with_area else nm
+    xs = np.ascontiguousarray(math.sqrt(dt) * system.xi)
+    bs = np.ascontiguousarray(dt / math.sqrt(12.0) * system.xi_brackets[pi, pj])
+    if chunk_steps is None:                  # a buffer that stays in cache between the fill and the kernel
+        chunk_steps = _FAST_BUFFER_BYTES // (8 * nb * w)
+    k_max = max(1, min(n_steps, chunk_steps))
+    buf = np.empty((k_max, nb, w))
+    zt, e, bad = np.empty((w, nb)), np.empty((3, nb)), np.empty(nb, dtype=np.bool_)
+    m = np.ascontiguousarray(mu.T)
+    start = 0
+    while start < n_steps:
+        k = min(k_max, n_steps - start)
+        z = buf[:k]
+        _standard_normal_into(rng, z)
+        res = _so3_brownian_block(m, z, zt, e, bad, xs, bs, pi.astype(np.int64), pj.astype(np.int64), dt, coef,
+                                  code, tol, max_iter, q, lin, minv, theta, save_every, start, out)
+        if res >= 0:
+            mu[...] = m.T
+            raise _chord_failure(res, nb, times, dt, method)
+        start += k
+    mu[...] = m.T
+
 
 
 def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rng, *, n_paths=None,
@@ -603,21 +880,17 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
     mu0, _ = _prepare(system, mu0, (n_paths,), orbit)
     n, m = system.dim, system.n_noise
     mu = np.array(np.broadcast_to(mu0, (n_paths, n)), dtype=np.float64)
-    if chunk_steps is None:
-        chunk_steps = max(1, min(n_steps, (2 << 20) // (8 * n_paths * (m * m + m + n))))
-    chunk_steps = check_positive_int(chunk_steps, "chunk_steps")
+    if chunk_steps is not None:
+        chunk_steps = check_positive_int(chunk_steps, "chunk_steps")
     nsave = n_steps // save_every + 1
     out = np.empty((n_paths, nsave, n))
     out[:, 0] = mu
     times = np.arange(n_steps + 1) * dt
     if _fast_so3(system) and (levy_area is True or levy_area is False or levy_area == "davie") and area_substeps == 1:
-        with_area = bool(levy_area)
-        res = _so3_brownian_kernel(mu, rng, n_steps, dt, np.ascontiguousarray(system.xi),
-                                   np.ascontiguousarray(system.xi_brackets), with_area, *_so3_args(system, method),
-                                   save_every, out)
-        if res >= 0:
-            raise _chord_failure(res, n_paths, times, dt, method)
+        _so3_brownian(system, method, mu, rng, n_steps, dt, bool(levy_area), chunk_steps, save_every, out, times)
     else:
+        if chunk_steps is None:
+            chunk_steps = max(1, min(n_steps, (2 << 20) // (8 * n_paths * (m * m + m + n))))
         start = 0
         while start < n_steps:
             k = min(chunk_steps, n_steps - start)
