@@ -571,8 +571,8 @@ def _prepare(system, mu0, batch_shape, orbit):
 
 
 def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(), save_every: int = 1, *,
-             orbit=None):
-    r"""Solve the system pathwise on a level-2 geometric rough path with a coadjoint scheme.
+             orbit=None, levy_area: bool = True):
+    r"""Solve the system pathwise on a geometric rough path with a coadjoint scheme.
 
     Parameters
     ----------
@@ -580,8 +580,9 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
     mu0 : array_like, shape ``(..., n)``
         Initial state(s); broadcast against the driver's batch shape.
     driver : RoughPath
-        Level-2 geometric rough path of dimension ``m = system.n_noise`` (its step Lévy areas are
-        used; a level-1 path is refused — use ``RoughPath.from_path`` for the piecewise-linear lift).
+        Rough path of dimension ``m = system.n_noise``. With ``levy_area=True`` (default) a level-2
+        geometric path, whose step Lévy areas enter :math:`\sigma_n`; with ``levy_area=False`` a
+        level-1 path (increments only; e.g. ``RoughPath.from_increments(dW)`` or ``X.to_level1()``).
     method : LieEuler() | LieHeun() | ImplicitMidpoint(tol, max_iter)
     save_every : int
         Keep every ``save_every``-th state (the final state is always at the end of the grid when
@@ -589,6 +590,13 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
     orbit : array_like, optional
         Casimir values the initial state must have (e.g. ``[1.0]`` for the unit sphere); a state off
         this orbit raises ``ValueError``.
+    levy_area : bool
+        ``True``: use the driver's step Lévy areas (strong order 1 for non-commuting ``xi``).
+        ``False``: level-1 driving, :math:`\sigma_n` built from the increments alone, i.e. the step
+        Lévy areas are taken to be zero (the piecewise-linear / Wong–Zakai lift of the increments:
+        strong order ½ against Brownian motion for non-commuting ``xi``, the same law-level
+        limit). Requires a level-1 driver, so areas are never dropped silently: pass
+        ``driver.to_level1()`` to discard the areas of a level-2 path deliberately.
 
     Returns
     -------
@@ -608,16 +616,31 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
     >>> t, Pi = simulate(rb, [0.0, 0.6, 0.8], X, LieHeun())
     >>> Pi.shape, bool(abs(np.linalg.norm(Pi[-1]) - 1.0) < 1e-14)
     ((101, 3), True)
+
+    Level-1 driving (increments only, zero Lévy area per step) is explicit:
+
+    >>> dW = np.random.default_rng(1).normal(0, 0.03, (100, 3))
+    >>> X1 = RoughPath.from_increments(dW, times=np.linspace(0, 1, 101))
+    >>> t, Pi1 = simulate(rb, [0.0, 0.6, 0.8], X1, LieHeun(), levy_area=False)
+    >>> Pi1.shape
+    (101, 3)
     """
     method = _check_method(method)
     if not isinstance(driver, RoughPath):
         raise TypeError(f"driver must be a roughpaths.RoughPath, got {type(driver).__name__}; for "
                         f"Brownian forcing without materialising a path use simulate_brownian.")
-    if driver.level != 2:
-        raise ValueError("driver is a level-1 path (no area); the coadjoint schemes need the step Lévy "
-                         "areas. Use RoughPath.from_path(values) for the piecewise-linear lift (zero Lévy "
-                         "area per step) or pass the areas.")
-    if driver.kind != "geometric":
+    if not isinstance(levy_area, (bool, np.bool_)):
+        raise TypeError(f"levy_area must be True (use the driver's Lévy areas) or False (level-1 driving, "
+                        f"zero area), got {levy_area!r}.")
+    if levy_area and driver.level != 2:
+        raise ValueError("driver is a level-1 path (no area) but levy_area=True: the scheme would need the "
+                         "step Lévy areas. Pass levy_area=False to drive with the increments alone (zero "
+                         "Lévy area per step), or a level-2 path (e.g. RoughPath.from_path(values) for the "
+                         "piecewise-linear lift, or the increments with their areas).")
+    if not levy_area and driver.level != 1:
+        raise ValueError("levy_area=False but driver is a level-2 path: its areas would be discarded. Pass "
+                         "driver.to_level1() to drop them deliberately, or levy_area=True to use them.")
+    if levy_area and driver.kind != "geometric":
         raise ValueError(f"driver is a {driver.kind!r} rough path; the coadjoint schemes solve the geometric "
                          f"(Stratonovich-type) RDE. Convert an Itô lift with XX + ½(t-s)I first.")
     if driver.dim != system.n_noise:
@@ -626,7 +649,7 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
     save_every = check_positive_int(save_every, "save_every")
     mu0, batch = _prepare(system, mu0, driver.batch_shape, orbit)
     n, nsteps = system.dim, driver.n_steps
-    eta = system.stochastic_velocity(driver.increments, driver.step_levy_areas)     # (..., N, n)
+    eta = system.stochastic_velocity(driver.increments, driver.step_levy_areas if levy_area else None)
     eta = np.broadcast_to(eta, batch + eta.shape[-2:]).reshape((-1,) + eta.shape[-2:])
     mu = np.array(np.broadcast_to(mu0, batch + (n,)).reshape(-1, n), dtype=np.float64)
     nsave = nsteps // save_every + 1

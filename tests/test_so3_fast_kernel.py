@@ -16,7 +16,12 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from mechanics.integrators import LieEuler, LieHeun, _standard_normal_into, simulate_brownian
+from mechanics.integrators import (
+    LieEuler,
+    LieHeun,
+    _standard_normal_into,
+    simulate_brownian,
+)
 from mechanics.rigid_body import rigid_body
 
 BITGENS = [np.random.PCG64, np.random.PCG64DXSM, np.random.SFC64, np.random.Philox, np.random.MT19937]
