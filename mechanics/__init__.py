@@ -39,7 +39,7 @@ from .integrators import (
     simulate,
     simulate_brownian,
 )
-from .lie_algebra import LieAlgebra, expm_batched, hat, se3, sl2r, so3, su2, vee
+from .lie_algebra import LieAlgebra, hat, se3, sl2r, so3, su2, vee
 from .lie_poisson import Hamiltonian, LiePoissonSystem, QuadraticHamiltonian, check_inertia, girsanov_shift
 from .rigid_body import RigidBody, isotropic_xi, rigid_body
 from .wong_zakai import (
@@ -58,7 +58,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     # Lie algebras
-    "LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee", "expm_batched",
+    "LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
     # Lie–Poisson systems
     "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",

@@ -28,6 +28,7 @@ import numpy as np
 import scipy.linalg
 
 from roughpaths._validation import as_float_array
+from roughpaths.solvers import expm_batched
 
 __all__ = ["LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee", "rodrigues_ad_star_exp", "se3_ad_star_exp"]
 
@@ -93,8 +94,8 @@ class LieAlgebra:
     casimir_names : sequence of str, optional
         Names of the Casimirs, for messages.
     ad_star_exp : callable, optional
-        Closed-form ``(sigma, mu) -> exp(ad*_sigma) mu``; default: :func:`expm_batched` of the
-        ``ad*`` matrices (:func:`expm_batched`).
+        Closed-form ``(sigma, mu) -> exp(ad*_sigma) mu``; default: the batched matrix exponential
+        :func:`roughpaths.solvers.expm_batched` of the ``ad*`` matrices.
 
     Examples
     --------
@@ -279,7 +280,7 @@ class LieAlgebra:
         r""":math:`\exp(\mathrm{ad}^*_\sigma)\,\mu`, the coadjoint action of :math:`\exp\sigma` used by the
         integrators (time-1 flow of :math:`\dot\mu = \mathrm{ad}^*_\sigma\mu`). Shapes ``(..., n)``
         broadcast. Closed form where the factory provides one (so(3): Rodrigues), else
-        :func:`expm_batched` of the batched ``ad*`` matrices.
+        :func:`roughpaths.solvers.expm_batched` of the batched ``ad*`` matrices.
         """
         sigma, mu = self._vec(sigma, "sigma"), self._vec(mu, "mu")
         return self._ad_star_exp_unchecked(sigma, mu)
@@ -290,29 +291,6 @@ class LieAlgebra:
         shape = np.broadcast_shapes(sigma.shape, mu.shape)
         m = expm_batched(np.einsum("...i,ijk->...jk", sigma, self._c))
         return np.broadcast_to(np.einsum("...jk,...k->...j", m, mu), shape)
-
-
-def expm_batched(a) -> np.ndarray:
-    """Matrix exponential of a batch of small real matrices ``(..., n, n)``.
-
-    Scaling and squaring with a degree-18 Taylor polynomial on ``a / 2^s``, ``|a / 2^s|_1 <= 1/2``
-    (truncation error below ``2^-19/19! ~ 1e-23``). Vectorised over the batch; for the tiny
-    ``ad*`` matrices of the integrators it is much faster than per-matrix Padé calls.
-    """
-    a = np.asarray(a, dtype=np.float64)
-    n = a.shape[-1]
-    norm = np.max(np.sum(np.abs(a), axis=-2), axis=-1) if a.size else np.zeros(a.shape[:-2])
-    s = np.maximum(0, np.ceil(np.log2(np.maximum(norm, 1e-300) / 0.5))).astype(int)
-    smax = int(np.max(s)) if s.size else 0
-    b = a / (2.0 ** s)[..., None, None]
-    eye = np.broadcast_to(np.eye(n), a.shape)
-    out = eye.copy()
-    for k in range(18, 0, -1):
-        out = eye + (b @ out) / k
-    for j in range(smax):
-        sq = out @ out
-        out = np.where((s > j)[..., None, None], sq, out)
-    return out
 
 
 def _jacobi_defect(c: np.ndarray) -> float:
