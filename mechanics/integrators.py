@@ -34,8 +34,15 @@ Proposition 2.1.
 
 Entry points: :func:`simulate` (a materialised :class:`roughpaths.RoughPath`) and
 :func:`simulate_brownian` (Stratonovich Brownian motion generated in time chunks, constant memory).
-For so(3) with a quadratic Hamiltonian both run a numba kernel; other algebras use a batched numpy
-loop (``Ad*exp`` in closed form for so(3)/se(3), batched ``expm`` otherwise).
+For so(3) with a quadratic Hamiltonian both run numba block kernels (state as three rows of paths,
+the per-step loop over paths vectorised); other algebras use a batched numpy loop (``Ad*exp`` in
+closed form for so(3)/se(3), :func:`roughpaths.solvers.expm_batched` otherwise).
+
+Random stream of :func:`simulate_brownian` (every path): for each step in turn, for each path in
+turn, the ``w`` unit normals of that path-step: ``dW`` (``m``), then with the area ``H`` (``m``) and
+``lambda`` (``m(m-1)/2``, pairs ``i < j`` lexicographic) — exactly ``rng.standard_normal((n_steps,
+n_paths, w))`` in C order, whatever the chunking in time (``chunk_steps``), and the generator ends in
+the same state as after that call.
 """
 
 from __future__ import annotations
@@ -49,7 +56,6 @@ import numpy as np
 from roughpaths._validation import as_float_array, check_positive_int, check_rng
 from roughpaths.rough_path import RoughPath
 
-from .lie_algebra import rodrigues_ad_star_exp
 from .lie_poisson import LiePoissonSystem
 
 __all__ = [

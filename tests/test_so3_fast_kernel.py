@@ -75,11 +75,11 @@ def _naive(inertia, xi, s, theta, mu0, dt, n_steps, seed, heun, area):
 
 
 CASES = {
-    "isotropic, dissipative": dict(xi=0.3 * np.eye(3), s=np.array([[0, 2.0, 5.0], [-2.0, 0, -1.0], [-5.0, 1.0, 0]]),
-                                   theta=1.0, dt=1e-2),
-    "large steps (trig branch), theta=0": dict(xi=1.5 * np.eye(3), s=np.zeros((3, 3)), theta=0.0, dt=0.05),
-    "four general noises": dict(xi=np.array([[0.3, 0.1, 0.0], [0.0, 0.2, -0.1], [0.1, 0.0, 0.4], [0.2, 0.2, 0.2]]),
-                                s=np.zeros((4, 4)), theta=0.5, dt=2e-2),
+    "isotropic, dissipative": {"xi": 0.3 * np.eye(3), "s": np.array([[0, 2.0, 5.0], [-2.0, 0, -1.0], [-5.0, 1.0, 0]]),
+                                   "theta": 1.0, "dt": 1e-2},
+    "large steps (trig branch), theta=0": {"xi": 1.5 * np.eye(3), "s": np.zeros((3, 3)), "theta": 0.0, "dt": 0.05},
+    "four general noises": {"xi": np.array([[0.3, 0.1, 0.0], [0.0, 0.2, -0.1], [0.1, 0.0, 0.4], [0.2, 0.2, 0.2]]),
+                                "s": np.zeros((4, 4)), "theta": 0.5, "dt": 2e-2},
 }
 
 
