@@ -236,15 +236,18 @@ def _rod(s0, s1, s2, m0, m1, m2):
 
 @numba.njit(cache=True, inline="always")
 def _w3(q, lin, minv, theta, m0, m1, m2):
+    # lin (6,): lin[0:3] = b + shift (conservative gradient g = Q mu + lin[0:3]); lin[3:6] = the change of
+    # the gradient inside the double bracket, f = g + lin[3:6] (0, or -shift with levy_in_dissipation=False)
     g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0]
     g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1]
     g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2]
     if theta == 0.0:
         return g0, g1, g2
-    # v = ad*_g mu = mu × g ; w = g + theta * Minv v
-    v0 = m1 * g2 - m2 * g1
-    v1 = m2 * g0 - m0 * g2
-    v2 = m0 * g1 - m1 * g0
+    f0, f1, f2 = g0 + lin[3], g1 + lin[4], g2 + lin[5]
+    # v = ad*_f mu = mu × f ; w = g + theta * Minv v
+    v0 = m1 * f2 - m2 * f1
+    v1 = m2 * f0 - m0 * f2
+    v2 = m0 * f1 - m1 * f0
     return (g0 + theta * (minv[0, 0] * v0 + minv[0, 1] * v1 + minv[0, 2] * v2),
             g1 + theta * (minv[1, 0] * v0 + minv[1, 1] * v1 + minv[1, 2] * v2),
             g2 + theta * (minv[2, 0] * v0 + minv[2, 1] * v1 + minv[2, 2] * v2))
@@ -253,10 +256,11 @@ def _w3(q, lin, minv, theta, m0, m1, m2):
 @numba.njit(cache=True)
 def _so3_chord(m0, m1, m2, e0, e1, e2, s0, s1, s2, dt, q, lin, minv, theta, tol, max_iter):
     """Chord iteration for the implicit midpoint sigma on so(3)*; returns sigma and a convergence flag."""
-    # chord Jacobian J = I - dt/2 Dw(mu) L(mu), L(mu) d = ad*_d mu = mu × d
-    g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0]
-    g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1]
-    g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2]
+    # chord Jacobian J = I - dt/2 Dw(mu) L(mu), L(mu) d = ad*_d mu = mu × d; g: the gradient inside
+    # the double bracket (see _w3 for the layout of lin)
+    g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0] + lin[3]
+    g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1] + lin[4]
+    g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2] + lin[5]
     L = np.empty((3, 3))
     L[0, 0], L[0, 1], L[0, 2] = 0.0, -m2, m1
     L[1, 0], L[1, 1], L[1, 2] = m2, 0.0, -m0
@@ -327,14 +331,24 @@ _NCOEF = 30
 _FAST_BUFFER_BYTES = 1 << 19
 
 
+def _so3_linear_terms(system):
+    """(6,): the conservative linear term ``b + shift`` (3), then the change of the gradient inside the
+    double bracket, ``shift_dissipation - shift`` (3; zero with ``levy_in_dissipation=True``)."""
+    h = system.hamiltonian
+    return np.concatenate([h.linear + system._shift, system._shift_dissipation - system._shift])
+
+
 def _so3_coefficients(system, method):
-    """Flat float64 vector of the constants of the so(3) kernels: Q (9), b (3), theta·M⁻¹ (9), spare."""
+    """Flat float64 vector of the constants of the so(3) kernels: Q (9), b + shift (3), theta·M⁻¹ (9),
+    shift_dissipation - shift (3), spare."""
     h = system.hamiltonian
     minv = np.eye(3) if system._metric_inv is None else system._metric_inv
     coef = np.zeros(_NCOEF)
+    lin = _so3_linear_terms(system)
     coef[0:9] = np.asarray(h.q, dtype=np.float64).ravel()
-    coef[9:12] = h.linear + system._shift
+    coef[9:12] = lin[:3]
     coef[12:21] = (system.theta * np.asarray(minv, dtype=np.float64)).ravel()
+    coef[21:24] = lin[3:]
     return coef
 
 
@@ -359,6 +373,7 @@ def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, thet
     q00, q01, q02, q10, q11, q12, q20, q21, q22 = (coef[0], coef[1], coef[2], coef[3], coef[4], coef[5],
                                                    coef[6], coef[7], coef[8])
     l0, l1, l2 = coef[9], coef[10], coef[11]
+    f0, f1, f2 = coef[21], coef[22], coef[23]     # gradient change inside the double bracket
     n00, n01, n02, n10, n11, n12, n20, n21, n22 = (coef[12], coef[13], coef[14], coef[15], coef[16],
                                                    coef[17], coef[18], coef[19], coef[20])
     hdt = 0.5 * dt
@@ -370,13 +385,13 @@ def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, thet
         e0 = ea[p]
         e1 = eb[p]
         e2 = ec[p]
-        # w(mu) = g + theta M⁻¹ (mu × g), g = Q mu + b
+        # w(mu) = g + theta M⁻¹ (mu × (g + f)), g = Q mu + b + shift, f = shift_dissipation - shift
         g0 = q00 * m0 + q01 * m1 + q02 * m2 + l0
         g1 = q10 * m0 + q11 * m1 + q12 * m2 + l1
         g2 = q20 * m0 + q21 * m1 + q22 * m2 + l2
-        v0 = m1 * g2 - m2 * g1
-        v1 = m2 * g0 - m0 * g2
-        v2 = m0 * g1 - m1 * g0
+        v0 = m1 * (g2 + f2) - m2 * (g1 + f1)
+        v1 = m2 * (g0 + f0) - m0 * (g2 + f2)
+        v2 = m0 * (g1 + f1) - m1 * (g0 + f0)
         w0 = g0 + n00 * v0 + n01 * v1 + n02 * v2
         w1 = g1 + n10 * v0 + n11 * v1 + n12 * v2
         w2 = g2 + n20 * v0 + n21 * v1 + n22 * v2
@@ -394,9 +409,9 @@ def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, thet
             g0 = q00 * y0 + q01 * y1 + q02 * y2 + l0
             g1 = q10 * y0 + q11 * y1 + q12 * y2 + l1
             g2 = q20 * y0 + q21 * y1 + q22 * y2 + l2
-            v0 = y1 * g2 - y2 * g1
-            v1 = y2 * g0 - y0 * g2
-            v2 = y0 * g1 - y1 * g0
+            v0 = y1 * (g2 + f2) - y2 * (g1 + f1)
+            v1 = y2 * (g0 + f0) - y0 * (g2 + f2)
+            v2 = y0 * (g1 + f1) - y1 * (g0 + f0)
             s0 = (w0 + g0 + n00 * v0 + n01 * v1 + n02 * v2) * hdt + e0
             s1 = (w1 + g1 + n10 * v0 + n11 * v1 + n12 * v2) * hdt + e1
             s2 = (w2 + g2 + n20 * v0 + n21 * v1 + n22 * v2) * hdt + e2
@@ -519,7 +534,7 @@ def _so3_args(system, method):
     """Constants of the so(3) kernels: (coef, code, tol, max_iter, q, lin, minv, theta)."""
     h = system.hamiltonian
     minv = np.eye(3) if system._metric_inv is None else system._metric_inv
-    lin = np.ascontiguousarray(h.linear + system._shift)
+    lin = np.ascontiguousarray(_so3_linear_terms(system))
     tol = float(getattr(method, "tol", 1e-13))
     max_iter = int(getattr(method, "max_iter", 1))
     return (_so3_coefficients(system, method), method.code, tol, max_iter, np.ascontiguousarray(h.q), lin,

@@ -25,9 +25,29 @@ The double-bracket term :math:`\vartheta\,\mathrm{ad}^*_{(\mathrm{ad}^*_{\nabla\
 :math:`\mathfrak g` (default: the coordinate dot product; for so(3) this gives
 :math:`\vartheta\,\Pi\times(\Pi\times\nabla\tilde h)`).
 
+Where the Lévy-area velocity enters (``levy_in_dissipation``):
+
+* ``True`` (default): the model above, Theorem 3.1's equation — :math:`\ell` in both the conservative
+  term and the double bracket (both built from :math:`\tilde h`); its Gibbs measure is
+  :math:`\propto\exp(-2\vartheta\tilde h/\sigma^2)` for isotropic noise.
+* ``False``: :math:`\ell` in the conservative term only,
+
+  .. math::
+
+      d\mu = \mathrm{ad}^*_{\nabla\tilde h}\mu\,dt
+            + \vartheta\,\mathrm{ad}^*_{(\mathrm{ad}^*_{\nabla h}\mu)^\sharp}\mu\,dt
+            + \sum_i \mathrm{ad}^*_{\xi_i}\mu\,d\mathbf X^i
+
+  (dissipation built from :math:`h`). Because Friz–Oberhauser turns the perturbation
+  :math:`\mathbb X\mapsto\mathbb X + \mathsf s(t-s)` into the drift :math:`\mathrm{ad}^*_\ell\mu` and leaves
+  the rest of the drift alone, this is *exactly* the ``s = 0`` system driven by ``X.perturb(s)``
+  (Proposition 2.1 with :math:`\vartheta > 0`), e.g. the white-noise limit of the coloured-noise rigid
+  body (:mod:`mechanics.wong_zakai`). For :math:`\vartheta > 0` the two models differ by
+  :math:`\vartheta\,\mathrm{ad}^*_{(\mathrm{ad}^*_\ell\mu)^\sharp}\mu`, an ``O(1)`` drift.
+
 ``convention="paper"`` reproduces the printed equations (srblevy)/(detrigidbodylevy)/(heavytoplevy):
 the Lévy torque enters with the opposite sign, :math:`\tilde h_{\rm paper} = h - \langle\mu,\ell\rangle`,
-in both the conservative and the dissipative term. It is *not* what a rough path with area
+in the conservative term and (with ``levy_in_dissipation=True``) the dissipative term. It is *not* what a rough path with area
 :math:`\mathbb X + \mathsf s(t-s)` produces; use it only to reproduce the paper's figures.
 """
 
@@ -218,6 +238,12 @@ class LiePoissonSystem:
     metric : array_like ``(n, n)``, optional
         Symmetric positive-definite metric on :math:`\mathfrak g` defining ``♯`` in the dissipation
         (default identity).
+    levy_in_dissipation : bool
+        Where the Lévy-area velocity :math:`\ell` enters (module docstring). ``True`` (default):
+        conservative term and double bracket, both from :math:`\tilde h` (Theorem 3.1's model).
+        ``False``: conservative term only, dissipation from :math:`h` — the exact equation of the
+        ``s = 0`` system driven by ``X.perturb(s)`` (and of the coloured-noise limit). The two
+        coincide when ``theta == 0`` or ``s == 0``.
 
     Examples
     --------
@@ -228,10 +254,18 @@ class LiePoissonSystem:
     >>> sys_ = LiePoissonSystem(so3(), np.diag([1.0, 2.0, 3.0]), 0.05 * np.eye(3), s=s, theta=1.0)
     >>> sys_.levy_velocity          # ½ s^{ij} ξ_i × ξ_j = σ² (s23, -s13, s12)
     array([ 0.    , -0.0625,  0.    ])
+    >>> Pi = np.array([0.6, 0.0, 0.8])
+    >>> lim = LiePoissonSystem(so3(), np.diag([1.0, 2.0, 3.0]), 0.05 * np.eye(3), s=s, theta=1.0,
+    ...                        levy_in_dissipation=False)
+    >>> bool(np.allclose(lim.conservative_drift(Pi), sys_.conservative_drift(Pi)))
+    True
+    >>> bool(np.allclose(lim.dissipation(Pi), sys_.with_s(np.zeros((3, 3))).dissipation(Pi)))
+    True
     """
 
     def __init__(self, algebra: LieAlgebra, hamiltonian, xi, s=None, theta=0.0, convention: str = "rp",
-                 *, hamiltonian_gradient=None, hamiltonian_hessian=None, metric=None):
+                 *, hamiltonian_gradient=None, hamiltonian_hessian=None, metric=None,
+                 levy_in_dissipation: bool = True):
         if not isinstance(algebra, LieAlgebra):
             raise TypeError(f"algebra must be a LieAlgebra (e.g. mechanics.lie_algebra.so3()), got "
                             f"{type(algebra).__name__}.")
@@ -258,6 +292,11 @@ class LiePoissonSystem:
         if convention not in CONVENTIONS:
             raise ValueError(f"convention must be one of {CONVENTIONS} ('rp' is the rough-path-correct "
                              f"default, 'paper' reproduces the printed sign slips), got {convention!r}.")
+        if not isinstance(levy_in_dissipation, (bool, np.bool_)):
+            raise TypeError(f"levy_in_dissipation must be True (Lévy velocity in the conservative term and the "
+                            f"double bracket, Theorem 3.1's model) or False (conservative term only: the "
+                            f"s = 0 system driven by X.perturb(s)), got {levy_in_dissipation!r}.")
+        self.levy_in_dissipation = bool(levy_in_dissipation)
         if metric is None:
             self._metric_inv = None
         else:
@@ -268,8 +307,11 @@ class LiePoissonSystem:
         self._xi_brackets = np.einsum("ia,jb,abk->ijk", xi, xi, c)          # [ξ_i, ξ_j], (m, m, n)
         self._levy_velocity = 0.5 * np.einsum("ij,ijk->k", s, self._xi_brackets)
         self._shift = self._levy_velocity if convention == "rp" else -self._levy_velocity
+        # velocity shift inside the double bracket: the same as _shift, or none (dissipation from h)
+        self._shift_dissipation = self._shift if self.levy_in_dissipation else np.zeros(n)
         self._noise_matrices = np.einsum("ia,ajk->ijk", xi, c)               # B_i = ad*_{ξ_i}, (m, n, n)
-        for arr in (self.xi, self.s, self._xi_brackets, self._levy_velocity, self._noise_matrices):
+        for arr in (self.xi, self.s, self._xi_brackets, self._levy_velocity, self._noise_matrices,
+                    self._shift_dissipation):
             arr.setflags(write=False)
 
     @staticmethod
@@ -318,13 +360,14 @@ class LiePoissonSystem:
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         LiePoissonSystem.__init__(new, self.algebra, self.hamiltonian, self.xi, s, self.theta,
-                                  self.convention, metric=None)
+                                  self.convention, metric=None, levy_in_dissipation=self.levy_in_dissipation)
         new._metric_inv = self._metric_inv
         return new
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}(algebra={self.algebra.name!r}, n={self.dim}, m={self.n_noise}, "
-                f"theta={self.theta}, convention={self.convention!r})")
+                f"theta={self.theta}, convention={self.convention!r}"
+                + ("" if self.levy_in_dissipation else ", levy_in_dissipation=False") + ")")
 
     # ------------------------------------------------------------------ Hamiltonians
     def _mu(self, mu):
@@ -346,6 +389,12 @@ class LiePoissonSystem:
     def _grad_tilde(self, mu):
         return self.hamiltonian.gradient(mu) + self._shift
 
+    def _grad_dissipation(self, mu, grad_tilde=None):
+        """Gradient inside the double bracket: ``∇h̃`` (levy_in_dissipation) or ``∇h``."""
+        if self.levy_in_dissipation:
+            return self._grad_tilde(mu) if grad_tilde is None else grad_tilde
+        return self.hamiltonian.gradient(mu) + self._shift_dissipation
+
     def _sharp(self, v):
         return v if self._metric_inv is None else v @ self._metric_inv
 
@@ -364,28 +413,30 @@ class LiePoissonSystem:
 
     def dissipation(self, mu) -> np.ndarray:
         r""":math:`\vartheta\,\mathrm{ad}^*_{(\mathrm{ad}^*_{\nabla\tilde h}\mu)^\sharp}\mu`, shape ``(..., n)``.
-        For so(3): :math:`\vartheta\,\Pi\times(\Pi\times\nabla\tilde h)`."""
+        For so(3): :math:`\vartheta\,\Pi\times(\Pi\times\nabla\tilde h)`. With
+        ``levy_in_dissipation=False``, :math:`\nabla h` replaces :math:`\nabla\tilde h` here."""
         mu = self._mu(mu)
-        v = self._ad_star(self._grad_tilde(mu), mu)
+        v = self._ad_star(self._grad_dissipation(mu), mu)
         return self.theta * self._ad_star(self._sharp(v), mu)
 
     def drift_velocity(self, mu) -> np.ndarray:
         r""":math:`w(\mu) = \nabla\tilde h + \vartheta(\mathrm{ad}^*_{\nabla\tilde h}\mu)^\sharp\in\mathfrak g`, the drift is
-        :math:`\mathrm{ad}^*_{w(\mu)}\mu`. Shape ``(..., n)``."""
+        :math:`\mathrm{ad}^*_{w(\mu)}\mu` (with ``levy_in_dissipation=False`` the second
+        :math:`\nabla\tilde h` is :math:`\nabla h`). Shape ``(..., n)``."""
         return self._w(self._mu(mu))
 
     def _w(self, mu):
         g = self._grad_tilde(mu)
         if self.theta == 0.0:
             return g
-        return g + self.theta * self._sharp(self._ad_star(g, mu))
+        return g + self.theta * self._sharp(self._ad_star(self._grad_dissipation(mu, g), mu))
 
     def _w_jacobian(self, mu):
         hess = self.hamiltonian.hessian(mu)
         if self.theta == 0.0:
             return np.array(hess, dtype=np.float64)
         c = self.algebra._c
-        g = self._grad_tilde(mu)
+        g = self._grad_dissipation(mu)                             # the gradient inside the bracket
         a_g = np.einsum("...i,ijk->...jk", g, c)                 # ad*_g
         lmu = np.einsum("...k,ijk->...ji", mu, c)                # δ ↦ ad*_δ μ
         d = a_g + lmu @ hess

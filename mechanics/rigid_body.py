@@ -11,6 +11,11 @@ For isotropic noise :math:`\xi_i = \sigma e_i`, :math:`c = \sigma^2(\mathsf s^{2
 \mathsf s^{12})`. The modified Hamiltonian is :math:`\tilde h = \tfrac12\Pi\cdot\mathbb I^{-1}\Pi +
 c\cdot\Pi` and :math:`|\Pi|` is the Casimir. ``convention="paper"`` uses :math:`-c` (the printed
 (srblevy)).
+
+``levy_in_dissipation=False`` keeps the torque in the conservative term only,
+:math:`d\Pi = \Pi\times W\,dt + \vartheta\,\Pi\times(\Pi\times\mathbb I^{-1}\Pi)\,dt + \sum_i
+\Pi\times\xi_i\circ dX^i`: the body with ``s = 0`` driven by ``X.perturb(s)`` (e.g. the white-noise
+limit of the coloured-noise body, :mod:`mechanics.wong_zakai`), not Theorem 3.1's model.
 """
 
 from __future__ import annotations
@@ -47,14 +52,15 @@ def _noise_vectors(xi, sigma, dim):
 class RigidBody(LiePoissonSystem):
     """A :class:`~mechanics.lie_poisson.LiePoissonSystem` on so(3) with :math:`h = \\tfrac12\\Pi\\cdot\\mathbb I^{-1}\\Pi`."""
 
-    def __init__(self, inertia, xi=None, s=None, theta=0.0, convention="rp", *, metric=None):
+    def __init__(self, inertia, xi=None, s=None, theta=0.0, convention="rp", *, metric=None,
+                 levy_in_dissipation=True):
         inertia = check_inertia(inertia, "inertia", dim=3)
         xi = as_float_array(xi, "xi")
         if xi.ndim != 2 or xi.shape[1] != 3:
             raise ValueError(f"xi must have shape (m, 3): one so(3) ≅ R³ noise vector per row, got shape "
                              f"{xi.shape}.")
         super().__init__(so3(), QuadraticHamiltonian.from_inertia(inertia), xi, s=s, theta=theta,
-                         convention=convention, metric=metric)
+                         convention=convention, metric=metric, levy_in_dissipation=levy_in_dissipation)
         self.inertia = inertia
         self.inertia.setflags(write=False)
 
@@ -72,7 +78,8 @@ class RigidBody(LiePoissonSystem):
         return self.modified_hamiltonian(Pi)
 
 
-def rigid_body(inertia, xi=None, sigma=None, s=None, theta=0.0, convention="rp", *, metric=None) -> RigidBody:
+def rigid_body(inertia, xi=None, sigma=None, s=None, theta=0.0, convention="rp", *, metric=None,
+               levy_in_dissipation=True) -> RigidBody:
     r"""The stochastic rigid body with SALT noise, Lévy-area perturbation ``s`` and dissipation ``theta``.
 
     Parameters
@@ -84,6 +91,10 @@ def rigid_body(inertia, xi=None, sigma=None, s=None, theta=0.0, convention="rp",
     s : array_like ``(m, m)``, antisymmetric, optional
     theta : float >= 0
     convention : {"rp", "paper"}
+    levy_in_dissipation : bool
+        ``True`` (default): the torque ``c`` in both terms (``W`` in the double bracket: Theorem 3.1,
+        Gibbs density ``∝ exp(-2θh̃/σ²)``). ``False``: ``c`` in the conservative term only, the double
+        bracket built from ``h`` (``I⁻¹Π``) — exactly the ``s = 0`` body driven by ``X.perturb(s)``.
 
     Examples
     --------
@@ -96,4 +107,4 @@ def rigid_body(inertia, xi=None, sigma=None, s=None, theta=0.0, convention="rp",
     0.16666666666666666
     """
     return RigidBody(inertia, _noise_vectors(xi, sigma, 3), s=s, theta=theta, convention=convention,
-                     metric=metric)
+                     metric=metric, levy_in_dissipation=levy_in_dissipation)

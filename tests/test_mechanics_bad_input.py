@@ -70,6 +70,12 @@ def test_bad_convention_sigma_and_both_noise_args():
         rigid_body(I3, sigma=-0.1)
 
 
+@pytest.mark.parametrize("value", ["False", 0, None, np.array([True])])
+def test_bad_levy_in_dissipation(value):
+    with pytest.raises(TypeError, match="levy_in_dissipation"):
+        rigid_body(I3, sigma=0.1, theta=1.0, levy_in_dissipation=value)
+
+
 def test_bad_hamiltonian_and_algebra():
     with pytest.raises(TypeError, match="hamiltonian_gradient"):
         LiePoissonSystem(so3(), lambda mu: mu @ mu, np.eye(3))

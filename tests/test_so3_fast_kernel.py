@@ -41,7 +41,7 @@ def _hat(v):
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _naive(inertia, xi, s, theta, mu0, dt, n_steps, seed, heun, area):
+def _naive(inertia, xi, s, theta, mu0, dt, n_steps, seed, heun, area, levy_in_dissipation=True):
     """Independent reimplementation: Pi × W written with np.cross, Ad*exp via expm (Pi -> exp(-hat s) Pi)."""
     m = xi.shape[0]
     iu = np.triu_indices(m, 1)
@@ -50,9 +50,9 @@ def _naive(inertia, xi, s, theta, mu0, dt, n_steps, seed, heun, area):
     qinv = np.linalg.inv(np.diag(inertia))
     c = 0.5 * sum(s[i, j] * np.cross(xi[i], xi[j]) for i in range(m) for j in range(m))
 
-    def vel(p):                               # w(Pi) = grad h~ + theta (Pi × grad h~)
+    def vel(p):                               # w(Pi) = grad h~ + theta (Pi × grad h~)  (or Pi × grad h)
         g = qinv @ p + c
-        return g + theta * np.cross(p, g)
+        return g + theta * np.cross(p, g if levy_in_dissipation else qinv @ p)
 
     out = np.array(mu0, dtype=float)
     for k in range(n_steps):
@@ -78,6 +78,9 @@ CASES = {
     "isotropic, dissipative": {"xi": 0.3 * np.eye(3), "s": np.array([[0, 2.0, 5.0], [-2.0, 0, -1.0], [-5.0, 1.0, 0]]),
                                    "theta": 1.0, "dt": 1e-2},
     "large steps (trig branch), theta=0": {"xi": 1.5 * np.eye(3), "s": np.zeros((3, 3)), "theta": 0.0, "dt": 0.05},
+    "torque in the conservative term only": {"xi": 0.3 * np.eye(3), "s": np.array([[0, 2.0, 5.0], [-2.0, 0, -1.0],
+                                                                                  [-5.0, 1.0, 0]]),
+                                             "theta": 1.0, "dt": 1e-2, "levy_in_dissipation": False},
     "four general noises": {"xi": np.array([[0.3, 0.1, 0.0], [0.0, 0.2, -0.1], [0.1, 0.0, 0.4], [0.2, 0.2, 0.2]]),
                                 "s": np.zeros((4, 4)), "theta": 0.5, "dt": 2e-2},
 }
@@ -89,17 +92,22 @@ CASES = {
 def test_fast_kernel_equals_naive_same_seed(case, method, area):
     kw = CASES[case]
     inertia = np.array([1.0, 2.0, 3.0])
-    rb = rigid_body(inertia, xi=kw["xi"], s=kw["s"], theta=kw["theta"])
+    lid = kw.get("levy_in_dissipation", True)
+    rb = rigid_body(inertia, xi=kw["xi"], s=kw["s"], theta=kw["theta"], levy_in_dissipation=lid)
     mu0 = np.random.default_rng(3).standard_normal((5, 3))
     mu0 /= np.linalg.norm(mu0, axis=-1, keepdims=True)
     n = 60
     _, got = simulate_brownian(rb, mu0, kw["dt"], n, np.random.default_rng(11), method=method, levy_area=area,
                                save_every=n)
-    ref = _naive(inertia, kw["xi"], kw["s"], kw["theta"], mu0, kw["dt"], n, 11, isinstance(method, LieHeun), area)
+    ref = _naive(inertia, kw["xi"], kw["s"], kw["theta"], mu0, kw["dt"], n, 11, isinstance(method, LieHeun), area, lid)
     np.testing.assert_allclose(got[:, -1], ref, rtol=0, atol=1e-12)
     if area and kw["s"].any():               # the area matters: the naive scheme without it is far off
-        far = _naive(inertia, kw["xi"], kw["s"], kw["theta"], mu0, kw["dt"], n, 11, True, False)
+        far = _naive(inertia, kw["xi"], kw["s"], kw["theta"], mu0, kw["dt"], n, 11, True, False, lid)
         assert np.max(np.abs(got[:, -1] - far)) > 1e-6
+    if not lid:                              # the placement matters: the naive h~-dissipated scheme is far off
+        other = _naive(inertia, kw["xi"], kw["s"], kw["theta"], mu0, kw["dt"], n, 11, isinstance(method, LieHeun),
+                       area, True)
+        assert np.max(np.abs(got[:, -1] - other)) > 1e-6
 
 
 def test_trig_branch_is_exercised():
