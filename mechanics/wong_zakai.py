@@ -36,11 +36,13 @@ Planar example (paper eq. (2dexample)): ``dx = Qx dt + P(x) y/ε dt`` with ``A =
 ``MB = √(δ/(α²+γ²)) W`` with ``W = RB`` a Brownian motion (the paper's scaling is right) and the limit
 is ``dX = (Q + N_{12}S)X dt + √(δ/(α²+γ²)) P(X)∘dW`` with ``N_{12} = δγ/(2α(α²+γ²))``.
 
-Integrators. Both systems are integrated with a Casimir-preserving Strang splitting on the
-coadjoint orbit: half a drift step (Lie midpoint), the exact noise rotation by the step's level-2
-log-signature ``η = Σ ξ_i X^i + ½ Σ L^{ij} ξ_i×ξ_j`` (``L`` the step Lévy area), half a drift step.
-Each grid step of the coloured driver carries the exact Chen-summed area of ``B^ε``, so steps of
-order ``ε²`` suffice (the paper used steps far below ``ε²``); see ``benchmarks/bench_coloured_paper_scale.py``.
+Integrators. All systems are :class:`~mechanics.lie_poisson.LiePoissonSystem` rigid bodies (the
+limit with ``levy_in_dissipation=False``: torque in the conservative term only) integrated by the
+shared Casimir-preserving coadjoint schemes of :mod:`mechanics.integrators` (Lie–Heun by default):
+``Π ↦ exp(ad*_σ)Π`` with ``σ = w̄Δt + η`` and the step's level-2 log-signature
+``η = Σ ξ_i X^i + ½ Σ L^{ij} ξ_i×ξ_j`` (``L`` the step Lévy area). Each grid step of the coloured
+driver carries the exact Chen-summed area of ``B^ε``, so steps of order ``ε²`` suffice (the paper
+used steps far below ``ε²``); see ``benchmarks/bench_coloured_paper_scale.py``.
 """
 
 from __future__ import annotations
@@ -48,13 +50,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 import scipy.linalg as sla
 
 from roughpaths._validation import as_float_array, check_positive_int, check_rng
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
+
+from .integrators import LieHeun, simulate
+from .lie_algebra import so3
+from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
+from .rigid_body import rigid_body
 
 __all__ = [
     "levy_torque",
@@ -160,109 +166,9 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
     return RigidBodyWongZakai(limit=lim, sigma=sg, coloured_xi=cxi, limit_xi=lxi, torque=c, perturbation_B=sB)
 
 
-# ------------------------------------------------------------------------------------ kernels
-@numba.njit(cache=True, inline="always")
-def _rot(s0, s1, s2, m0, m1, m2):  # pragma: no cover
-    # m × s flow: exp(-[s]×) m = m - a s×m + b s×(s×m)
-    t2 = s0 * s0 + s1 * s1 + s2 * s2
-    if t2 < 1e-8:
-        a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
-        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
-    else:
-        t = math.sqrt(t2)
-        a = math.sin(t) / t
-        hh = math.sin(0.5 * t)
-        b = 2.0 * hh * hh / t2
-    c0 = s1 * m2 - s2 * m1
-    c1 = s2 * m0 - s0 * m2
-    c2 = s0 * m1 - s1 * m0
-    d0 = s1 * c2 - s2 * c1
-    d1 = s2 * c0 - s0 * c2
-    d2 = s0 * c1 - s1 * c0
-    return m0 - a * c0 + b * d0, m1 - a * c1 + b * d1, m2 - a * c2 + b * d2
-
-
-@numba.njit(cache=True, inline="always")
-def _cay(s0, s1, s2, m0, m1, m2):  # pragma: no cover
-    # Cayley approximation of exp(-[s]×) m (orthogonal: |m| exact, error O(|s|³))
-    k0, k1, k2 = 0.5 * s0, 0.5 * s1, 0.5 * s2
-    f = 2.0 / (1.0 + k0 * k0 + k1 * k1 + k2 * k2)
-    c0 = k1 * m2 - k2 * m1
-    c1 = k2 * m0 - k0 * m2
-    c2 = k0 * m1 - k1 * m0
-    d0 = k1 * c2 - k2 * c1
-    d1 = k2 * c0 - k0 * c2
-    d2 = k0 * c1 - k1 * c0
-    return m0 + f * (d0 - c0), m1 + f * (d1 - c1), m2 + f * (d2 - c2)
-
-
-@numba.njit(cache=True, inline="always")
-def _wdrift(iinv, cc, cd, theta, m0, m1, m2):  # pragma: no cover
-    # rotation velocity of Π×(IΠ + cc) + θ Π×(Π×(IΠ + cd)) = Π × w
-    g0 = iinv[0] * m0 + cd[0]
-    g1 = iinv[1] * m1 + cd[1]
-    g2 = iinv[2] * m2 + cd[2]
-    v0 = m1 * g2 - m2 * g1
-    v1 = m2 * g0 - m0 * g2
-    v2 = m0 * g1 - m1 * g0
-    return (iinv[0] * m0 + cc[0] + theta * v0, iinv[1] * m1 + cc[1] + theta * v1,
-            iinv[2] * m2 + cc[2] + theta * v2)
-
-
-@numba.njit(cache=True)
-def _rb_kernel(Pi, inc, area, dts, iinv, xi, cc, cd, theta, save_every, k0, out, osave):  # pragma: no cover
-    """Strang step: half drift (Lie midpoint, Cayley map), noise rotation by η (exact, Rodrigues), half drift."""
-    P, S, m = inc.shape
-    xx = np.zeros((m, m, 3))
-    for i in range(m):
-        for j in range(m):
-            xx[i, j, 0] = xi[i, 1] * xi[j, 2] - xi[i, 2] * xi[j, 1]
-            xx[i, j, 1] = xi[i, 2] * xi[j, 0] - xi[i, 0] * xi[j, 2]
-            xx[i, j, 2] = xi[i, 0] * xi[j, 1] - xi[i, 1] * xi[j, 0]
-    for p in range(P):
-        m0, m1, m2 = Pi[p, 0], Pi[p, 1], Pi[p, 2]
-        for s in range(S):
-            hh = 0.5 * dts[s]
-            for half in range(2):
-                if half == 1:
-                    # noise rotation by the level-2 log-signature
-                    e0 = 0.0
-                    e1 = 0.0
-                    e2 = 0.0
-                    for i in range(m):
-                        x = inc[p, s, i]
-                        e0 += xi[i, 0] * x
-                        e1 += xi[i, 1] * x
-                        e2 += xi[i, 2] * x
-                        for j in range(m):
-                            lv = 0.25 * (area[p, s, i, j] - area[p, s, j, i])  # ½ · Lévy area
-                            e0 += lv * xx[i, j, 0]
-                            e1 += lv * xx[i, j, 1]
-                            e2 += lv * xx[i, j, 2]
-                    m0, m1, m2 = _rot(e0, e1, e2, m0, m1, m2)
-                w0, w1, w2 = _wdrift(iinv, cc, cd, theta, m0, m1, m2)
-                q0, q1, q2 = _cay(0.5 * hh * w0, 0.5 * hh * w1, 0.5 * hh * w2, m0, m1, m2)
-                w0, w1, w2 = _wdrift(iinv, cc, cd, theta, q0, q1, q2)
-                m0, m1, m2 = _cay(hh * w0, hh * w1, hh * w2, m0, m1, m2)
-            k = k0 + s + 1
-            if k % save_every == 0:
-                j = k // save_every - osave
-                if j >= 0 and j < out.shape[1]:
-                    out[p, j, 0] = m0
-                    out[p, j, 1] = m1
-                    out[p, j, 2] = m2
-        Pi[p, 0], Pi[p, 1], Pi[p, 2] = m0, m1, m2
-
-
-def _inertia_inverse(inertia):
-    I = as_float_array(inertia, "inertia")
-    if I.shape == (3, 3):
-        if np.max(np.abs(I - np.diag(np.diag(I)))) > 0:
-            raise ValueError("inertia must be diagonal (principal axes) here; rotate the body frame first.")
-        I = np.diag(I)
-    if I.shape != (3,) or np.any(I <= 0):
-        raise ValueError(f"inertia must be 3 positive principal moments, got {np.asarray(inertia)!r}.")
-    return 1.0 / I
+# ------------------------------------------------------------------------------- shared integrators
+def _check_inertia3(inertia):
+    return check_inertia(inertia, "inertia", dim=3)
 
 
 def _vec3(v, name):
@@ -271,25 +177,63 @@ def _vec3(v, name):
     return as_float_array(v, name, ndim=1, last_dims=(3,))
 
 
+def _perturbation_for(xi, v, name):
+    """Antisymmetric ``s`` with ``½ Σ s^{ij} ξ_i×ξ_j = v`` (least squares; ``None`` for ``v = 0``)."""
+    if not np.any(v):
+        return None
+    m = xi.shape[0]
+    pi, pj = np.triu_indices(m, 1)
+    if pi.size == 0:
+        raise ValueError(f"{name} = {v} needs at least two noise vectors xi (the Lévy torque is ½ s^ij xi_i × "
+                         f"xi_j), got {m}.")
+    basis = np.cross(xi[pi], xi[pj]).T                                   # (3, npair): Σ_{i<j} s^{ij} ξ_i×ξ_j
+    coef, *_ = np.linalg.lstsq(basis, v, rcond=None)
+    resid = float(np.max(np.abs(basis @ coef - v)))
+    if resid > 1e-12 * max(1.0, float(np.max(np.abs(v)))):
+        raise ValueError(f"{name} = {v} is not a combination ½ s^ij xi_i × xi_j of the noise vectors' brackets "
+                         f"(residual {resid:.3g}); with these xi only torques in their span can be represented.")
+    s = np.zeros((m, m))
+    s[pi, pj], s[pj, pi] = coef, -coef
+    return s
+
+
+def _rigid_system(inertia, xi, theta, torque, dissipation_shift):
+    r"""so(3) system ``dΠ = Π×(Ω + c)dt + θΠ×(Π×(Ω + c_d))dt + Σ Π×ξ_i dX^i`` for the shared integrators.
+
+    ``h = ½Π·I⁻¹Π + c_d·Π`` and the Lévy velocity ``ℓ = c − c_d`` (via ``s``) in the conservative
+    term only (``levy_in_dissipation=False``).
+    """
+    I = _check_inertia3(inertia)
+    c, cd = _vec3(torque, "torque"), _vec3(dissipation_shift, "dissipation_shift")
+    s = _perturbation_for(xi, c - cd, "torque - dissipation_shift")
+    ham = QuadraticHamiltonian(np.linalg.inv(I), cd if np.any(cd) else None)
+    return LiePoissonSystem(so3(), ham, xi, s=s, theta=float(theta), levy_in_dissipation=False)
+
+
 def integrate_rigid_body(driver: RoughPath, Pi0, inertia, xi, theta=0.0, *, torque=None, dissipation_shift=None,
-                         save_every: int = 1):
+                         save_every: int = 1, method=None):
     r"""Integrate ``dΠ = Π×(Ω + c)dt + θΠ×(Π×(Ω + c_d))dt + Σ Π×ξ_i dX^i`` on a level-2 rough path.
 
-    Casimir-preserving Strang splitting (module docstring) using the increments and Lévy areas of
-    ``driver``; |Π| is conserved to round-off. With ``torque = dissipation_shift = c`` this is the
-    rough-path-correct (srblevy) model; with ``dissipation_shift = 0`` it is the limit of (srbcoloured).
+    With ``torque = dissipation_shift = c`` this is the rough-path-correct (srblevy) model; with
+    ``dissipation_shift = 0`` it is the limit of (srbcoloured). Runs the shared coadjoint integrators
+    (:func:`mechanics.integrators.simulate`, Lie–Heun by default, numba so(3) kernel) on the
+    system ``h = ½Π·I⁻¹Π + c_d·Π`` with the Lévy velocity ``c − c_d`` in the conservative term only
+    (``levy_in_dissipation=False``); ``|Π|`` is conserved to round-off.
 
     Parameters
     ----------
     driver : RoughPath
         Level-2 geometric path, dimension ``m``, batch ``(...)``.
     Pi0 : array_like ``(3,)`` or ``(..., 3)``
-    inertia : array_like ``(3,)`` principal moments
+    inertia : array_like ``(3,)`` principal moments or ``(3, 3)`` symmetric positive definite
     xi : array_like ``(m, 3)``
     theta : float
     torque, dissipation_shift : array_like ``(3,)``, optional
-        ``c`` in the conservative and ``c_d`` in the dissipative term (default 0).
+        ``c`` in the conservative and ``c_d`` in the dissipative term (default 0). ``c − c_d`` must
+        be a combination of the brackets ``ξ_i×ξ_j`` (always so for three independent ``ξ``).
     save_every : int
+    method : LieEuler() | LieHeun() | ImplicitMidpoint(...), optional
+        Default ``LieHeun()``.
 
     Returns
     -------
@@ -308,37 +252,27 @@ def integrate_rigid_body(driver: RoughPath, Pi0, inertia, xi, theta=0.0, *, torq
     if not isinstance(driver, RoughPath) or driver.level != 2:
         raise TypeError("driver must be a level-2 roughpaths.RoughPath (its step Lévy areas are used).")
     xi = as_float_array(xi, "xi", ndim=2, last_dims=(driver.dim, 3))
-    iinv = _inertia_inverse(inertia)
-    save_every = check_positive_int(save_every, "save_every")
-    batch = driver.batch_shape
-    P0 = as_float_array(Pi0, "Pi0", last_dims=(3,))
-    Pi = np.array(np.broadcast_to(P0, batch + (3,)).reshape(-1, 3))
-    P = Pi.shape[0]
-    N, m = driver.n_steps, driver.dim
-    inc = driver.increments.reshape(P, N, m)
-    area = driver.areas.reshape(P, N, m, m)
-    K = N // save_every + 1
-    out = np.empty((P, K, 3))
-    out[:, 0] = Pi
-    _rb_kernel(Pi, np.ascontiguousarray(inc), np.ascontiguousarray(area), driver.dt, iinv, xi,
-               _vec3(torque, "torque"), _vec3(dissipation_shift, "dissipation_shift"), float(theta),
-               save_every, 0, out, 0)
-    return driver.times[::save_every][:K], out.reshape(batch + (K, 3))
+    system = _rigid_system(inertia, xi, theta, torque, dissipation_shift)
+    return simulate(system, Pi0, driver, LieHeun() if method is None else method, save_every)
 
 
 def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0), theta=1.0, Pi0=(0.0, 0.0, 1.0),
                                    T=1.0, h=None, n_paths=1, rng, substeps=None, save_every=1,
-                                   systems=("coloured", "limit", "no_torque"), chunk_steps=None):
+                                   systems=("coloured", "limit", "no_torque"), chunk_steps=None, method=None):
     r"""Coloured rigid body (srbcoloured) and its limits, coupled through the same Brownian motion.
 
     Streams the exact coloured noise (:func:`roughpaths.coloured_noise.iter_coloured_noise`) in time
-    chunks (constant memory) and integrates, on the same draws:
+    chunks (constant memory) and integrates, on the same draws, with the shared coadjoint
+    integrators (:func:`mechanics.integrators.simulate` on each chunk's :class:`~roughpaths.RoughPath`):
 
     * ``"coloured"``: (srbcoloured), ``ξ_i = σe_i`` driven by the level-2 lift of ``B^ε``;
     * ``"limit"``: the white-noise limit, ``ξ'_k = σ(A⁻¹D)[:, k]`` driven by ``B`` with the Lévy torque
-      ``c`` in the conservative part only (exact limit);
+      ``c`` in the conservative part only (exact limit): ``rigid_body(..., s=s_B,
+      levy_in_dissipation=False)`` with ``s_B = M⁻¹NM⁻ᵀ`` (for a non-invertible ``M = A⁻¹D``: the
+      same RDE in B^ε coordinates, ``ξ_i = σe_i``, ``s = N``, driven by ``(MB, M𝔹Mᵀ)``);
     * ``"no_torque"``: the same without the torque (plain Stratonovich Wong–Zakai guess);
-    * ``"srblevy"``: torque in both parts (dissipation from ``h̃``, the paper's (srblevy) model).
+    * ``"srblevy"``: torque in both parts (dissipation from ``h̃``, the paper's (srblevy) model:
+      ``levy_in_dissipation=True``).
 
     The limit systems use ``B``'s piecewise-linear lift over the sub-steps (its Lévy area is the
     conditional expectation given the sub-step increments).
@@ -359,6 +293,8 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     save_every : int
     systems : tuple of str
     chunk_steps : int, optional
+    method : LieEuler() | LieHeun() | ImplicitMidpoint(...), optional
+        Default ``LieHeun()``.
 
     Returns
     -------
@@ -379,15 +315,24 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     h = T / n_steps
     save_every = check_positive_int(save_every, "save_every")
     n_paths = check_positive_int(n_paths, "n_paths")
-    iinv = _inertia_inverse(inertia)
+    method = LieHeun() if method is None else method
+    inertia = _check_inertia3(inertia)
     P0 = as_float_array(Pi0, "Pi0", ndim=1, last_dims=(3,))
     K = n_steps // save_every + 1
-    zero = np.zeros(3)
+    M = wz.limit.scaling
+    if wz.perturbation_B is not None:          # the limit's noise vectors σ M[:, k], driven by B
+        lxi, ls, lmap = wz.limit_xi, wz.perturbation_B, None
+    else:                                      # B^ε coordinates: σ e_i driven by MB (same RDE)
+        lxi, ls, lmap = wz.coloured_xi, wz.limit.levy_perturbation, M
+
+    def body(xi, s=None, lid=True):
+        return rigid_body(inertia, xi=xi, s=s, theta=theta, levy_in_dissipation=lid)
+
     cfg = {
-        "coloured": (wz.coloured_xi, zero, zero, False),
-        "limit": (wz.limit_xi, wz.torque, zero, True),
-        "no_torque": (wz.limit_xi, zero, zero, True),
-        "srblevy": (wz.limit_xi, wz.torque, wz.torque, True),
+        "coloured": (body(wz.coloured_xi), False),
+        "limit": (body(lxi, ls, False), True),
+        "no_torque": (body(lxi), True),
+        "srblevy": (body(lxi, ls, True), True),
     }
     state = {k: np.tile(P0, (n_paths, 1)) for k in systems}
     out = {k: np.empty((n_paths, K, 3)) for k in systems}
@@ -398,11 +343,19 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
                                                          n_paths=n_paths, substeps=substeps,
                                                          chunk_steps=chunk_steps):
         S = inc.shape[1]
-        dts = np.full(S, h)
+        times = (done + np.arange(S + 1)) * h
+        X = RoughPath(inc, area, times=times, kind="geometric", check=False)
+        if any(cfg[k][1] for k in systems):
+            if lmap is not None:
+                binc, barea = binc @ lmap.T, lmap @ barea @ lmap.T
+            XB = RoughPath(binc, barea, times=times, kind="geometric", check=False)
+        j = np.arange(done + 1, done + S + 1)
+        keep = j % save_every == 0
         for k in systems:
-            xi, cc, cd, use_b = cfg[k]
-            _rb_kernel(state[k], binc if use_b else inc, barea if use_b else area, dts, iinv, xi, cc, cd,
-                       float(theta), save_every, done, out[k], 0)
+            system, use_b = cfg[k]
+            _, st = simulate(system, state[k], XB if use_b else X, method)          # (P, S + 1, 3)
+            out[k][:, j[keep] // save_every] = st[:, 1:][:, keep]
+            state[k] = st[:, -1].copy()
         done += S
     res = {"times": np.arange(K) * h * save_every, "h": h, "n_steps": n_steps}
     res.update(out)
