@@ -220,14 +220,15 @@ class _Spec:
 
 
 def _draw_block(gens, k, dt, m, levy_area):
-    """Increments (c, k, m) and Stratonovich areas (c, k, m, m), one generator call per path."""
+    """Increments (c, k, m) and Stratonovich areas (c, k, m, m) (``None`` without Lévy area: level-1
+    driving), one generator call per path."""
     c = len(gens)
     dW = np.empty((c, k, m))
     if levy_area is None:
         sq = math.sqrt(dt)
         for p, g in enumerate(gens):
             dW[p] = g.standard_normal((k, m)) * sq
-        return dW, 0.5 * dW[..., :, None] * dW[..., None, :]
+        return dW, None
     from roughpaths.brownian import brownian_increments_and_areas
     areas = np.empty((c, k, m, m))
     for p, g in enumerate(gens):
@@ -272,8 +273,12 @@ def _run_chunk(spec: _Spec, first: int, last: int):
         k = min(spec.block_steps, spec.n_steps - step)
         dW, areas = _draw_block(gens, k, spec.dt, m, spec.levy_area)
         times = (step + np.arange(k + 1)) * spec.dt
-        X = RoughPath(dW, areas, times=times, kind="geometric", check=False)
-        _, states = simulate(system, mu, X, spec.method)            # (c, k+1, n)
+        if areas is None:                                            # level 1: zero step Lévy area
+            X = RoughPath.from_increments(dW, None, times=times)
+            _, states = simulate(system, mu, X, spec.method, levy_area=False)   # (c, k+1, n)
+        else:
+            X = RoughPath(dW, areas, times=times, kind="geometric", check=False)
+            _, states = simulate(system, mu, X, spec.method)        # (c, k+1, n)
         idx = step + np.arange(1, k + 1)                             # global step numbers of states[:, 1:]
         # averaged steps: idx > burn_in and idx % average_every == 0, as a strided slice (no copy)
         first_ok = max(spec.burn_in + 1, step + 1)
