@@ -607,7 +607,7 @@ def _wz_row(fig, gs_row, traj, times, T, label):
           "dy = −ε⁻²Ay dt + ε⁻¹dB, A = kI + Λ, k = 0.05, Λ = skew(0,0,1) read as Λ₁₃ = 1 = −Λ₃₁ (the reading fixed "
           "by the paper's printed A⁻¹D), θ = 1, σ = 0.05, 𝕀 = diag(1, 2, 3), Π(0) = e₃ (red dot). The equation has "
           "no Lévy drift; the trajectory leaves the north pole and settles near ±e₂. Integrated with the "
-          "Casimir-preserving Strang scheme on the exact level-2 lift of B^ε (steps ε²/(2‖A‖)).", requires=_WZ)
+          "Casimir-preserving coadjoint Lie–Heun scheme on the exact level-2 lift of B^ε (steps ε²/(2‖A‖)).", requires=_WZ)
 def fig4(ctx) -> FigureResult:
     run = _wong_zakai_run(ctx)
     res, T = run["res"], run["T"]

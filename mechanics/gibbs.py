@@ -153,6 +153,11 @@ class GibbsMeasure:
         for attr in ("inertia", "xi", "theta", "torque_velocity"):
             if not hasattr(system, attr):
                 raise TypeError(f"system must be a rigid body (mechanics.rigid_body.rigid_body), it has no .{attr}.")
+        if system.theta > 0 and not getattr(system, "levy_in_dissipation", True) and np.any(system.torque_velocity):
+            raise ValueError("the Gibbs density exp(-2θh̃/σ²) is the invariant law of Theorem 3.1's model, whose "
+                             "dissipation is built from h̃; this system has levy_in_dissipation=False (torque in "
+                             "the conservative term only), whose invariant law is not of that form. Build the "
+                             "system with levy_in_dissipation=True, or estimate its law by simulation.")
         xi = np.asarray(system.xi, dtype=np.float64)
         sigma = float(xi[0, 0]) if xi.shape == (3, 3) else 0.0
         if xi.shape != (3, 3) or not np.allclose(xi, sigma * np.eye(3), rtol=0, atol=1e-14 * max(abs(sigma), 1e-300)) \

@@ -152,3 +152,14 @@ def test_from_system():
     assert np.allclose(gp.mean, -ref.mean, atol=1e-14)     # flipped torque c -> -c: mirrored law
     with pytest.raises(ValueError, match="isotropic"):
         GibbsMeasure.from_system(rigid_body([1.0, 2.0, 3.0], xi=np.diag([0.1, 0.2, 0.3]), theta=1.0))
+
+
+def test_from_system_refuses_torque_outside_the_dissipation():
+    """exp(−2θh̃/σ²) is the law of Theorem 3.1's model only; the conservative-only variant is refused."""
+    from mechanics import rigid_body
+
+    s = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
+    other = rigid_body(np.diag([1.0, 2.0, 3.0]), sigma=0.3, s=s, theta=1.0, levy_in_dissipation=False)
+    with pytest.raises(ValueError, match="levy_in_dissipation"):
+        GibbsMeasure.from_system(other)
+    GibbsMeasure.from_system(rigid_body(np.diag([1.0, 2.0, 3.0]), sigma=0.3, s=s, theta=1.0))
