@@ -62,7 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "the paper's printed equations, slips included, to reproduce its figures literally")
     p.add_argument("--seed", default="0", metavar="INT", help="seed of every random stream (default 0)")
     size = p.add_mutually_exclusive_group()
-    size.add_argument("--full", action="store_true", help="paper-scale sizes (long: tens of minutes)")
+    size.add_argument("--full", action="store_true", help="paper-scale sizes (about 4-6 minutes on 2 cores; epsilon = 0.005 over T = 500 for Figures 4-5)")
     size.add_argument("--tiny", action="store_true",
                       help="smoke-test sizes (seconds; numbers not meaningful, checks may fail)")
     p.add_argument("--only", action="append", default=None, metavar="NAMES",
