@@ -31,7 +31,8 @@ __all__ = ["HeavyTop", "heavy_top"]
 class HeavyTop(LiePoissonSystem):
     """A :class:`~mechanics.lie_poisson.LiePoissonSystem` on se(3)* (state ``(..., 6) = (Pi, Gamma)``)."""
 
-    def __init__(self, inertia, chi, xi, s=None, theta=0.0, convention="rp", *, metric=None):
+    def __init__(self, inertia, chi, xi, s=None, theta=0.0, convention="rp", *, metric=None,
+                 levy_in_dissipation=True):
         inertia = check_inertia(inertia, "inertia", dim=3)
         chi = as_float_array(chi, "chi", ndim=1)
         if chi.shape != (3,):
@@ -47,7 +48,7 @@ class HeavyTop(LiePoissonSystem):
         sign = 1.0 if convention == "rp" else -1.0
         lin = np.concatenate([np.zeros(3), sign * chi])
         super().__init__(se3(), QuadraticHamiltonian(q, lin), xi, s=s, theta=theta, convention=convention,
-                         metric=metric)
+                         metric=metric, levy_in_dissipation=levy_in_dissipation)
         self.inertia, self.chi = inertia, chi
         self._q, self._chi_lin = q, np.concatenate([np.zeros(3), chi])
 
@@ -61,7 +62,8 @@ class HeavyTop(LiePoissonSystem):
         return self.energy(mu) + self._mu(mu) @ self.torque_velocity
 
 
-def heavy_top(inertia, chi, xi=None, sigma=None, s=None, theta=0.0, convention="rp", *, metric=None) -> HeavyTop:
+def heavy_top(inertia, chi, xi=None, sigma=None, s=None, theta=0.0, convention="rp", *, metric=None,
+              levy_in_dissipation=True) -> HeavyTop:
     r"""The stochastic heavy top on se(3)*.
 
     Parameters
@@ -72,6 +74,10 @@ def heavy_top(inertia, chi, xi=None, sigma=None, s=None, theta=0.0, convention="
     s : array_like ``(m, m)`` antisymmetric, optional
     theta : float >= 0
     convention : {"rp", "paper"}
+    levy_in_dissipation : bool
+        Where the Lévy-area velocity enters (see :class:`~mechanics.lie_poisson.LiePoissonSystem`):
+        ``True`` (default) in the Hamiltonian of both the conservative and the double-bracket term;
+        ``False`` in the conservative term only (the exact form of driving by ``X.perturb(s)``).
 
     Examples
     --------
@@ -82,4 +88,4 @@ def heavy_top(inertia, chi, xi=None, sigma=None, s=None, theta=0.0, convention="
     array([0., 0., 0.])
     """
     return HeavyTop(inertia, chi, _noise_vectors(xi, sigma, 3), s=s, theta=theta, convention=convention,
-                    metric=metric)
+                    metric=metric, levy_in_dissipation=levy_in_dissipation)
