@@ -45,7 +45,7 @@ import numpy as np
 
 from roughpaths._validation import as_float_array, check_positive_int, check_rng
 
-from .equilibria import _as_c, _check_radius, as_inverse_inertia, rigid_body_equilibria
+from .equilibria import _as_c, _check_radius, _tangent_basis, as_inverse_inertia, rigid_body_equilibria
 
 __all__ = ["GibbsMeasure", "gibbs_beta", "gibbs_moments"]
 
@@ -187,13 +187,8 @@ class GibbsMeasure:
     # ------------------------------------------------------------------ quadrature
     def _frame(self):
         n = self._pole
-        k = int(np.argmin(np.abs(n)))
-        e = np.zeros(3)
-        e[k] = 1.0
-        u = np.cross(n, e)
-        u /= np.linalg.norm(u)
-        v = np.cross(n, u)
-        return u, v, n
+        b = _tangent_basis(n)
+        return b[:, 0], b[:, 1], n
 
     def _rule(self, level):
         """Nodes (ϑ, weights_ϑ) and the number of φ nodes of refinement ``level``."""
