@@ -38,7 +38,7 @@ from typing import Callable
 
 import numpy as np
 
-from roughpaths._validation import as_float_array, check_positive_int
+from roughpaths.validation import as_float_array, check_positive_int
 
 __all__ = ["RunningMoments", "EnsembleResult", "moment_observable", "split_moment_features",
            "path_generator", "run_ensemble"]

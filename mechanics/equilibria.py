@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from roughpaths._validation import as_float_array, check_antisymmetric
+from roughpaths.validation import as_float_array, check_antisymmetric
 
 __all__ = [
     "Equilibrium",

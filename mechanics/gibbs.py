@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from roughpaths._validation import as_float_array, check_positive_int, check_rng
+from roughpaths.validation import as_float_array, check_positive_int, check_rng
 
 from .equilibria import _as_c, _check_radius, _tangent_basis, as_inverse_inertia, rigid_body_equilibria
 

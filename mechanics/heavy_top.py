@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from roughpaths._validation import as_float_array
+from roughpaths.validation import as_float_array
 
 from .lie_algebra import se3
 from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia

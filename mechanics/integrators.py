@@ -36,7 +36,7 @@ Entry points: :func:`simulate` (a materialised :class:`roughpaths.RoughPath`) an
 :func:`simulate_brownian` (Stratonovich Brownian motion generated in time chunks, constant memory).
 For so(3) with a quadratic Hamiltonian both run numba block kernels (state as three rows of paths,
 the per-step loop over paths vectorised); other algebras use a batched numpy loop (``Ad*exp`` in
-closed form for so(3)/se(3), :func:`roughpaths.solvers.expm_batched` otherwise).
+closed form for so(3)/se(3), :func:`roughpaths.expm_batched` otherwise).
 
 Random stream of :func:`simulate_brownian` (every path): for each step in turn, for each path in
 turn, the ``w`` unit normals of that path-step: ``dW`` (``m``), then with the area ``H`` (``m``) and
@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from roughpaths._validation import as_float_array, check_positive_int, check_rng
+from roughpaths.validation import as_float_array, check_positive_int, check_rng
 from roughpaths.rough_path import RoughPath
 
 from .lie_poisson import LiePoissonSystem

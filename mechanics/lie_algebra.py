@@ -27,8 +27,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from roughpaths._validation import as_float_array
-from roughpaths.solvers import expm_batched
+from roughpaths.validation import as_float_array
+from roughpaths import expm_batched
 
 __all__ = ["LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee", "rodrigues_ad_star_exp", "se3_ad_star_exp"]
 
@@ -95,7 +95,7 @@ class LieAlgebra:
         Names of the Casimirs, for messages.
     ad_star_exp : callable, optional
         Closed-form ``(sigma, mu) -> exp(ad*_sigma) mu``; default: the batched matrix exponential
-        :func:`roughpaths.solvers.expm_batched` of the ``ad*`` matrices.
+        :func:`roughpaths.expm_batched` of the ``ad*`` matrices.
 
     Examples
     --------
@@ -280,7 +280,7 @@ class LieAlgebra:
         r""":math:`\exp(\mathrm{ad}^*_\sigma)\,\mu`, the coadjoint action of :math:`\exp\sigma` used by the
         integrators (time-1 flow of :math:`\dot\mu = \mathrm{ad}^*_\sigma\mu`). Shapes ``(..., n)``
         broadcast. Closed form where the factory provides one (so(3): Rodrigues), else
-        :func:`roughpaths.solvers.expm_batched` of the batched ``ad*`` matrices.
+        :func:`roughpaths.expm_batched` of the batched ``ad*`` matrices.
         """
         sigma, mu = self._vec(sigma, "sigma"), self._vec(mu, "mu")
         return self._ad_star_exp_unchecked(sigma, mu)

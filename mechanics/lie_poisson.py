@@ -57,7 +57,7 @@ import numbers
 
 import numpy as np
 
-from roughpaths._validation import as_float_array, check_antisymmetric
+from roughpaths.validation import as_float_array, check_antisymmetric
 
 from .lie_algebra import LieAlgebra
 

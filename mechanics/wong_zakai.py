@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from roughpaths._validation import as_float_array, check_positive_int, check_rng
+from roughpaths.validation import as_float_array, check_positive_int, check_rng
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
 

@@ -31,8 +31,10 @@ from .norms import (
     rough_path_p_variation,
 )
 from .rough_path import RoughPath, chen_defect
-from .solve import Solution, solve
-from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, expm_batched
+from .driver import Driver
+from .solve import NonFiniteStateError, Solution, solve
+from ._linalg import expm_batched
+from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
 from .signature import logsignature, rough_path_signature, signature
 from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
 from .tensor_algebra import (
@@ -55,6 +57,9 @@ __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
     "solve",
     "Solution",
+    "NonFiniteStateError",
+    "Driver",
+    "Solver",
     "Euler",
     "Heun",
     "Davie",

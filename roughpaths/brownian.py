@@ -67,7 +67,7 @@ import numbers
 
 import numpy as np
 
-from ._validation import as_float_array, check_positive_int, check_rng, check_times
+from .validation import as_float_array, check_positive_int, check_rng, check_times
 from ._brownian_kernels import _step_areas
 from .level2 import outer
 from .rough_path import RoughPath

@@ -67,7 +67,7 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from ._validation import as_float_array, check_positive_int, check_rng, check_times
+from .validation import as_float_array, check_positive_int, check_rng, check_times
 from .rough_path import RoughPath
 
 __all__ = [

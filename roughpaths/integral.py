@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_float_array
+from .validation import as_float_array
 from .rough_path import RoughPath
 
 __all__ = ["rough_integral"]

@@ -50,7 +50,7 @@ import numbers
 import numpy as np
 
 from . import _norm_kernels as _k
-from ._validation import as_float_array, check_same_batch, check_times
+from .validation import as_float_array, check_same_batch, check_times
 from .rough_path import RoughPath
 
 __all__ = [

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_float_array, check_antisymmetric, check_times
+from .validation import as_float_array, check_antisymmetric, check_times
 from .level2 import outer
 
 __all__ = ["RoughPath", "chen_defect"]

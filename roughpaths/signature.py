@@ -20,7 +20,7 @@ import numba
 import numpy as np
 
 from . import _signature_kernels as _k
-from ._validation import as_float_array, check_positive_int
+from .validation import as_float_array, check_positive_int
 from .tensor_algebra import (_reversed_to_rowmajor, lyndon_coordinates, logsigdim, sigdim,
                              tensor_log)
 

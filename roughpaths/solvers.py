@@ -1,15 +1,10 @@
 r"""One-step RDE solvers for :func:`roughpaths.solve.solve`.
 
-Each solver is a small class with two class attributes and one method:
-
-* ``increment_level`` -- 1 if a step uses only the increment :math:`X_{s,t}`, 2 if it also uses the
-  area :math:`\mathbb{X}_{s,t}` (a level-2 solver refuses a level-1 driver);
-* ``order`` -- the declared **strong order on Brownian rough paths** (Stratonovich lift, non-commuting
-  fields, mesh ``h``: the error is :math:`O(h^{\text{order}})` in :math:`L^2`);
-  ``smooth_order`` -- the order on **smooth drivers** with exact increments (and areas);
-* ``step(fields, y, t, dt, dX, dXX)`` -- one step from ``y`` (``(..., e)``) over ``[t, t + dt]`` with the
-  increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` at level 1), vectorised
-  over the batch (leading axes broadcast).
+Each solver is a small class following the numbered contract of :class:`Solver` (what level of
+increment a step consumes, its declared orders, its calculus, the invariants it preserves, and the
+``step`` / ``integrate`` methods). The solvers below integrate
+:class:`~roughpaths.vector_fields.VectorFields`; :mod:`mechanics` adds coadjoint solvers for
+Lie–Poisson systems under the same contract, so that one :func:`roughpaths.solve` integrates both.
 
 Conventions (``CONVENTIONS.md``): area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`, bracket
 :math:`[V, W] = DW\cdot V - DV\cdot W`, Lévy area :math:`A = \tfrac12(\mathbb{X} - \mathbb{X}^T)`.
@@ -27,24 +22,98 @@ solver        level  order (BM, RP)  smooth order  note
 from __future__ import annotations
 
 import numbers
-from math import factorial
 
 import numpy as np
 
+from ._linalg import expm_batched
 from .level2 import outer
 
-__all__ = ["Solver", "Euler", "Heun", "Davie", "LogODE", "SOLVERS", "expm_batched"]
+__all__ = ["Solver", "Euler", "Heun", "Davie", "LogODE", "SOLVERS"]
 
 
 class Solver:
-    """Base class: subclasses set ``increment_level``, ``order``, ``smooth_order`` and define ``step``."""
+    r"""Base class of the one-step solvers that :func:`roughpaths.solve` drives: the solver contract.
+
+    A solver is a small object. :func:`~roughpaths.solve` relies on exactly the following, in this
+    order (subclasses override what they need; the defaults serve vector-field RDEs):
+
+    1. ``increment_level`` (class attribute, 1 or 2): what a step consumes, the increment
+       :math:`X_{s,t}` alone (1) or also the area :math:`\mathbb{X}_{s,t}` (2). ``solve`` refuses a
+       driver of lower level; a level-1 solver never sees the areas of a level-2 driver.
+    2. ``order`` and ``smooth_order`` (class attributes): the declared strong order on Brownian rough
+       paths (Stratonovich lift, non-commuting fields) and the order on smooth drivers with exact
+       increments and areas. Convergence tests fit these.
+    3. ``calculus`` (class attribute): ``"stratonovich"`` if the scheme solves the geometric
+       (Stratonovich) RDE on a geometric driver, ``"ito"`` if it converges to the Itô solution on
+       Brownian motion whatever the area it is given (left-point evaluation, :class:`Euler`).
+    4. ``preserves`` (class attribute, tuple of str): invariants kept to round-off by construction,
+       e.g. ``("casimirs",)`` for coadjoint schemes; empty for the generic schemes.
+    5. ``check_fields(fields)``: return the object to integrate, or raise ``TypeError`` naming what
+       this solver accepts. The default accepts :class:`~roughpaths.vector_fields.VectorFields`.
+    6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath`` or a
+       :class:`~roughpaths.driver.Driver`) cannot drive this scheme. The default checks the level.
+    7. ``step(fields, y, t, dt, dX, dXX)``: one step from ``y`` (``(..., e)``) over ``[t, t + dt]``
+       with the increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` for a
+       level-1 solver), vectorised over the leading (broadcast) batch axes. Each batch member's
+       result must depend on that member's data only (no reductions or shared scalings over the batch).
+    8. ``integrate(fields, y, times, dX, dXX, save, stop_on_failure)``: advance a block of steps
+       (``times`` of shape ``(K + 1,)``, ``dX`` ``(..., K, d)``, ``dXX`` ``(..., K, d, d)`` or ``None``,
+       ``save`` a boolean mask ``(K,)`` of the steps after which the state is kept). Returns
+       ``(y, saved, first_bad)``: the final state, the kept states ``(..., save.sum(), e)`` and, per
+       batch member, the index of the first step after which the member was non-finite (``-1`` if
+       never). With ``stop_on_failure`` it may return as soon as a member fails. The default loops
+       :meth:`step`; compiled fast paths override this method and must return what stepping returns.
+    """
 
     increment_level: int = 1
     order: float = 0.0
     smooth_order: float = 0.0
+    calculus: str = "stratonovich"
+    preserves: tuple = ()
+
+    def check_fields(self, fields):
+        """Return ``fields`` if this solver can integrate it (contract item 5)."""
+        from .vector_fields import VectorFields
+
+        if not isinstance(fields, VectorFields):
+            raise TypeError(f"{self!r} integrates VectorFields objects (LinearVectorFields(M) or "
+                            f"VectorFields(callables, ...)), got {type(fields).__name__}; a Lie–Poisson "
+                            f"system needs a coadjoint solver (mechanics.LieEuler(), LieHeun(), "
+                            f"ImplicitMidpoint()).")
+        return fields
+
+    def check_driver(self, driver) -> None:
+        """Raise ``ValueError`` if ``driver`` cannot drive this scheme (contract item 6)."""
+        if self.increment_level >= 2 and driver.level < 2:
+            raise ValueError(f"{self!r} is a level-2 solver and needs the driver's area, but the driver is "
+                             f"level 1 (no area); pass a level-2 RoughPath (e.g. a Brownian rough path with "
+                             f"its Lévy area), or choose a level-1 solver (Heun(), Euler()) if dropping the "
+                             f"area is intended.")
 
     def step(self, fields, y, t, dt, dX, dXX):  # pragma: no cover - abstract
-        raise NotImplementedError
+        """One step (contract item 7)."""
+        raise NotImplementedError(f"{type(self).__name__} does not define step()")
+
+    def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
+        """Advance ``y`` over a block of steps (contract item 8) by calling :meth:`step` per step."""
+        n = times.shape[0] - 1
+        saved = np.empty(y.shape[:-1] + (int(np.count_nonzero(save)), y.shape[-1]))
+        first_bad = np.full(y.shape[:-1], -1, dtype=np.int64)
+        dts = np.diff(times)
+        slot = 0
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for k in range(n):
+                y = self.step(fields, y, times[k], dts[k], dX[..., k, :],
+                              None if dXX is None else dXX[..., k, :, :])
+                bad = ~np.all(np.isfinite(y), axis=-1)
+                if bad.any():
+                    first_bad[bad & (first_bad < 0)] = k
+                    if stop_on_failure:
+                        break
+                if save[k]:
+                    saved[..., slot, :] = y
+                    slot += 1
+        return y, saved, first_bad
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
@@ -70,6 +139,7 @@ class Euler(Solver):
     increment_level = 1
     order = 0.5
     smooth_order = 1.0
+    calculus = "ito"
 
     def step(self, fields, y, t, dt, dX, dXX):
         V = fields.fields(y)
@@ -216,63 +286,3 @@ class LogODE(Solver):
 
 #: Solver names accepted by :func:`~roughpaths.solve.solve` as strings (default instances).
 SOLVERS = {"euler": Euler, "heun": Heun, "davie": Davie, "logode": LogODE}
-
-
-# ---------------------------------------------------------------------- batched matrix exponential
-_THETA = ((3, 1.495585217958292e-2), (5, 2.539398330063230e-1), (7, 9.504178996162932e-1),
-          (9, 2.097847961257068e0), (13, 5.371920351148152e0))
-
-
-def _pade_coefficients(m):
-    return [factorial(2 * m - k) * factorial(m) / (factorial(2 * m) * factorial(k) * factorial(m - k))
-            for k in range(m + 1)]
-
-
-_PADE = {m: _pade_coefficients(m) for m, _ in _THETA}
-
-
-def expm_batched(A) -> np.ndarray:
-    r"""Matrix exponential of a batch ``A`` (shape ``(..., n, n)``), vectorised.
-
-    Scaling and squaring with the diagonal Padé approximant of degree ``m ∈ {3, 5, 7, 9, 13}`` chosen
-    from the largest 1-norm in the batch (Higham 2005 thresholds, backward error below the float64
-    unit roundoff). One degree and one number of squarings serve the whole batch, so a batch of
-    small matrices costs a handful of batched ``matmul`` calls and one batched ``solve``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from roughpaths.solvers import expm_batched
-    >>> R = expm_batched(np.array([[0.0, -np.pi / 2], [np.pi / 2, 0.0]]))   # rotation by 90°
-    >>> np.round(R, 12) + 0.0
-    array([[ 0., -1.],
-           [ 1.,  0.]])
-    """
-    A = np.asarray(A, dtype=np.float64)
-    n = A.shape[-1]
-    if A.size == 0:
-        return np.broadcast_to(np.eye(n), A.shape).copy()
-    norm = float(np.max(np.sum(np.abs(A), axis=-2)))
-    if not np.isfinite(norm):
-        return np.full(A.shape, np.nan)
-    s = 0
-    for m, theta in _THETA:
-        if norm <= theta:
-            break
-    else:
-        m = 13
-        s = max(0, int(np.ceil(np.log2(norm / _THETA[-1][1]))))
-        A = A / (2.0 ** s)
-    b = _PADE[m]
-    eye = np.broadcast_to(np.eye(n), A.shape)
-    A2 = A @ A
-    powers = [eye, A2]                                 # A^0, A^2, A^4, ...
-    for _ in range(2, m // 2 + 1):
-        powers.append(powers[-1] @ A2)
-    Uin = sum(b[2 * k + 1] * powers[k] for k in range(m // 2 + 1))
-    U = A @ Uin
-    V = sum(b[2 * k] * powers[k] for k in range(m // 2 + 1))
-    R = np.linalg.solve(V - U, V + U)
-    for _ in range(s):
-        R = R @ R
-    return R

@@ -40,7 +40,7 @@ from functools import lru_cache
 import numpy as np
 
 from ._lyndon import bracket_string, lyndon_expansion, lyndon_projection, lyndon_words
-from ._validation import as_float_array, check_positive_int, check_same_batch
+from .validation import as_float_array, check_positive_int, check_same_batch
 
 __all__ = [
     "sigdim",

@@ -35,7 +35,7 @@ import numbers
 
 import numpy as np
 
-from ._validation import as_float_array, check_antisymmetric
+from .validation import as_float_array, check_antisymmetric
 
 __all__ = ["VectorFields", "LinearVectorFields", "LinearDrift", "FD_STEP"]
 
@@ -119,7 +119,7 @@ class VectorFields:
 
     def __init__(self, fields, jacobians=None, *, drift=None, drift_jacobian=None,
                  dim_state=None, dim_noise=None):
-        from ._validation import check_positive_int
+        from .validation import check_positive_int
         if dim_state is None or dim_noise is None:
             raise TypeError("dim_state (e) and dim_noise (d) are required for callable vector fields, "
                             "e.g. VectorFields(f, dim_state=3, dim_noise=2).")

@@ -20,7 +20,7 @@ import scipy.linalg
 from hypothesis import given
 from hypothesis import strategies as st
 
-from roughpaths.solvers import expm_batched
+from roughpaths import expm_batched
 from roughpaths.vector_fields import LinearDrift, LinearVectorFields, VectorFields
 
 E, D = 3, 2

@@ -1,4 +1,7 @@
-"""Input checks shared by every public function (private).
+"""Input checks shared by every public function of ``roughpaths`` and ``mechanics``.
+
+This module is public to the two packages (``from roughpaths.validation import ...``); it is the one
+place where argument checks live, so that a mistake gets the same kind of message everywhere.
 
 Every check raises a ``TypeError`` (wrong kind of object) or ``ValueError`` (wrong value) whose
 message names the argument, shows the offending value or shape, and says how to fix it.
