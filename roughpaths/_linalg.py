@@ -6,15 +6,21 @@ so a member's result is bitwise the same whether it is computed alone or beside 
 non-finite member gives NaN for itself only. The work is still vectorised: the members are grouped
 by degree (at most five groups), and the squarings run on the shrinking set of members that still
 need them.
+
+The small products :func:`matvec` and :func:`vecmat` serve the same promise for the linear vector
+fields: ``y @ A.T`` on a batch ``(B, e)`` is one BLAS matrix product whose summation order depends on
+``B`` (a member differs in the last bit from the same row computed alone), whereas these generalised
+ufuncs sum every member's product in one fixed order, whatever the batch.
 """
 
 from __future__ import annotations
 
 from math import factorial
 
+import numba
 import numpy as np
 
-__all__ = ["expm_batched"]
+__all__ = ["expm_batched", "matvec", "vecmat"]
 
 # (degree m, largest 1-norm for which the degree-m diagonal Padé approximant has backward error
 # below the float64 unit roundoff): Higham, SIAM J. Matrix Anal. Appl. 26 (2005), Table 2.3.
@@ -107,9 +113,31 @@ def expm_batched(A) -> np.ndarray:
             continue
         s = squarings[idx]
         scaled = flat[idx] / (2.0 ** s)[:, None, None] if m == 13 else flat[idx]
-        R = _pade(scaled, m)
-        for r in range(1, int(s.max(initial=0)) + 1):
-            active = np.flatnonzero(s >= r)
-            R[active] = R[active] @ R[active]
+        with np.errstate(over="ignore", invalid="ignore"):      # a member whose exp overflows: inf/NaN
+            R = _pade(scaled, m)
+            for r in range(1, int(s.max(initial=0)) + 1):
+                active = np.flatnonzero(s >= r)
+                R[active] = R[active] @ R[active]
         out[idx] = R
     return out.reshape(shape)
+
+
+@numba.guvectorize(["void(float64[:, :], float64[:], float64[:])"], "(a,b),(b)->(a)", nopython=True, cache=True)
+def matvec(A, x, out):  # pragma: no cover - compiled
+    """``out[..., a] = Σ_b A[..., a, b] x[..., b]`` (broadcast over leading axes), one summation order."""
+    for a in range(A.shape[0]):
+        acc = 0.0
+        for b in range(A.shape[1]):
+            acc += A[a, b] * x[b]
+        out[a] = acc
+
+
+@numba.guvectorize(["void(float64[:], float64[:, :], float64[:])"], "(b),(b,c)->(c)", nopython=True, cache=True)
+def vecmat(x, M, out):  # pragma: no cover - compiled
+    """``out[..., c] = Σ_b x[..., b] M[..., b, c]`` (broadcast over leading axes), one summation order."""
+    for c in range(M.shape[1]):
+        out[c] = 0.0
+    for b in range(M.shape[0]):
+        xb = x[b]
+        for c in range(M.shape[1]):
+            out[c] += xb * M[b, c]

@@ -25,7 +25,7 @@ import numbers
 
 import numpy as np
 
-from ._linalg import expm_batched
+from ._linalg import expm_batched, matvec
 from .level2 import outer
 
 __all__ = ["Solver", "Euler", "Heun", "Davie", "LogODE", "SOLVERS"]
@@ -125,6 +125,19 @@ class Solver:
         return hash(type(self))
 
 
+def _second_order(J, V, A):
+    r""":math:`\sum_{i,j} A^{ij}\,DV_j\cdot V_i` from ``J`` (``(..., d, e, e)``), ``V`` (``(..., e, d)``), ``A`` (``(..., d, d)``).
+
+    Summed over ``j`` in a fixed order with stacked mat-vec products, so every batch member gets the
+    arithmetic it gets alone (an ``einsum`` over the batch may reorder its reduction by memory layout).
+    """
+    W = V @ A                                                       # [..., b, j] = Σ_i V_i^b A^{ij}
+    acc = (J[..., 0, :, :] @ W[..., :, 0, None])[..., 0]
+    for j in range(1, J.shape[-3]):
+        acc = acc + (J[..., j, :, :] @ W[..., :, j, None])[..., 0]
+    return acc
+
+
 def _drift_part(fields, y, dt):
     return fields.drift(y) * dt if fields.has_drift else 0.0
 
@@ -197,12 +210,12 @@ class Davie(Solver):
         V = fields.fields(y)
         J = fields.jacobians(y)
         noise = (V @ dX[..., None])[..., 0]
-        second = np.einsum("...jab,...bj->...a", J, V @ dXX)      # Σ_ij DV_j·V_i XX^{ij}
+        second = _second_order(J, V, dXX)                          # Σ_ij DV_j·V_i XX^{ij}
         if not fields.has_drift:
             return y + noise + second
         f0 = fields.drift(y)
         f1 = fields.drift(y + f0 * dt + noise)
-        cross = np.einsum("...iab,...b,...i->...a", J, f0, dX)     # Σ_i X^i DV_i·V_0
+        cross = _second_order(J, f0[..., None], dX[..., None, :])  # Σ_i X^i DV_i·V_0
         return y + 0.5 * dt * (f0 + f1) + noise + second + 0.5 * dt * cross
 
     @staticmethod
@@ -213,8 +226,8 @@ class Davie(Solver):
         out = y + noise + (G2 @ y[..., None])[..., 0]
         A = fields.drift_matrix
         if fields.has_drift:
-            f0 = y @ A.T
-            f1 = (y + f0 * dt + noise) @ A.T
+            f0 = matvec(A, y)
+            f1 = matvec(A, y + f0 * dt + noise)
             out = out + 0.5 * dt * (f0 + f1) + 0.5 * dt * (Mx @ f0[..., None])[..., 0]
         return out
 
@@ -267,7 +280,7 @@ class LogODE(Solver):
         def W(z):
             V = fields.fields(z)
             J = fields.jacobians(z)
-            w = (V @ dX[..., None])[..., 0] + np.einsum("...jab,...bj->...a", J, V @ L)
+            w = (V @ dX[..., None])[..., 0] + _second_order(J, V, L)
             if fields.has_drift:
                 w = w + fields.drift(z) * dt
             return w

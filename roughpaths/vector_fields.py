@@ -35,6 +35,7 @@ import numbers
 
 import numpy as np
 
+from ._linalg import matvec, vecmat
 from .validation import as_float_array, check_antisymmetric
 
 __all__ = ["VectorFields", "LinearVectorFields", "LinearDrift", "FD_STEP"]
@@ -59,7 +60,7 @@ class LinearDrift:
         self.matrix = m
 
     def __call__(self, y):
-        return np.asarray(y, dtype=np.float64) @ self.matrix.T
+        return matvec(self.matrix, np.asarray(y, dtype=np.float64))
 
     def jacobian(self, y):
         """``(..., e, e)``: the matrix, broadcast over the batch of ``y``."""
@@ -376,7 +377,7 @@ class LinearVectorFields(VectorFields):
     def _linear_fields(self, y):
         y = np.asarray(y, dtype=np.float64)
         d, e = self.dim_noise, self.dim_state
-        out = (y @ self._Mt).reshape(y.shape[:-1] + (d, e))          # [..., i, a] = (M_i y)_a
+        out = vecmat(y, self._Mt).reshape(y.shape[:-1] + (d, e))     # [..., i, a] = (M_i y)_a
         return np.swapaxes(out, -1, -2)
 
     def _linear_jac(self, y):
@@ -398,8 +399,8 @@ class LinearVectorFields(VectorFields):
             cache = (M.reshape(d, e * e), np.einsum("jab,ibc->ijac", M, M).reshape(d * d, e * e))
             self._gen_cache = cache
         Mflat, MMflat = cache
-        Mx = (dX @ Mflat).reshape(dX.shape[:-1] + (e, e))
-        G2 = (L.reshape(L.shape[:-2] + (d * d,)) @ MMflat).reshape(L.shape[:-2] + (e, e))
+        Mx = vecmat(dX, Mflat).reshape(dX.shape[:-1] + (e, e))
+        G2 = vecmat(L.reshape(L.shape[:-2] + (d * d,)), MMflat).reshape(L.shape[:-2] + (e, e))
         return Mx, G2
 
     def _logode_generator(self, dt, dX, L):
