@@ -29,6 +29,16 @@ Definitions (``X`` a rough path on the grid :math:`t_0 < \dots < t_N`)
 * :func:`holder_distance`: the inhomogeneous distance
   :math:`\rho_\alpha(X, Y) = \sup |X_{s,t} - Y_{s,t}|/(t-s)^\alpha + \sup |\mathbb{X}_{s,t} - \mathbb{Y}_{s,t}|/(t-s)^{2\alpha}`.
 
+Scale
+-----
+Every quantity is computed on a rescaled copy: each batch member's increments by a power of two
+``c`` near its largest entry (areas by ``c²``, the dilation of the rough path), and the grid by a
+power of two near its length when that length lies outside ``[2⁻⁶⁴, 2⁶⁴]``; the result is scaled
+back at the end. Powers of two divide exactly, so nothing changes for moderate inputs, and a path
+scaled by ``1e160`` or ``1e-170`` gets its norm scaled by the same factor instead of overflowing to
+``inf`` or underflowing to ``0`` (the squared norms the kernels accumulate would otherwise leave the
+float64 range). Only a result that itself lies outside that range is ``inf`` or ``0``.
+
 Cost
 ----
 Hölder quantities visit all :math:`N(N+1)/2` grid pairs: time :math:`O(N^2 d)` (level 1) or
@@ -152,6 +162,38 @@ def _dummy_areas(d: int) -> np.ndarray:
     return np.zeros((1, 1, d, d))
 
 
+def _pow2(x: np.ndarray) -> np.ndarray:
+    """A power of two within a factor 2 of each positive ``x`` (1 where ``x`` is 0): exact to divide by."""
+    _, e = np.frexp(x)
+    return np.where(x > 0, np.ldexp(1.0, e), 1.0)
+
+
+def _member_scale(inc: np.ndarray, areas: np.ndarray | None = None) -> np.ndarray:
+    """Per-member dilation ``c`` (shape ``(B,)``) bringing increments (and areas / c²) near unit size."""
+    big = np.max(np.abs(inc), axis=(-2, -1), initial=0.0)
+    if areas is not None:
+        big = np.maximum(big, np.sqrt(np.max(np.abs(areas), axis=(-3, -2, -1), initial=0.0)))
+    return _pow2(big)
+
+
+def _dilate(inc: np.ndarray, areas: np.ndarray | None, c: np.ndarray):
+    """Increments / c and areas / c² per member (exact: c is a power of two)."""
+    inc = inc / c[:, None, None]
+    if areas is not None:
+        cc = c[:, None, None, None]
+        areas = areas / cc / cc
+    return np.ascontiguousarray(inc), None if areas is None else np.ascontiguousarray(areas)
+
+
+def _time_scale(t: np.ndarray):
+    """``(t / τ, τ)`` with τ a power of two near the grid length if that lies outside [2⁻⁶⁴, 2⁶⁴], else (t, 1)."""
+    span = float(t[-1] - t[0])
+    if 2.0 ** -64 <= span <= 2.0 ** 64:
+        return t, 1.0
+    tau = float(_pow2(np.array(span)))
+    return t / tau, tau
+
+
 def _lag_weights(t: np.ndarray, alpha: float) -> np.ndarray:
     """``(t_k - t_0)^{2α}`` if the grid is uniform to round-off (then ``t_j - t_i = t_{j-i} - t_0``), else empty."""
     dt = np.diff(t)
@@ -198,13 +240,16 @@ def holder_seminorm(X, alpha, *, times=None, prune=True, max_points=_DEFAULT_MAX
     inc, t, batch = _level1_data(X, times, "X", need_times=True)
     _check_max_points(t.size, max_points, "X")
     nb, n, d = inc.shape
+    c = _member_scale(inc)
+    inc, _ = _dilate(inc, None, c)
+    t, tau = _time_scale(t)
     if prune:
         paths = np.zeros((nb, n + 1, d))
         np.cumsum(inc, axis=-2, out=paths[:, 1:, :])
         s1 = _k.holder_level1_pruned(paths, t, a, 32)
     else:
         s1, _ = _k.holder_sups(inc, _dummy_areas(d), inc, _dummy_areas(d), t, a, False, False, _lag_weights(t, a))
-    return _shape(np.sqrt(s1), batch)
+    return _shape(np.sqrt(s1) * c * tau ** -a, batch)
 
 
 def area_holder_seminorm(X, alpha, *, max_points=_DEFAULT_MAX_POINTS):
@@ -235,8 +280,11 @@ def area_holder_seminorm(X, alpha, *, max_points=_DEFAULT_MAX_POINTS):
     a = _check_alpha(alpha)
     inc, areas, t, batch = _level2_data(X, "X")
     _check_max_points(t.size, max_points, "X")
+    c = _member_scale(inc, areas)
+    inc, areas = _dilate(inc, areas, c)
+    t, tau = _time_scale(t)
     _, s2 = _k.holder_sups(inc, areas, inc, areas, t, a, True, False, _lag_weights(t, a))
-    return _shape(np.sqrt(s2), batch)
+    return _shape(np.sqrt(s2) * c * c * tau ** (-2.0 * a), batch)
 
 
 def rough_path_holder_norm(X, alpha, *, max_points=_DEFAULT_MAX_POINTS):
@@ -252,8 +300,11 @@ def rough_path_holder_norm(X, alpha, *, max_points=_DEFAULT_MAX_POINTS):
     a = _check_alpha(alpha)
     inc, areas, t, batch = _level2_data(X, "X")
     _check_max_points(t.size, max_points, "X")
+    c = _member_scale(inc, areas)
+    inc, areas = _dilate(inc, areas, c)
+    t, tau = _time_scale(t)
     s1, s2 = _k.holder_sups(inc, areas, inc, areas, t, a, True, False, _lag_weights(t, a))
-    return _shape(np.sqrt(s1) + s2 ** 0.25, batch)
+    return _shape((np.sqrt(s1) + s2 ** 0.25) * c * tau ** -a, batch)
 
 
 def holder_distance(X, Y, alpha, *, max_points=_DEFAULT_MAX_POINTS):
@@ -306,8 +357,12 @@ def holder_distance(X, Y, alpha, *, max_points=_DEFAULT_MAX_POINTS):
 
     ix, iy = full(ix, bx, (n, d)), full(iy, by, (n, d))
     ax, ay = full(ax, bx, (n, d, d)), full(ay, by, (n, d, d))
+    c = np.maximum(_member_scale(ix, ax), _member_scale(iy, ay))      # one dilation for both paths
+    ix, ax = _dilate(ix, ax, c)
+    iy, ay = _dilate(iy, ay, c)
+    tx, tau = _time_scale(tx)
     s1, s2 = _k.holder_sups(ix, ax, iy, ay, tx, a, True, True, _lag_weights(tx, a))
-    return _shape(np.sqrt(s1) + np.sqrt(s2), batch)
+    return _shape(np.sqrt(s1) * c * tau ** -a + np.sqrt(s2) * c * c * tau ** (-2.0 * a), batch)
 
 
 # ---------------------------------------------------------------------------------- p-variation
@@ -376,10 +431,12 @@ def p_variation(X, p, *, times=None, return_partition=False, prune=True,
     inc, _, batch = _level1_data(X, times, "X", need_times=False)
     _check_max_points(inc.shape[-2] + 1, max_points, "X")
     nb, n, d = inc.shape
+    c = _member_scale(inc)
+    inc, _ = _dilate(inc, None, c)
     paths = np.zeros((nb, n + 1, d))
     np.cumsum(inc, axis=-2, out=paths[:, 1:, :])
     vals, prev = _k.pvar_level1(paths, pp, bool(prune), 32)
-    out = _shape(vals ** (1.0 / pp), batch)
+    out = _shape(vals ** (1.0 / pp) * c, batch)
     if return_partition:
         return out, _partition_mask(prev).reshape(batch + (n + 1,))
     return out
@@ -408,8 +465,10 @@ def area_p_variation(X, p, *, return_partition=False, max_points=_DEFAULT_MAX_PO
     pp = _check_p(p)
     inc, areas, t, batch = _level2_data(X, "X")
     _check_max_points(t.size, max_points, "X")
+    c = _member_scale(inc, areas)
+    inc, areas = _dilate(inc, areas, c)
     vals, prev = _k.pvar_level2(inc, areas, 0.5 * pp)
-    out = _shape(vals ** (2.0 / pp), batch)
+    out = _shape(vals ** (2.0 / pp) * c * c, batch)
     if return_partition:
         return out, _partition_mask(prev).reshape(batch + (t.size,))
     return out

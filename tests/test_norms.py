@@ -315,3 +315,39 @@ def test_bad_arguments(rng):
     B3 = RoughPath.from_path(rng.standard_normal((3, 6, 2)))
     with pytest.raises(ValueError, match="batch shapes of X"):
         holder_distance(B2, B3, 0.4)
+
+
+@pytest.mark.parametrize("scale", [1e-170, 1e-100, 1e100, 1e160, 1e300])
+def test_level1_norms_are_homogeneous_at_extreme_scales(scale):
+    """|cX|_α = c|X|_α and |cX|_{p-var} = c|X|_{p-var}: no overflow to inf, no underflow to 0."""
+    rng = np.random.default_rng(5)
+    t = np.linspace(0.0, 1.0, 80)
+    x = np.cumsum(rng.standard_normal((3, 80, 2)), axis=-2)
+    ref_h, ref_p = holder_seminorm(x, 0.4, times=t), p_variation(x, 2.5)
+    np.testing.assert_allclose(holder_seminorm(x * scale, 0.4, times=t) / scale, ref_h, rtol=1e-14)
+    np.testing.assert_allclose(p_variation(x * scale, 2.5) / scale, ref_p, rtol=1e-14)
+
+
+@pytest.mark.parametrize("scale", [1e-140, 1e-60, 1e60, 1e140])
+def test_level2_norms_are_homogeneous_under_dilation(scale):
+    """Dilation δ_c(x, a) = (cx, c²a): every homogeneous norm scales by c (areas by c²)."""
+    rng = np.random.default_rng(6)
+    x = np.cumsum(rng.standard_normal((2, 60, 2)), axis=-2)
+    X, Y = RoughPath.from_path(x), RoughPath.from_path(x * scale)
+    np.testing.assert_allclose(rough_path_holder_norm(Y, 0.4) / scale, rough_path_holder_norm(X, 0.4), rtol=1e-13)
+    np.testing.assert_allclose(area_holder_seminorm(Y, 0.4) / scale**2, area_holder_seminorm(X, 0.4), rtol=1e-13)
+    np.testing.assert_allclose(area_p_variation(Y, 2.5) / scale**2, area_p_variation(X, 2.5), rtol=1e-13)
+    s = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    np.testing.assert_allclose(holder_distance(Y, Y.perturb(s * scale**2), 0.3) / scale**2,
+                               holder_distance(X, X.perturb(s), 0.3), rtol=1e-13)
+
+
+@pytest.mark.parametrize("span", [1e-300, 1e-30, 1e30, 1e300])
+def test_holder_norms_rescale_with_the_clock(span):
+    """Reparametrising t -> span·t divides the α-Hölder seminorm by span^α (area: span^{2α})."""
+    rng = np.random.default_rng(7)
+    t = np.linspace(0.0, 1.0, 50)
+    x = np.cumsum(rng.standard_normal((50, 2)), axis=0)
+    X, Y = RoughPath.from_path(x, times=t), RoughPath.from_path(x, times=t * span)
+    np.testing.assert_allclose(holder_seminorm(Y, 0.5) * span**0.5, holder_seminorm(X, 0.5), rtol=1e-13)
+    np.testing.assert_allclose(area_holder_seminorm(Y, 0.5) * span, area_holder_seminorm(X, 0.5), rtol=1e-13)
