@@ -138,15 +138,16 @@ def _second_order(J, V, A):
     return acc
 
 
-def _drift_part(fields, y, dt):
-    return fields.drift(y) * dt if fields.has_drift else 0.0
+def _drift_part(fields, y, t, dt):
+    return fields.drift(y, t) * dt if fields.has_drift else 0.0
 
 
 class Euler(Solver):
     r"""Explicit Euler, :math:`Y + V_0(Y)h + V_i(Y)X^i_{s,t}` (level 1).
 
     Order 1 on smooth drivers. On a Brownian driver it converges (strong order ½) to the **Itô**
-    solution, whatever the area of the driver: it evaluates the fields at the left point only.
+    solution, whatever the area of the driver: it evaluates the fields at the left point only
+    (time-dependent fields at the step's start time ``t``).
     """
 
     increment_level = 1
@@ -155,8 +156,8 @@ class Euler(Solver):
     calculus = "ito"
 
     def step(self, fields, y, t, dt, dX, dXX):
-        V = fields.fields(y)
-        return y + _drift_part(fields, y, dt) + (V @ dX[..., None])[..., 0]
+        V = fields.fields(y, t)
+        return y + _drift_part(fields, y, t, dt) + (V @ dX[..., None])[..., 0]
 
 
 class Heun(Solver):
@@ -165,7 +166,8 @@ class Heun(Solver):
     :math:`\tilde Y = Y + V_0(Y)h + V(Y)X_{s,t}`,
     :math:`Y' = Y + \tfrac12(V_0(Y) + V_0(\tilde Y))h + \tfrac12(V(Y) + V(\tilde Y))X_{s,t}`.
     Order 2 on smooth drivers; strong order ½ towards the Stratonovich solution for non-commuting
-    fields (it cannot see the Lévy area), order 1 for commuting fields.
+    fields (it cannot see the Lévy area), order 1 for commuting fields. Time-dependent fields are
+    evaluated at ``t`` in the predictor and at ``t + h`` at the predicted point.
     """
 
     increment_level = 1
@@ -173,16 +175,16 @@ class Heun(Solver):
     smooth_order = 2.0
 
     def step(self, fields, y, t, dt, dX, dXX):
-        V = fields.fields(y)
+        V = fields.fields(y, t)
         dx = dX[..., None]
-        f0 = fields.drift(y) if fields.has_drift else None
+        f0 = fields.drift(y, t) if fields.has_drift else None
         pred = y + (V @ dx)[..., 0]
         if f0 is not None:
             pred = pred + f0 * dt
-        V2 = fields.fields(pred)
+        V2 = fields.fields(pred, t + dt)
         out = y + 0.5 * ((V + V2) @ dx)[..., 0]
         if f0 is not None:
-            out = out + 0.5 * dt * (f0 + fields.drift(pred))
+            out = out + 0.5 * dt * (f0 + fields.drift(pred, t + dt))
         return out
 
 
@@ -196,6 +198,10 @@ class Davie(Solver):
     :math:`\int (r - s)\,dX^i` approximated by :math:`\tfrac12 h X^i`, exact to :math:`O(h^3)` on
     smooth paths and to a mean-zero :math:`O(h^{3/2})` on Brownian ones).
 
+    Time-dependent fields: the driving fields and their Jacobians are evaluated at the midpoint
+    time :math:`t + h/2` (this contributes the :math:`\tfrac12 h\,\partial_t V_i\,X^i` term that keeps
+    order 2 on smooth drivers), the drift at ``t`` and, at the predictor, at ``t + h``.
+
     Declared orders: strong order 1 on Brownian rough paths (Stratonovich lift with the Lévy area;
     with an Itô lift it solves the Itô equation), order 2 on smooth drivers with exact areas.
     """
@@ -207,14 +213,15 @@ class Davie(Solver):
     def step(self, fields, y, t, dt, dX, dXX):
         if getattr(fields, "is_linear", False):
             return self._linear_step(fields, y, dt, dX, dXX)
-        V = fields.fields(y)
-        J = fields.jacobians(y)
+        tm = t + 0.5 * dt
+        V = fields.fields(y, tm)
+        J = fields.jacobians(y, tm)
         noise = (V @ dX[..., None])[..., 0]
         second = _second_order(J, V, dXX)                          # Σ_ij DV_j·V_i XX^{ij}
         if not fields.has_drift:
             return y + noise + second
-        f0 = fields.drift(y)
-        f1 = fields.drift(y + f0 * dt + noise)
+        f0 = fields.drift(y, t)
+        f1 = fields.drift(y + f0 * dt + noise, t + dt)
         cross = _second_order(J, f0[..., None], dX[..., None, :])  # Σ_i X^i DV_i·V_0
         return y + 0.5 * dt * (f0 + f1) + noise + second + 0.5 * dt * cross
 
@@ -248,7 +255,8 @@ class LogODE(Solver):
     * :class:`~roughpaths.vector_fields.LinearVectorFields` with a linear drift: the flow is exact,
       :math:`Y' = \exp(G) Y` with :math:`G = A_0 h + M_i x^i + \sum_{ij} L^{ij} M_j M_i`, computed by a
       batched scaling-and-squaring Padé exponential (:func:`expm_batched`).
-    * otherwise: ``inner_steps`` classical RK4 steps of the autonomous ODE :math:`z' = W(z)` on ``[0, 1]``.
+    * otherwise: ``inner_steps`` classical RK4 steps of the autonomous ODE :math:`z' = W(z)` on ``[0, 1]``;
+      time-dependent fields are frozen at the midpoint time :math:`t + h/2` of the step.
 
     Declared orders: strong order 1 on Brownian rough paths, order 2 on smooth drivers with exact
     areas (the level-3 terms of the step signature are :math:`O(h^3)` there).
@@ -277,12 +285,14 @@ class LogODE(Solver):
             G = fields._logode_generator(dt, dX, L)
             return (expm_batched(G) @ y[..., None])[..., 0]
 
+        tm = t + 0.5 * dt
+
         def W(z):
-            V = fields.fields(z)
-            J = fields.jacobians(z)
+            V = fields.fields(z, tm)
+            J = fields.jacobians(z, tm)
             w = (V @ dX[..., None])[..., 0] + _second_order(J, V, L)
             if fields.has_drift:
-                w = w + fields.drift(z) * dt
+                w = w + fields.drift(z, tm) * dt
             return w
 
         n = self.inner_steps

@@ -5,7 +5,10 @@ The rough differential equation is
 .. math:: dY = V_0(Y)\,dt + \sum_{i=1}^d V_i(Y)\,d\mathbf{X}^i, \qquad V_i : \mathbb{R}^e \to \mathbb{R}^e .
 
 A family is one object; every method is vectorised over leading batch axes of ``y`` (shape
-``(..., e)``). Conventions (``CONVENTIONS.md``):
+``(..., e)``). Naming, said once: the maths' :math:`V_0` is the drift (``drift=`` here and in
+:func:`roughpaths.solve`), and the driving fields :math:`V_1..V_d` are indexed from 0 in the API
+(``fields(y)[..., :, i]`` and ``bracket(i, j)`` refer to :math:`V_{i+1}`). Fields may depend on time,
+:math:`V_i(t, y)` (``time_dependent=True``); autonomous fields are the default. Conventions (``CONVENTIONS.md``):
 
 * ``fields(y)[..., a, i]`` is :math:`V_i^a(y)` (shape ``(..., e, d)``);
 * ``jacobians(y)[..., i, a, b]`` is :math:`\partial_b V_i^a(y)` (shape ``(..., d, e, e)``);
@@ -35,6 +38,8 @@ import numbers
 
 import numpy as np
 
+from ._field_callables import (_Autonomous, _Bracket, _Frozen, _FrizOberhauserDrift, _signature_hint,
+                              _Stack, _Sum)
 from ._linalg import matvec, vecmat
 from .validation import as_float_array, check_antisymmetric
 
@@ -84,13 +89,19 @@ def _as_callable(f, name):
 class VectorFields:
     r"""A family :math:`(V_0; V_1, \dots, V_d)` of vector fields on :math:`\mathbb{R}^e` given by callables.
 
+    Naming: the maths writes :math:`V_0` for the drift and :math:`V_1..V_d` for the driving fields;
+    the API indexes the **driving** fields from 0, so column / index ``i`` of :meth:`fields`,
+    :meth:`jacobians` and :meth:`bracket` is :math:`V_{i+1}`, and :math:`V_0` is ``drift``.
+
     Parameters
     ----------
     fields : callable or sequence of d callables
-        Either one callable ``y (..., e) -> (..., e, d)`` (column ``i`` is :math:`V_i`), or a list of
-        ``d`` callables ``y (..., e) -> (..., e)``. Callables must accept leading batch axes.
+        Either one callable ``y (..., e) -> (..., e, d)`` (column ``i`` is the driving field
+        :math:`V_{i+1}`), or a list of ``d`` callables ``y (..., e) -> (..., e)``. Callables must accept
+        leading batch axes (checked at construction on a batch of distinct random points against
+        one-point evaluations).
     jacobians : callable or sequence of d callables, optional
-        ``y -> (..., d, e, e)`` with ``[..., i, a, b] = ∂_b V_i^a``, or ``d`` callables
+        ``y -> (..., d, e, e)`` with ``[..., i, a, b] = ∂_b V_{i+1}^a``, or ``d`` callables
         ``y -> (..., e, e)``. If omitted, computed by central differences (step ``FD_STEP·max(1,|y_b|)``,
         about ``1e-10`` relative accuracy; see the module docstring).
     drift : callable, LinearDrift, array_like (e, e) or None
@@ -99,6 +110,15 @@ class VectorFields:
         ``y -> (..., e, e)``; computed by central differences if omitted and ever needed.
     dim_state, dim_noise : int
         ``e`` and ``d``. Required for callables (no shapes can be inferred without evaluating them).
+    time_dependent : bool
+        If True, every callable takes ``(t, y)`` (``t`` a float) instead of ``y``; the solvers pass
+        the time (see each solver for where in the step the fields are evaluated). Default False:
+        autonomous fields.
+
+    Notes
+    -----
+    A family built from module-level functions (or other picklable callables) pickles, so it can be
+    sent to a process pool; lambdas and local functions cannot be pickled by Python.
 
     Examples
     --------
@@ -109,137 +129,165 @@ class VectorFields:
     >>> rot = lambda y: np.stack([-y[..., 1], y[..., 0]], axis=-1)
     >>> rad = lambda y: y
     >>> V = VectorFields([rot, rad], dim_state=2, dim_noise=2)
-    >>> V.fields(np.array([1.0, 2.0]))      # columns: V_0(y), V_1(y)
+    >>> V.fields(np.array([1.0, 2.0]))      # columns: driving fields V_1(y), V_2(y) (API indices 0, 1)
     array([[-2.,  1.],
            [ 1.,  2.]])
     >>> np.allclose(V.bracket(0, 1)(np.array([0.3, -0.2])), 0.0)
     True
+
+    A time-dependent field :math:`V_1(t, y) = \cos(t)\, y`:
+
+    >>> W = VectorFields(lambda t, y: (np.cos(t) * y)[..., None], dim_state=1, dim_noise=1,
+    ...                  time_dependent=True)
+    >>> W.fields(np.array([2.0]), t=0.0)
+    array([[2.]])
     """
 
     is_linear = False
+    time_dependent = False
 
     def __init__(self, fields, jacobians=None, *, drift=None, drift_jacobian=None,
-                 dim_state=None, dim_noise=None):
+                 dim_state=None, dim_noise=None, time_dependent=False):
         from .validation import check_positive_int
         if dim_state is None or dim_noise is None:
             raise TypeError("dim_state (e) and dim_noise (d) are required for callable vector fields, "
                             "e.g. VectorFields(f, dim_state=3, dim_noise=2).")
+        if not isinstance(time_dependent, (bool, np.bool_)):
+            raise TypeError(f"time_dependent must be True or False, got {time_dependent!r}.")
         self.dim_state = check_positive_int(dim_state, "dim_state")
         self.dim_noise = check_positive_int(dim_noise, "dim_noise")
+        self.time_dependent = bool(time_dependent)
+        wrap = (lambda f: f) if self.time_dependent else _Autonomous
         d = self.dim_noise
         if isinstance(fields, (list, tuple)):
             if len(fields) != d:
                 raise ValueError(f"fields is a list of {len(fields)} callables but dim_noise={d}; "
                                  f"give one callable per driving component.")
-            fs = [_as_callable(f, f"fields[{i}]") for i, f in enumerate(fields)]
-            self._fields = lambda y: np.stack([f(y) for f in fs], axis=-1)
+            self._fields = _Stack([wrap(_as_callable(f, f"fields[{i}]")) for i, f in enumerate(fields)], -1)
         else:
-            self._fields = _as_callable(fields, "fields")
-            if self._fields is None:
+            f = _as_callable(fields, "fields")
+            if f is None:
                 raise TypeError("fields must be a callable or a list of callables, got None.")
+            self._fields = wrap(f)
         if isinstance(jacobians, (list, tuple)):
             if len(jacobians) != d:
                 raise ValueError(f"jacobians is a list of {len(jacobians)} callables but dim_noise={d}.")
-            js = [_as_callable(f, f"jacobians[{i}]") for i, f in enumerate(jacobians)]
-            self._jac = lambda y: np.stack([j(y) for j in js], axis=-3)
+            self._jac = _Stack([wrap(_as_callable(f, f"jacobians[{i}]")) for i, f in enumerate(jacobians)], -3)
         else:
-            self._jac = _as_callable(jacobians, "jacobians")
-        self._drift, self._drift_jac = _parse_drift(drift, drift_jacobian, self.dim_state)
+            j = _as_callable(jacobians, "jacobians")
+            self._jac = None if j is None else wrap(j)
+        self._drift, self._drift_jac = _parse_drift(drift, drift_jacobian, self.dim_state, self.time_dependent)
+        self._raw = (fields, jacobians, drift)
         self._check_shapes()
 
     # ------------------------------------------------------------------ helpers
+    def _probe(self, f, y, name, raw):
+        t = 0.25
+        try:
+            return np.asarray(f(t, y))
+        except TypeError as exc:
+            raise TypeError(f"calling {name} on y of shape {y.shape} failed: {exc}."
+                            f"{_signature_hint(raw, name) if not self.time_dependent else ''}") from None
+
     def _check_shapes(self):
         e, d = self.dim_state, self.dim_noise
+        raw_f, raw_j, raw_d = getattr(self, "_raw", (None, None, None))
         y = np.linspace(0.1, 0.3, e)
-        f = np.asarray(self._fields(y))
-        if f.shape != (e, d):
-            raise ValueError(f"fields(y) for y of shape ({e},) must return shape (e, d) = ({e}, {d}), got "
-                             f"{f.shape}; check dim_state/dim_noise or the callable.")
-        fb = np.asarray(self._fields(np.stack([y, y])))
-        if fb.shape != (2, e, d):
-            raise ValueError(f"fields must be batched: for y of shape (2, {e}) it must return (2, {e}, {d}), "
-                             f"got {fb.shape}; use y[..., k] rather than y[k] inside the callable.")
+        checks = [("fields", self._fields, (e, d), raw_f, "(e, d)")]
         if self._jac is not None:
-            j = np.asarray(self._jac(np.stack([y, y])))
-            if j.shape != (2, d, e, e):
-                raise ValueError(f"jacobians(y) for y of shape (2, {e}) must return (2, d, e, e) = "
-                                 f"(2, {d}, {e}, {e}), got {j.shape}.")
+            checks.append(("jacobians", self._jac, (d, e, e), raw_j, "(d, e, e)"))
         if self._drift is not None:
-            v = np.asarray(self._drift(np.stack([y, y])))
-            if v.shape != (2, e):
-                raise ValueError(f"drift(y) for y of shape (2, {e}) must return (2, {e}), got {v.shape}.")
+            checks.append(("drift", self._drift, (e,), raw_d, "(e,)"))
+        for name, fn, tail, raw, label in checks:
+            one = self._probe(fn, y, name, raw)
+            if one.shape != tail:
+                raise ValueError(f"{name}(y) for y of shape ({e},) must return shape {label} = {tail}, got "
+                                 f"{one.shape}; check dim_state/dim_noise or the callable.")
+        # Batching probe: distinct random points in a (2, 3) batch, each row compared with its own
+        # one-point evaluation (identical rows, or a batch as long as e, could hide a callable that
+        # indexes y[k] instead of y[..., k]).
+        yb = np.random.default_rng(12345).uniform(0.1, 0.9, size=(2, 3, e))
+        for name, fn, tail, raw, _ in checks:
+            fb = self._probe(fn, yb, name, raw)
+            if fb.shape != (2, 3) + tail:
+                raise ValueError(f"{name} must be batched: for y of shape (2, 3, {e}) it must return "
+                                 f"{(2, 3) + tail}, got {fb.shape}; use y[..., k] rather than y[k] inside "
+                                 f"the callable.")
+            for k in ((0, 0), (1, 2)):
+                one = np.asarray(fn(0.25, yb[k]))
+                if not np.allclose(fb[k], one, rtol=1e-12, atol=1e-12, equal_nan=True):
+                    raise ValueError(f"{name} is not batched correctly: for a batch y of shape (2, 3, {e}) "
+                                     f"its row {k} differs from {name} evaluated at that point alone; the "
+                                     f"callable must act on the last axis only (use y[..., k] rather than "
+                                     f"y[k], and axis=-1 in reductions).")
 
     @property
     def has_drift(self) -> bool:
         """Whether :math:`V_0` is non-zero (given)."""
         return self._drift is not None
 
+    def _time(self, t):
+        if t is None:
+            if self.time_dependent:
+                raise ValueError("t is required: this family is time-dependent (time_dependent=True); "
+                                 "pass the time, e.g. V.fields(y, t).")
+            return 0.0
+        return t
+
     # ------------------------------------------------------------------ evaluation
-    def drift(self, y) -> np.ndarray:
-        """:math:`V_0(y)`, shape ``(..., e)`` (zeros if the family has no drift)."""
+    def drift(self, y, t=None) -> np.ndarray:
+        """:math:`V_0(t, y)`, shape ``(..., e)`` (zeros if the family has no drift); ``t`` only if time-dependent."""
         y = np.asarray(y, dtype=np.float64)
         if self._drift is None:
             return np.zeros_like(y)
-        return np.asarray(self._drift(y), dtype=np.float64)
+        return np.asarray(self._drift(self._time(t), y), dtype=np.float64)
 
-    def fields(self, y) -> np.ndarray:
-        """:math:`V_i^a(y)` as ``[..., a, i]``, shape ``(..., e, d)``."""
-        return np.asarray(self._fields(np.asarray(y, dtype=np.float64)), dtype=np.float64)
+    def fields(self, y, t=None) -> np.ndarray:
+        """The driving fields as ``[..., a, i]`` (column ``i`` is :math:`V_{i+1}`), shape ``(..., e, d)``."""
+        return np.asarray(self._fields(self._time(t), np.asarray(y, dtype=np.float64)), dtype=np.float64)
 
-    def jacobians(self, y) -> np.ndarray:
-        r""":math:`\partial_b V_i^a(y)` as ``[..., i, a, b]``, shape ``(..., d, e, e)``."""
+    def jacobians(self, y, t=None) -> np.ndarray:
+        r""":math:`\partial_b V_{i+1}^a(t, y)` as ``[..., i, a, b]``, shape ``(..., d, e, e)``."""
         y = np.asarray(y, dtype=np.float64)
+        t = self._time(t)
         if self._jac is not None:
-            return np.asarray(self._jac(y), dtype=np.float64)
+            return np.asarray(self._jac(t, y), dtype=np.float64)
         # central differences; J[..., a, i, b] then moved to [..., i, a, b]
-        return np.moveaxis(_central_jacobian(self._fields, y), -2, -3)
+        return np.moveaxis(_central_jacobian(_Frozen(self._fields, t), y), -2, -3)
 
-    def drift_jacobian(self, y) -> np.ndarray:
-        r""":math:`\partial_b V_0^a(y)`, shape ``(..., e, e)``."""
+    def drift_jacobian(self, y, t=None) -> np.ndarray:
+        r""":math:`\partial_b V_0^a(t, y)`, shape ``(..., e, e)``."""
         y = np.asarray(y, dtype=np.float64)
         if self._drift is None:
             return np.zeros(y.shape + (y.shape[-1],))
+        t = self._time(t)
         if self._drift_jac is not None:
-            return np.asarray(self._drift_jac(y), dtype=np.float64)
-        return _central_jacobian(self._drift, y)
-
-    def second_order_term(self, y, area, fields=None, jacobians=None) -> np.ndarray:
-        r""":math:`\sum_{i,j} \mathbb{X}^{ij}\, DV_j\cdot V_i(y)`, shape ``(..., e)``.
-
-        ``area`` has shape ``(..., d, d)`` (broadcast against ``y``); this is the level-2 term of the
-        Davie step. Precomputed ``fields(y)`` / ``jacobians(y)`` may be passed to avoid recomputing.
-        """
-        V = self.fields(y) if fields is None else fields
-        J = self.jacobians(y) if jacobians is None else jacobians
-        W = V @ area                                   # [..., b, j] = Σ_i V_i^b XX^{ij}
-        return np.einsum("...jab,...bj->...a", J, W)
+            return np.asarray(self._drift_jac(t, y), dtype=np.float64)
+        return _central_jacobian(_Frozen(self._drift, t), y)
 
     # ------------------------------------------------------------------ brackets
     def _check_index(self, i, name):
         if isinstance(i, bool) or not isinstance(i, numbers.Integral) or not 0 <= i < self.dim_noise:
             raise ValueError(f"{name} must be an integer field index in 0..{self.dim_noise - 1} "
-                             f"(driving components, 0-based; the drift is not indexed), got {i!r}.")
+                             f"(driving fields V_1..V_d, 0-based; the drift V_0 is not indexed), got {i!r}.")
         return int(i)
 
     def bracket(self, i, j):
-        r"""The Jacobi–Lie bracket :math:`[V_i, V_j] = DV_j\cdot V_i - DV_i\cdot V_j` as a callable ``y -> (..., e)``.
+        r"""The Jacobi–Lie bracket of the driving fields ``i`` and ``j`` (0-based: :math:`[V_{i+1}, V_{j+1}]`).
 
-        Indices are 0-based over the driving fields (``0..d-1``).
+        :math:`[V, W] = DW\cdot V - DV\cdot W`. Returns a callable ``y -> (..., e)`` (``(t, y)`` for a
+        time-dependent family, the bracket at frozen time ``t``).
         """
-        i, j = self._check_index(i, "i"), self._check_index(j, "j")
+        return _Bracket(self, self._check_index(i, "i"), self._check_index(j, "j"))
 
-        def _br(y):
-            y = np.asarray(y, dtype=np.float64)
-            V, J = self.fields(y), self.jacobians(y)
-            return (np.einsum("...ab,...b->...a", J[..., j, :, :], V[..., :, i])
-                    - np.einsum("...ab,...b->...a", J[..., i, :, :], V[..., :, j]))
-        return _br
-
-    def brackets(self, y) -> np.ndarray:
-        r"""All brackets :math:`[V_i, V_j](y)` as ``[..., i, j, a]``, shape ``(..., d, d, e)``."""
+    def brackets(self, y, t=None) -> np.ndarray:
+        r"""All brackets of the driving fields as ``[..., i, j, a]``, shape ``(..., d, d, e)`` (0-based indices)."""
         y = np.asarray(y, dtype=np.float64)
-        V, J = self.fields(y), self.jacobians(y)
-        DVjVi = np.einsum("...jab,...bi->...ija", J, V)          # [i, j] = DV_j · V_i
+        V, J = self.fields(y, t), self.jacobians(y, t)
+        d = self.dim_noise
+        # [i, j] = DV_j · V_i, one stacked mat-vec per pair (a fixed order for every batch member)
+        DVjVi = np.stack([np.stack([(J[..., j, :, :] @ V[..., :, i, None])[..., 0] for j in range(d)], axis=-2)
+                          for i in range(d)], axis=-3)
         return DVjVi - np.swapaxes(DVjVi, -2, -3)
 
     def friz_oberhauser_drift(self, s):
@@ -248,62 +296,74 @@ class VectorFields:
         Parameters
         ----------
         s : array_like, shape ``(d, d)``
-            Antisymmetric (a non-antisymmetric ``s`` is rejected: it breaks geometricity).
+            Antisymmetric (a non-antisymmetric ``s`` is rejected: it breaks geometricity). Indices are
+            those of the driving fields (0-based in the API).
 
         Returns
         -------
-        callable ``y (..., e) -> (..., e)``
+        callable ``y (..., e) -> (..., e)`` (``(t, y)`` for a time-dependent family)
             A :class:`LinearDrift` for linear families. Equal to :math:`\sum_{i,j} s^{ij} DV_j\cdot V_i`
             and to :math:`\sum_{i<j} s^{ij}[V_i, V_j]`.
         """
         s = check_antisymmetric(s, "s", dim=self.dim_noise)
         if s.ndim != 2:
             raise ValueError(f"s must have shape (d, d) = ({self.dim_noise}, {self.dim_noise}), got {s.shape}.")
-
-        def _fo(y):
-            return 0.5 * np.einsum("ij,...ija->...a", s, self.brackets(y))
-        return _fo
+        return _FrizOberhauserDrift(self, s)
 
     # ------------------------------------------------------------------ composition
     def with_drift(self, extra, jacobian=None) -> "VectorFields":
         r"""A new family with drift :math:`V_0 + \text{extra}` (same driving fields).
 
-        ``extra`` is a callable ``y -> (..., e)``, a :class:`LinearDrift`, or a matrix ``(e, e)``.
+        ``extra`` is a callable (``y -> (..., e)``, or ``(t, y) -> (..., e)`` for a time-dependent
+        family), a :class:`LinearDrift`, or a matrix ``(e, e)``.
         """
-        f, fj = _parse_drift(extra, jacobian, self.dim_state)
+        f, fj = _parse_drift(extra, jacobian, self.dim_state, self.time_dependent)
         if f is None:
             return self
         old, oldj = self._drift, self._drift_jac
         new = object.__new__(VectorFields)
         new.dim_state, new.dim_noise = self.dim_state, self.dim_noise
+        new.time_dependent = self.time_dependent
         new._fields, new._jac = self._fields, self._jac
+        new._raw = (self._raw[0], self._raw[1], extra) if hasattr(self, "_raw") else (None, None, extra)
         if old is None:
             new._drift, new._drift_jac = f, fj
         else:
-            new._drift = lambda y: old(y) + f(y)
-            new._drift_jac = None if (oldj is None or fj is None) else (lambda y: oldj(y) + fj(y))
+            new._drift = _Sum(old, f)
+            new._drift_jac = None if (oldj is None or fj is None) else _Sum(oldj, fj)
         new._check_shapes()
         return new
 
     def __repr__(self) -> str:
         jac = "user Jacobian" if self._jac is not None else "central-difference Jacobian"
+        td = ", time-dependent" if self.time_dependent else ""
         return (f"{type(self).__name__}(e={self.dim_state}, d={self.dim_noise}, {jac}, "
-                f"drift={'yes' if self.has_drift else 'no'})")
+                f"drift={'yes' if self.has_drift else 'no'}{td})")
 
 
-def _parse_drift(drift, drift_jacobian, e):
-    """Return ``(callable or None, jacobian callable or None)`` for a drift argument."""
+def _parse_drift(drift, drift_jacobian, e, time_dependent=False):
+    """Return ``(callable (t, y) or None, its Jacobian callable (t, y) or None)`` for a drift argument."""
     if drift is None:
         return None, None
     if isinstance(drift, LinearDrift):
         m = drift
     elif callable(drift):
-        return drift, _as_callable(drift_jacobian, "drift_jacobian")
+        j = _as_callable(drift_jacobian, "drift_jacobian")
+        if time_dependent:
+            return drift, j
+        return _Autonomous(drift), None if j is None else _Autonomous(j)
     else:
         m = LinearDrift(as_float_array(drift, "drift", ndim=2))
     if m.matrix.shape != (e, e):
         raise ValueError(f"drift matrix must have shape (e, e) = ({e}, {e}), got {m.matrix.shape}.")
-    return m, m.jacobian
+    return _Autonomous(m), _Autonomous(m.jacobian)
+
+
+def _linear_part(drift):
+    """The :class:`LinearDrift` behind a stored drift callable, or None."""
+    if isinstance(drift, _Autonomous) and isinstance(drift.f, LinearDrift):
+        return drift.f
+    return None
 
 
 def _central_jacobian(f, y):
@@ -360,27 +420,29 @@ class LinearVectorFields(VectorFields):
         self._fields = self._linear_fields
         self._jac = self._linear_jac
         self._drift, self._drift_jac = _parse_drift(drift, drift_jacobian, self.dim_state)
+        self._raw = (None, None, drift)
         self._check_shapes()
 
     @property
     def is_linear(self) -> bool:
         """True if the drift is absent or linear (then ``drift_matrix`` is the matrix)."""
-        return self._drift is None or isinstance(self._drift, LinearDrift)
+        return self._drift is None or _linear_part(self._drift) is not None
 
     @property
     def drift_matrix(self) -> np.ndarray | None:
         """The drift matrix ``(e, e)`` (zeros if no drift), or None if the drift is not linear."""
         if self._drift is None:
             return np.zeros((self.dim_state, self.dim_state))
-        return self._drift.matrix if isinstance(self._drift, LinearDrift) else None
+        lin = _linear_part(self._drift)
+        return None if lin is None else lin.matrix
 
-    def _linear_fields(self, y):
+    def _linear_fields(self, t, y):
         y = np.asarray(y, dtype=np.float64)
         d, e = self.dim_noise, self.dim_state
         out = vecmat(y, self._Mt).reshape(y.shape[:-1] + (d, e))     # [..., i, a] = (M_i y)_a
         return np.swapaxes(out, -1, -2)
 
-    def _linear_jac(self, y):
+    def _linear_jac(self, t, y):
         y = np.asarray(y, dtype=np.float64)
         return np.broadcast_to(self.matrices, y.shape[:-1] + self.matrices.shape)
 
@@ -408,7 +470,7 @@ class LinearVectorFields(VectorFields):
         Mx, G2 = self._linear_parts(dX, L)
         G = Mx + G2
         if self._drift is not None:
-            G = G + dt * self._drift.matrix
+            G = G + dt * self.drift_matrix
         return G
 
     def friz_oberhauser_drift(self, s):
@@ -423,13 +485,17 @@ class LinearVectorFields(VectorFields):
         f, fj = _parse_drift(extra, jacobian, self.dim_state)
         if f is None:
             return self
-        if isinstance(f, LinearDrift) and self.is_linear:
-            return LinearVectorFields(self.matrices, LinearDrift(self.drift_matrix + f.matrix))
+        if _linear_part(f) is not None and self.is_linear:
+            return LinearVectorFields(self.matrices, LinearDrift(self.drift_matrix + _linear_part(f).matrix))
         old, oldj = self._drift, self._drift_jac
+        new = LinearVectorFields(self.matrices)
         if old is None:
-            return LinearVectorFields(self.matrices, f, drift_jacobian=fj)
-        newj = None if (oldj is None or fj is None) else (lambda y: oldj(y) + fj(y))
-        return LinearVectorFields(self.matrices, lambda y: old(y) + f(y), drift_jacobian=newj)
+            new._drift, new._drift_jac = f, fj
+        else:
+            new._drift = _Sum(old, f)
+            new._drift_jac = None if (oldj is None or fj is None) else _Sum(oldj, fj)
+        new._check_shapes()
+        return new
 
     with_drift.__doc__ = VectorFields.with_drift.__doc__
 
