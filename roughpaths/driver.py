@@ -8,7 +8,9 @@ long or large runs need memory for one block only. A driver has
   ``batch_shape`` (the leading axes of every block), like a ``RoughPath``;
 * :meth:`Driver.blocks`, an iterator of consecutive ``RoughPath`` blocks covering the grid (block
   ``b`` has ``times = self.times[k_b : k_{b+1} + 1]``); the numbers must not depend on the block size;
-* :meth:`Driver.rough_path`, the whole path materialised (the blocks concatenated).
+* :meth:`Driver.rough_path`, the whole path materialised (the blocks concatenated);
+* optionally ``select(paths)``: a driver for a subset of the paths (flat indices), bitwise equal to
+  those paths of the full driver; ``solve(..., executor=...)`` uses it to split a batch.
 """
 
 from __future__ import annotations

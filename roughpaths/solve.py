@@ -120,7 +120,7 @@ def _failure_message(failed_step, times, batch) -> tuple:
 
 
 def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_failure="raise",
-          block_steps=None) -> Solution:
+          block_steps=None, executor=None, chunks=None) -> Solution:
     r"""Solve the RDE :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i`, :math:`Y_{t_0} = y_0`, on the driver's grid.
 
     Parameters
@@ -153,6 +153,14 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     block_steps : int, optional
         Steps per block requested from a :class:`~roughpaths.driver.Driver` (its default if ``None``);
         it changes memory use, never the numbers.
+    executor : concurrent.futures.Executor, optional
+        Split the (flattened) batch into ``chunks`` contiguous groups of members and solve each on
+        the executor (a thread or process pool, or a Dask cluster's ``client.get_executor()``). Since
+        members never affect each other, the result is bitwise that of the serial call. With a process
+        pool or a cluster, the fields, driver and solver must pickle (vector fields built from
+        module-level functions do). A lazy driver must offer ``select(paths)``.
+    chunks : int, optional
+        Number of groups for ``executor`` (default ``min(members, 4 × CPU count)``).
 
     Returns
     -------
@@ -186,6 +194,9 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     """
     solver = _resolve_solver(solver)
     fields = solver.check_fields(fields)
+    if executor is not None:
+        return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
+                            on_failure=on_failure, block_steps=block_steps)
     if not isinstance(driver, (RoughPath, Driver)):
         raise TypeError(f"driver must be a RoughPath or a Driver (e.g. roughpaths.BrownianDriver), got "
                         f"{type(driver).__name__}; build a path with RoughPath.from_path(values, times=...) "
@@ -267,3 +278,58 @@ def _index_of(driver, save_at):
         return driver.index_of(save_at, "save_at")
     return RoughPath(np.zeros((driver.n_steps, driver.dim)), times=driver.times, check=False).index_of(
         save_at, "save_at")
+
+
+def _chunk_of(driver, batch, lo, hi):
+    """Members ``lo:hi`` of the flattened batch of ``driver`` (broadcast to ``batch``)."""
+    if isinstance(driver, RoughPath):
+        n, d = driver.n_steps, driver.dim
+        inc = np.broadcast_to(driver.increments, batch + (n, d)).reshape((-1, n, d))[lo:hi]
+        areas = None
+        if driver.areas is not None:
+            areas = np.broadcast_to(driver.areas, batch + (n, d, d)).reshape((-1, n, d, d))[lo:hi]
+        x0 = np.broadcast_to(driver.x0, batch + (d,)).reshape((-1, d))[lo:hi]
+        return RoughPath(inc, areas, times=driver.times, x0=x0, kind=driver.kind, check=False)
+    if driver.batch_shape != batch:
+        raise ValueError(f"with executor=, a lazy driver's batch shape {driver.batch_shape} must be the "
+                         f"batch shape of the solve {batch}; give y0 without extra batch axes.")
+    if not hasattr(driver, "select"):
+        raise TypeError(f"executor= needs to split the driver's batch, but {type(driver).__name__} has no "
+                        f"select(paths) method; materialise it with driver.rough_path() or solve serially.")
+    return driver.select(np.arange(lo, hi))
+
+
+def _solve_split(fields, driver, y0, solver, executor, chunks, **kw):
+    import os
+
+    from .validation import check_positive_int
+
+    if not hasattr(executor, "submit"):
+        raise TypeError(f"executor must be a concurrent.futures.Executor (e.g. ProcessPoolExecutor(), or a "
+                        f"Dask client's get_executor()), got {type(executor).__name__}.")
+    if not isinstance(driver, (RoughPath, Driver)):
+        raise TypeError(f"driver must be a RoughPath or a Driver, got {type(driver).__name__}.")
+    y = as_float_array(y0, "y0", min_ndim=1)
+    batch = check_same_batch(y.shape[:-1], driver.batch_shape, "y0", "driver")
+    members = int(np.prod(batch, dtype=np.int64))
+    if kw["drift"] is not None:
+        fields = fields.with_drift(kw["drift"])
+    kw["drift"] = None
+    if members == 0:
+        return solve(fields, driver, y0, solver, **kw)
+    n_chunks = min(members, 4 * (os.cpu_count() or 1)) if chunks is None else check_positive_int(chunks, "chunks")
+    bounds = np.linspace(0, members, min(n_chunks, members) + 1).round().astype(int)
+    yflat = np.broadcast_to(y, batch + y.shape[-1:]).reshape((-1, y.shape[-1]))
+    mode, kw["on_failure"] = kw["on_failure"], "mask"
+    futures = [executor.submit(solve, fields, _chunk_of(driver, batch, lo, hi), yflat[lo:hi], solver, **kw)
+               for lo, hi in zip(bounds[:-1], bounds[1:])]
+    parts = [f.result() for f in futures]
+    states = np.concatenate([s.states for s in parts], axis=0).reshape(batch + parts[0].states.shape[-2:])
+    failed = np.concatenate([s.failed_step for s in parts]).reshape(batch)
+    if mode == "raise" and (failed >= 0).any():
+        msg, mem, steps = _failure_message(failed, np.asarray(driver.times), batch)
+        raise NonFiniteStateError(msg, mem, steps)
+    stats = {"solver": repr(solver), "n_steps": driver.n_steps, "n_blocks": sum(s.stats["n_blocks"] for s in parts),
+             "batch_shape": batch, "chunks": len(parts),
+             "wall_time": max(s.stats["wall_time"] for s in parts)}
+    return Solution(times=parts[0].times, states=states, failed_step=failed, stats=stats)
