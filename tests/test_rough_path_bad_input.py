@@ -147,3 +147,21 @@ def test_other_methods_reject(X):
         Xb[3]
     with pytest.raises(TypeError, match="fine and coarse"):
         chen_defect(X, INC)
+
+
+def test_level2_group_operations_refuse_bad_elements():
+    from roughpaths import level2_exp, level2_inv, level2_log, level2_mul
+
+    x, a = np.ones(2), np.zeros((2, 2))
+    with pytest.raises(ValueError, match="non-finite"):
+        level2_mul(x, a, np.array([np.nan, 0.0]), a)
+    with pytest.raises(ValueError, match=r"a must have shape \(\.\.\., d, d\) = \(\.\.\., 2, 2\)"):
+        level2_inv(x, np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="same dimension d"):
+        level2_mul(x, a, np.ones(3), np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="do not broadcast"):
+        level2_mul(np.ones((4, 2)), np.zeros((4, 2, 2)), np.ones((3, 2)), np.zeros((3, 2, 2)))
+    with pytest.raises(TypeError, match="real"):
+        level2_exp(np.ones(2, dtype=complex), a)
+    with pytest.raises(ValueError, match="non-finite"):
+        level2_log(x, np.full((2, 2), np.inf))
