@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .validation import as_float_array, check_same_batch
+from .validation import as_float_array, check_memory, check_same_batch
 from .driver import Driver
 from .rough_path import RoughPath
 from .solvers import SOLVERS, Davie, Solver
@@ -233,6 +233,10 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         idx = np.unique(_index_of(driver, save_at).ravel())
     save_mask = np.zeros(n + 1, dtype=bool)
     save_mask[idx] = True
+    members = float(np.prod(batch, dtype=np.float64))
+    check_memory(8.0 * members * idx.size * e, f"the saved states ({members:.0f} member(s) x {idx.size} "
+                 f"time(s) x {e})", "save fewer times (save_at='end' or a coarser array of grid times) or "
+                 "solve the batch in parts")
     out = np.empty(batch + (idx.size, e))
     slot = 0
     if save_mask[0]:

@@ -20,6 +20,8 @@ __all__ = [
     "check_rng",
     "check_positive_int",
     "check_same_batch",
+    "check_memory",
+    "memory_budget",
 ]
 
 
@@ -140,3 +142,66 @@ def check_same_batch(shape_a: tuple, shape_b: tuple, name_a: str, name_b: str) -
     except ValueError:
         raise ValueError(f"batch shapes of {name_a} {tuple(shape_a)} and {name_b} {tuple(shape_b)} "
                          f"do not broadcast; give them the same leading axes.") from None
+
+
+def memory_budget() -> int:
+    """The number of bytes a single array allocation may take before it is refused.
+
+    ``ROUGHPATHS_MAX_BYTES`` (an integer, bytes) if set; otherwise three quarters of the memory
+    currently available (``MemAvailable`` on Linux, else of the physical memory), so that a request
+    that would push the machine into swap or the OOM killer is refused with an estimate instead.
+    """
+    import os
+
+    env = os.environ.get("ROUGHPATHS_MAX_BYTES")
+    if env:
+        try:
+            value = int(float(env))
+        except ValueError:
+            raise ValueError(f"ROUGHPATHS_MAX_BYTES must be a number of bytes, got {env!r}.") from None
+        if value <= 0:
+            raise ValueError(f"ROUGHPATHS_MAX_BYTES must be positive, got {env!r}.")
+        return value
+    avail = None
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    avail = int(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    if avail is None:
+        try:
+            avail = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        except (ValueError, OSError, AttributeError):
+            avail = 8 * 2**30
+    return int(0.75 * avail)
+
+
+def _human(nbytes: float) -> str:
+    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if nbytes >= size:
+            return f"{nbytes / size:.3g} {unit}"
+    return f"{nbytes:.0f} B"
+
+
+def check_memory(nbytes, what: str, fix: str, *, max_bytes=None) -> None:
+    """Refuse, before allocating, an array of ``nbytes`` bytes above the budget.
+
+    Parameters
+    ----------
+    nbytes : int or float
+        The estimated size (compute it in floating point so it cannot overflow).
+    what : str
+        What would be allocated, e.g. ``"the saved states (1000 paths x 10001 times x 3)"``.
+    fix : str
+        How to stay within the budget, e.g. ``"save fewer times (save_at='end')"``.
+    max_bytes : int, optional
+        The budget; default :func:`memory_budget`.
+    """
+    budget = memory_budget() if max_bytes is None else max_bytes
+    if float(nbytes) > budget:
+        raise ValueError(f"{what} would take {_human(float(nbytes))}, more than the memory budget of "
+                         f"{_human(budget)} (three quarters of the available memory, or "
+                         f"ROUGHPATHS_MAX_BYTES); {fix}.")

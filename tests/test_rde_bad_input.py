@@ -136,3 +136,12 @@ def test_rough_integral_bad_input(setup):
         rough_integral(np.zeros((4, 8, 2)), np.zeros((4, 8, 2, 2)), X)
     with pytest.raises(ValueError, match="d=2"):
         rough_integral(np.zeros((4, 9, 3)), np.zeros((4, 9, 3, 3)), X)
+
+
+def test_solve_refuses_a_state_array_above_the_memory_budget(monkeypatch):
+    V = LinearVectorFields(np.zeros((1, 2, 2)))
+    X = RoughPath.from_increments(np.zeros((1000, 1)))
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", "10000")
+    with pytest.raises(ValueError, match=r"saved states .* 1001 time\(s\) .* memory budget .*save_at='end'"):
+        solve(V, X, np.ones(2), Heun())
+    assert solve(V, X, np.ones(2), Heun(), save_at="end").states.shape == (1, 2)
