@@ -20,6 +20,8 @@ from .coloured_noise import (
     sample_coloured_noise,
 )
 from .integral import rough_integral
+from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
+                        levy_areas_from_normals, sample_levy_areas)
 from .level2 import level2_exp, level2_inv, level2_log, level2_mul
 from .norms import (
     area_holder_seminorm,
@@ -89,6 +91,12 @@ __all__ = [
     "brownian_increments_and_areas",
     "refine",
     "DEFAULT_SUBSTEPS",
+    "sample_levy_areas",
+    "levy_areas_from_normals",
+    "levy_area_terms",
+    "levy_area_normals",
+    "choose_levy_area_method",
+    "LEVY_AREA_METHODS",
     "level2_mul",
     "level2_inv",
     "level2_exp",
