@@ -1,0 +1,185 @@
+"""Griffe extension: render the library's reStructuredText docstring markup as Markdown at build time.
+
+The library's docstrings are numpydoc with Sphinx-style reStructuredText inside (``:math:`…```,
+``:class:`~a.B```, ``.. math::`` blocks …), which Python-Markdown shows verbatim. mkdocstrings loads
+this extension (``extensions:`` in ``mkdocs.yml``); once a package is loaded it rewrites every
+docstring's text, before mkdocstrings parses the numpydoc sections:
+
+* ``:math:`x``` becomes ``$x$`` and a ``.. math::`` directive becomes a ``$$ … $$`` block (one per
+  blank-line-separated equation; an equation with ``\\`` line breaks and no environment of its own is
+  wrapped in ``aligned``, as Sphinx wraps it in ``split``). ``pymdownx.arithmatex`` (generic mode)
+  turns both into ``\\( … \\)`` / ``\\[ … \\]`` spans that KaTeX typesets in the browser
+  (``docs/javascripts/katex.js``).
+* ``:class:``, ``:func:``, ``:meth:``, ``:attr:``, ``:mod:``, ``:data:``, ``:exc:``, ``:obj:`` and
+  ``:const:`` become mkdocs-autorefs links: the target is resolved in the docstring's scope (as Sphinx
+  does), then to its canonical path (where it is defined, which is where mkdocstrings renders it).
+  ``~`` shows the last component only; functions and methods get ``()``. A target outside the two
+  packages (``numpy.random.Generator``) or one that cannot be resolved is shown as code, not linked.
+
+The library's docstrings stay the single source; nothing here is needed to read them in a terminal.
+"""
+
+from __future__ import annotations
+
+import html
+import importlib
+import inspect
+import re
+from typing import Any
+
+import griffe
+
+__all__ = ["RstToMarkdown", "convert", "math_directives_to_markdown"]
+
+_PACKAGES = ("roughpaths", "mechanics")
+_XREF_ROLES = ("class", "func", "meth", "attr", "mod", "data", "exc", "obj", "const")
+_ROLE_RE = re.compile(r":(?:py:)?(?P<role>math|" + "|".join(_XREF_ROLES) + r"):`(?P<body>[^`]+)`", re.S)
+_DIRECTIVE_RE = re.compile(r"^(?P<indent>[ \t]*)\.\. math::[ \t]*(?P<rest>.*)$")
+_ENV_RE = re.compile(r"\\begin\{")
+
+
+def math_directives_to_markdown(text: str) -> str:
+    """Replace every ``.. math::`` directive in ``text`` by ``$$`` blocks at the directive's indentation."""
+    lines = text.split("\n")
+    out: list[str] = []
+    i = 0
+    while i < len(lines):
+        m = _DIRECTIVE_RE.match(lines[i])
+        if not m:
+            out.append(lines[i])
+            i += 1
+            continue
+        indent = m["indent"]
+        body = [m["rest"]] if m["rest"].strip() else []
+        i += 1
+        # The directive's argument and content: every following line indented deeper, or blank.
+        while i < len(lines) and (not lines[i].strip() or _indent(lines[i]) > len(indent)):
+            body.append(lines[i])
+            i += 1
+        # Trailing blank lines belong to the text after the directive.
+        trailing = 0
+        while body and not body[-1].strip():
+            body.pop()
+            trailing += 1
+        equations: list[list[str]] = [[]]
+        for line in body:
+            if line.strip().startswith(":") and line.strip().split(":")[1] in ("label", "nowrap"):
+                continue  # directive options: no meaning here
+            if line.strip():
+                equations[-1].append(line.strip())
+            elif equations[-1]:
+                equations.append([])
+        for eq in (e for e in equations if e):
+            tex = "\n".join(eq)
+            if "\\\\" in tex and not _ENV_RE.search(tex):
+                tex = "\\begin{aligned}\n" + tex + "\n\\end{aligned}"
+            if out and out[-1].strip():
+                out.append("")
+            out += [indent + "$$", *(indent + t for t in tex.split("\n")), indent + "$$", ""]
+        if out and not out[-1].strip():
+            out.pop()
+        out += [""] * max(trailing, 1) if i < len(lines) else []
+    return "\n".join(out)
+
+
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip(" \t"))
+
+
+def _canonical(path: str) -> str | None:
+    """The canonical dotted path of the object ``path`` names (where it is defined), or ``None``."""
+    parts = path.split(".")
+    for k in range(len(parts), 0, -1):
+        try:
+            obj: Any = importlib.import_module(".".join(parts[:k]))
+        except ImportError:
+            continue
+        except Exception:  # noqa: BLE001 - a module that fails to import cannot be linked
+            return None
+        canon = obj.__name__
+        for name in parts[k:]:
+            try:
+                obj = inspect.getattr_static(obj, name)
+            except AttributeError:
+                return None
+            target = getattr(obj, "__func__", obj)  # classmethod / staticmethod
+            target = getattr(target, "fget", target)  # property
+            mod, qual = getattr(target, "__module__", None), getattr(target, "__qualname__", None)
+            if isinstance(mod, str) and isinstance(qual, str) and "<" not in qual and (inspect.isclass(target) or inspect.isfunction(target)):
+                canon = f"{mod}.{qual}"
+            elif inspect.ismodule(obj):
+                canon = obj.__name__
+            else:
+                canon = f"{canon}.{name}"
+        return canon
+    return None
+
+
+def _resolve(obj: griffe.Object, target: str) -> str | None:
+    """Resolve ``target`` as written in ``obj``'s docstring to a canonical path, or ``None``."""
+    target = target.lstrip(".")
+    head, _, rest = target.partition(".")
+    candidates = []
+    scope: griffe.Object | None = obj
+    while scope is not None:  # the docstring's scope, then its parents (Sphinx's lookup order)
+        try:
+            candidates.append(scope.resolve(head) + (f".{rest}" if rest else ""))
+            break
+        except (griffe.NameResolutionError, AttributeError, KeyError):
+            scope = scope.parent
+    if head in _PACKAGES or head in ("numpy", "scipy", "matplotlib", "numba"):
+        candidates.append(target)
+    if obj.is_class or obj.is_module:
+        candidates.append(f"{obj.path}.{target}")
+    if obj.parent is not None:
+        candidates.append(f"{obj.parent.path}.{target}")
+    for cand in candidates:
+        canon = _canonical(cand)
+        if canon is not None:
+            return canon
+    return None
+
+
+def convert(text: str, obj: griffe.Object | None = None) -> str:
+    """Convert the RST roles and ``.. math::`` directives in ``text`` (the docstring of ``obj``)."""
+    text = math_directives_to_markdown(text)
+
+    def role(m: re.Match) -> str:
+        kind, body = m["role"], m["body"]
+        if kind == "math":
+            return "$" + " ".join(body.split()) + "$"
+        body = " ".join(body.split())
+        explicit = re.fullmatch(r"(?P<title>.+?)\s*<(?P<target>[^<>]+)>", body)
+        if explicit:
+            title, target = explicit["title"], explicit["target"]
+        else:
+            target = body.lstrip("!")
+            short = target.startswith("~")
+            target = target.lstrip("~")
+            title = target.rsplit(".", 1)[-1] if short else target
+            if kind in ("func", "meth") and not title.endswith(")"):
+                title += "()"
+        target = target.removesuffix("()")
+        path = _resolve(obj, target) if obj is not None else None
+        code = f"<code>{html.escape(title)}</code>"
+        if path is None or path.split(".")[0] not in _PACKAGES:
+            return code
+        return f'<autoref identifier="{html.escape(path)}" optional>{code}</autoref>'
+
+    return _ROLE_RE.sub(role, text)
+
+
+class RstToMarkdown(griffe.Extension):
+    """Rewrite the docstrings of a loaded package from reStructuredText markup to Markdown."""
+
+    def on_package(self, *, pkg: griffe.Module, **kwargs: Any) -> None:
+        seen: set[int] = set()
+        stack: list[griffe.Object] = [pkg]
+        while stack:
+            obj = stack.pop()
+            if id(obj) in seen:
+                continue
+            seen.add(id(obj))
+            if obj.docstring is not None:
+                obj.docstring.value = convert(obj.docstring.value, obj)
+            stack.extend(m for m in obj.members.values() if not m.is_alias)
