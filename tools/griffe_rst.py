@@ -10,6 +10,7 @@ docstring's text, before mkdocstrings parses the numpydoc sections:
   wrapped in ``aligned``, as Sphinx wraps it in ``split``). ``pymdownx.arithmatex`` (generic mode)
   turns both into ``\\( … \\)`` / ``\\[ … \\]`` spans that KaTeX typesets in the browser
   (``docs/javascripts/katex.js``).
+* A bullet-list item's further blocks are re-indented from RST's 2 columns to Markdown's 4.
 * ``:class:``, ``:func:``, ``:meth:``, ``:attr:``, ``:mod:``, ``:data:``, ``:exc:``, ``:obj:`` and
   ``:const:`` become mkdocs-autorefs links: the target is resolved in the docstring's scope (as Sphinx
   does), then to its canonical path (where it is defined, which is where mkdocstrings renders it).
@@ -29,7 +30,7 @@ from typing import Any
 
 import griffe
 
-__all__ = ["RstToMarkdown", "convert", "math_directives_to_markdown"]
+__all__ = ["RstToMarkdown", "convert", "math_directives_to_markdown", "rst_lists_to_markdown"]
 
 _PACKAGES = ("roughpaths", "mechanics")
 _XREF_ROLES = ("class", "func", "meth", "attr", "mod", "data", "exc", "obj", "const")
@@ -79,6 +80,35 @@ def math_directives_to_markdown(text: str) -> str:
         if out and not out[-1].strip():
             out.pop()
         out += [""] * max(trailing, 1) if i < len(lines) else []
+    return "\n".join(out)
+
+
+_BULLET_RE = re.compile(r"^(?P<indent>[ \t]*)[*+-] \S")
+
+
+def rst_lists_to_markdown(text: str) -> str:
+    """Indent the blocks inside RST bullet-list items by 4 spaces instead of 2 (Markdown's rule).
+
+    In RST, a bullet item's further paragraphs (and ``$$`` blocks) are indented to the item's text,
+    two columns past the bullet; Python-Markdown only keeps a block in the item when it is indented
+    four columns, and otherwise ends the list and shows the block as an indented paragraph.
+    """
+    lines = text.split("\n")
+    out: list[str] = []
+    bullet: int | None = None  # indentation of the current item's bullet
+    for line in lines:
+        m = _BULLET_RE.match(line)
+        if m:
+            bullet = len(m["indent"])
+            out.append(line)
+            continue
+        if bullet is not None and line.strip():
+            ind = _indent(line)
+            if ind <= bullet:
+                bullet = None
+            elif ind >= bullet + 2:
+                line = "  " + line
+        out.append(line)
     return "\n".join(out)
 
 
@@ -142,7 +172,7 @@ def _resolve(obj: griffe.Object, target: str) -> str | None:
 
 def convert(text: str, obj: griffe.Object | None = None) -> str:
     """Convert the RST roles and ``.. math::`` directives in ``text`` (the docstring of ``obj``)."""
-    text = math_directives_to_markdown(text)
+    text = rst_lists_to_markdown(math_directives_to_markdown(text))
 
     def role(m: re.Match) -> str:
         kind, body = m["role"], m["body"]
