@@ -7,30 +7,28 @@ round trip returns arrays whose bytes, dtype (``float64``) and shape are identic
 
 File format, version 1
 ----------------------
-``__metadata__``
-    A 0-d unicode array holding one JSON object with these keys:
+An ``.npz`` archive with these entries:
 
-    * ``format``: ``"roughpaths-npz"``; ``format_version``: ``1`` (an integer, raised whenever
-      a reader of the previous version could misread a file; :func:`load` refuses a newer one);
-    * ``type``: ``"RoughPath"`` or ``"Solution"``;
-    * ``package``, ``package_version``, ``numpy_version``: who wrote it; ``created``: UTC time,
-      ISO 8601;
-    * ``conventions``: the area convention of the stored areas, ``XX[..., i, j]`` over
-      :math:`[s, t]` is :math:`\int_s^t (X^i_r - X^i_s)\,dX^j_r` (the ordering of ``iisignature``
-      and ``esig``), the Lévy area :math:`\tfrac12(\mathbb{X} - \mathbb{X}^T)` *with* the ½, and
-      ``areas`` being per grid step (see the project's ``docs/conventions.md``);
-    * ``seed``: the seed the data came from, when the caller passes it to :func:`save` (an object
-      does not know its seed), else ``null``;
-    * ``user``: the caller's own JSON-serialisable ``metadata`` dict (``{}`` by default);
-    * for a ``RoughPath``: ``kind``, ``level``, ``dim``, ``n_steps``, ``batch_shape``;
-      for a ``Solution``: ``stats`` (tuples are kept as tuples).
+* ``__metadata__``: a 0-d unicode array holding one JSON object with the keys
 
-``RoughPath`` arrays
-    ``times`` ``(N + 1,)``, ``increments`` ``(..., N, d)``, ``areas`` ``(..., N, d, d)`` (absent
-    for a level-1 path), ``x0`` ``(..., d)``.
+  - ``format``: ``"roughpaths-npz"``; ``format_version``: ``1``, an integer raised whenever a
+    reader of the previous version could misread a file (:func:`load` refuses a newer one);
+  - ``type``: ``"RoughPath"`` or ``"Solution"``;
+  - ``package``, ``package_version``, ``numpy_version``: who wrote the file; ``created``: the UTC
+    time, ISO 8601;
+  - ``conventions``: the area convention of the stored areas, ``XX[..., i, j]`` over
+    :math:`[s, t]` being :math:`\int_s^t (X^i_r - X^i_s)\,dX^j_r` (the ordering of ``iisignature``
+    and ``esig``), the Lévy area :math:`\tfrac12(\mathbb{X} - \mathbb{X}^T)` *with* the ½, and
+    ``areas`` stored per grid step (the project's ``docs/conventions.md``);
+  - ``seed``: the seed the data came from when the caller passes it to :func:`save` (an object
+    does not know its seed), else ``null``;
+  - ``user``: the caller's own JSON-serialisable ``metadata`` dict (``{}`` by default);
+  - for a ``RoughPath``: ``kind``, ``level``, ``dim``, ``n_steps``, ``batch_shape``; for a
+    ``Solution``: ``stats`` (tuples come back as tuples).
 
-``Solution`` arrays
-    ``times`` ``(K,)``, ``states`` ``(..., K, e)``.
+* for a ``RoughPath``: the arrays ``times`` ``(N + 1,)``, ``increments`` ``(..., N, d)``,
+  ``areas`` ``(..., N, d, d)`` (absent for a level-1 path) and ``x0`` ``(..., d)``;
+* for a ``Solution``: the arrays ``times`` ``(K,)`` and ``states`` ``(..., K, e)``.
 
 Writes are atomic: the file is written under a temporary name in the target folder and renamed
 over the target only once complete, so a crash never leaves a half-written file under the name.

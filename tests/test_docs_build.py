@@ -5,7 +5,8 @@ Claims:
 * every page, cross-reference, included tutorial file and API reference (mkdocstrings from the
   numpydoc docstrings) resolves, with no warning;
 * no reStructuredText is left in the HTML: no ``:math:``/``:class:``/``:func:``/… role and no
-  ``.. math::`` (or other) directive (``tools/griffe_rst.py`` converts them when the docstrings
+  ``.. math::`` (or other) directive, and none of the converted markup shows as text (an escaped
+  ``<autoref>`` tag or a ``$\…`` formula inside a code block or a type column) (``tools/griffe_rst.py`` converts them when the docstrings
   are loaded; before it, the API pages showed about 590 raw roles and 23 directives);
 * every formula on the site is valid input for KaTeX (each arithmatex span is typeset by the
   vendored KaTeX under Node.js with ``throwOnError``), and no dollar-delimited formula was left
@@ -36,6 +37,9 @@ RAW_ROLE = re.compile(r":(?:py:)?(?:math|class|func|meth|attr|mod|data|exc|obj|c
                       r":(?:`|&#96;|<code>)")
 RAW_DIRECTIVE = re.compile(r"(?m)^\s*\.\. [a-z][a-z-]*::|\.\. (?:math|note|warning|seealso|code-block|"
                            r"versionadded|versionchanged|deprecated)::")
+# Converted markup that ended up shown as text (e.g. in a code block or a verbatim type column):
+# an escaped autoref tag, or a dollar-delimited formula (arithmatex writes \( \), never $).
+LEFTOVER = re.compile(r"&lt;autoref|\$\\[A-Za-z]")
 ARITHMATEX = re.compile(r'<(span|div) class="arithmatex">(.*?)</\1>', re.S)
 
 
@@ -86,7 +90,7 @@ def test_no_raw_restructuredtext(site):
     found = []
     for page in _pages(site):
         text = page.read_text(encoding="utf-8")
-        for rx in (RAW_ROLE, RAW_DIRECTIVE):
+        for rx in (RAW_ROLE, RAW_DIRECTIVE, LEFTOVER):
             for m in rx.finditer(text):
                 found.append(f"{page.relative_to(site)}: ...{text[max(0, m.start() - 60):m.end() + 60]!r}...")
     assert not found, f"{len(found)} raw reStructuredText roles/directives in the HTML:\n" + "\n".join(found[:20])

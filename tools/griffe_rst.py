@@ -10,7 +10,11 @@ docstring's text, before mkdocstrings parses the numpydoc sections:
   wrapped in ``aligned``, as Sphinx wraps it in ``split``). ``pymdownx.arithmatex`` (generic mode)
   turns both into ``\\( … \\)`` / ``\\[ … \\]`` spans that KaTeX typesets in the browser
   (``docs/javascripts/katex.js``).
-* A bullet-list item's further blocks are re-indented from RST's 2 columns to Markdown's 4.
+* A bullet-list item's further blocks and nested lists are re-indented from RST's 2 columns to
+  Markdown's 4.
+* On the entry lines of typed numpydoc sections (``name : type`` in Parameters, Returns, Raises …),
+  which mkdocstrings shows verbatim in the type column, a role becomes its plain text and a
+  double-backtick literal loses its backticks.
 * ``:class:``, ``:func:``, ``:meth:``, ``:attr:``, ``:mod:``, ``:data:``, ``:exc:``, ``:obj:`` and
   ``:const:`` become mkdocs-autorefs links: the target is resolved in the docstring's scope (as Sphinx
   does), then to its canonical path (where it is defined, which is where mkdocstrings renders it).
@@ -87,29 +91,54 @@ _BULLET_RE = re.compile(r"^(?P<indent>[ \t]*)[*+-] \S")
 
 
 def rst_lists_to_markdown(text: str) -> str:
-    """Indent the blocks inside RST bullet-list items by 4 spaces instead of 2 (Markdown's rule).
+    """Re-indent RST bullet lists for Markdown: an item's further blocks and nested lists by 4 columns.
 
-    In RST, a bullet item's further paragraphs (and ``$$`` blocks) are indented to the item's text,
-    two columns past the bullet; Python-Markdown only keeps a block in the item when it is indented
-    four columns, and otherwise ends the list and shows the block as an indented paragraph.
+    In RST, an item's further paragraphs, ``$$`` blocks and nested lists are indented to the item's
+    text, two columns past the bullet; Python-Markdown keeps a block in the item only when it is
+    indented four columns, and otherwise ends the list and shows the block as a paragraph (or, past
+    four columns, as code).
     """
-    lines = text.split("\n")
     out: list[str] = []
-    bullet: int | None = None  # indentation of the current item's bullet
-    for line in lines:
-        m = _BULLET_RE.match(line)
-        if m:
-            bullet = len(m["indent"])
+    stack: list[tuple[int, int]] = []  # (RST indentation of an open item's bullet, shift of its content)
+    for line in text.split("\n"):
+        if not line.strip():
             out.append(line)
             continue
-        if bullet is not None and line.strip():
-            ind = _indent(line)
-            if ind <= bullet:
-                bullet = None
-            elif ind >= bullet + 2:
-                line = "  " + line
-        out.append(line)
+        ind = _indent(line)
+        bullet = _BULLET_RE.match(line) is not None
+        while stack and ind <= stack[-1][0] and not (bullet and ind == stack[-1][0]):
+            stack.pop()
+        if bullet and stack and ind == stack[-1][0]:
+            stack.pop()  # a sibling item closes the previous one
+        shift = stack[-1][1] if stack else 0
+        out.append(" " * shift + line)
+        if bullet:
+            stack.append((ind, shift + 2))
     return "\n".join(out)
+
+
+_SECTION_RE = re.compile(r"^(?P<indent>[ \t]*)(?P<title>\S[^\n]*?)[ \t]*\n(?P=indent)-{3,}[ \t]*$", re.M)
+# numpydoc sections whose lines at the section's own indentation are "name : type" entries, which
+# mkdocstrings shows verbatim (not as Markdown) in the type column.
+_TYPED_SECTIONS = {"parameters", "other parameters", "returns", "yields", "receives", "raises", "warns",
+                   "attributes"}
+
+
+def _type_line_spans(text: str) -> list[tuple[int, int]]:
+    """Character ranges of the entry lines ("name : type") of the typed numpydoc sections."""
+    spans = []
+    headers = list(_SECTION_RE.finditer(text))
+    for k, h in enumerate(headers):
+        if h["title"].strip().lower() not in _TYPED_SECTIONS:
+            continue
+        body_start = text.index("\n", h.end() - 1) + 1 if "\n" in text[h.end() - 1:] else len(text)
+        body_end = headers[k + 1].start() if k + 1 < len(headers) else len(text)
+        pos = body_start
+        for line in text[body_start:body_end].split("\n"):
+            if line.strip() and _indent(line) == len(h["indent"]):
+                spans.append((pos, pos + len(line)))
+            pos += len(line) + 1
+    return spans
 
 
 def _indent(line: str) -> int:
@@ -173,12 +202,13 @@ def _resolve(obj: griffe.Object, target: str) -> str | None:
 def convert(text: str, obj: griffe.Object | None = None) -> str:
     """Convert the RST roles and ``.. math::`` directives in ``text`` (the docstring of ``obj``)."""
     text = rst_lists_to_markdown(math_directives_to_markdown(text))
+    type_lines = _type_line_spans(text)
 
     def role(m: re.Match) -> str:
-        kind, body = m["role"], m["body"]
+        kind, body = m["role"], " ".join(m["body"].split())
+        in_type = any(a <= m.start() < b for a, b in type_lines)
         if kind == "math":
-            return "$" + " ".join(body.split()) + "$"
-        body = " ".join(body.split())
+            return body if in_type else f"${body}$"
         explicit = re.fullmatch(r"(?P<title>.+?)\s*<(?P<target>[^<>]+)>", body)
         if explicit:
             title, target = explicit["title"], explicit["target"]
@@ -191,12 +221,20 @@ def convert(text: str, obj: griffe.Object | None = None) -> str:
                 title += "()"
         target = target.removesuffix("()")
         path = _resolve(obj, target) if obj is not None else None
+        if in_type:  # shown verbatim: plain words, no markup
+            return title
         code = f"<code>{html.escape(title)}</code>"
         if path is None or path.split(".")[0] not in _PACKAGES:
             return code
         return f'<autoref identifier="{html.escape(path)}" optional>{code}</autoref>'
 
-    return _ROLE_RE.sub(role, text)
+    text = _ROLE_RE.sub(role, text)
+    # The type column is verbatim too: drop the double backticks of RST literals there.
+    parts, last = [], 0
+    for a, b in _type_line_spans(text):
+        parts += [text[last:a], text[a:b].replace("``", "")]
+        last = b
+    return "".join(parts) + text[last:]
 
 
 class RstToMarkdown(griffe.Extension):
