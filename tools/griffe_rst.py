@@ -145,36 +145,63 @@ def _indent(line: str) -> int:
     return len(line) - len(line.lstrip(" \t"))
 
 
-def _canonical(path: str) -> str | None:
-    """The canonical dotted path of the object ``path`` names (where it is defined), or ``None``."""
-    parts = path.split(".")
-    for k in range(len(parts), 0, -1):
+def _canonical(path: str, module: bool = False) -> str | None:
+    """The canonical dotted path of the object ``path`` names (where it is defined), or ``None``.
+
+    Names are looked up as Python does, attribute by attribute from the top-level package, so
+    ``roughpaths.solve`` is the function the package exports, not the submodule of the same name;
+    with ``module=True`` (the ``:mod:`` role) a module of that name is preferred.
+    """
+    if module:
         try:
-            obj: Any = importlib.import_module(".".join(parts[:k]))
-        except ImportError:
-            continue
+            return importlib.import_module(path).__name__
+        except Exception:  # noqa: BLE001 - not a module: fall back to attribute lookup
+            pass
+    parts = path.split(".")
+    # Attribute by attribute from the top-level package first, then from the longest importable
+    # module prefix (``roughpaths.signature.logsignature``: the package exports a function
+    # ``signature`` that hides the submodule).
+    for k in (1, *range(len(parts), 1, -1)):
+        try:
+            start: Any = importlib.import_module(".".join(parts[:k]))
         except Exception:  # noqa: BLE001 - a module that fails to import cannot be linked
-            return None
-        canon = obj.__name__
-        for name in parts[k:]:
-            try:
-                obj = inspect.getattr_static(obj, name)
-            except AttributeError:
-                return None
-            target = getattr(obj, "__func__", obj)  # classmethod / staticmethod
-            target = getattr(target, "fget", target)  # property
-            mod, qual = getattr(target, "__module__", None), getattr(target, "__qualname__", None)
-            if isinstance(mod, str) and isinstance(qual, str) and "<" not in qual and (inspect.isclass(target) or inspect.isfunction(target)):
-                canon = f"{mod}.{qual}"
-            elif inspect.ismodule(obj):
-                canon = obj.__name__
-            else:
-                canon = f"{canon}.{name}"
-        return canon
+            continue
+        canon = _walk(start, parts[k:])
+        if canon is not None:
+            return canon
     return None
 
 
-def _resolve(obj: griffe.Object, target: str) -> str | None:
+def _walk(obj: Any, names: list[str]) -> str | None:
+    canon = obj.__name__
+    for name in names:
+        try:
+            obj = inspect.getattr_static(obj, name)
+        except AttributeError:
+            if inspect.isclass(obj) and any(name in getattr(c, "__annotations__", {}) for c in obj.__mro__):
+                canon = f"{canon}.{name}"  # a dataclass field or annotated instance attribute
+                obj = None
+                continue
+            if not inspect.ismodule(obj):
+                return None
+            try:
+                obj = importlib.import_module(f"{obj.__name__}.{name}")
+            except Exception:  # noqa: BLE001
+                return None
+        target = getattr(obj, "__func__", obj)  # classmethod / staticmethod
+        target = getattr(target, "fget", target)  # property
+        mod, qual = getattr(target, "__module__", None), getattr(target, "__qualname__", None)
+        if inspect.ismodule(obj):
+            canon = obj.__name__
+        elif (isinstance(mod, str) and isinstance(qual, str) and "<" not in qual
+              and (inspect.isclass(target) or inspect.isfunction(target))):
+            canon = f"{mod}.{qual}"
+        else:
+            canon = f"{canon}.{name}"
+    return canon
+
+
+def _resolve(obj: griffe.Object, target: str, module: bool = False) -> str | None:
     """Resolve ``target`` as written in ``obj``'s docstring to a canonical path, or ``None``."""
     target = target.lstrip(".")
     head, _, rest = target.partition(".")
@@ -193,7 +220,7 @@ def _resolve(obj: griffe.Object, target: str) -> str | None:
     if obj.parent is not None:
         candidates.append(f"{obj.parent.path}.{target}")
     for cand in candidates:
-        canon = _canonical(cand)
+        canon = _canonical(cand, module)
         if canon is not None:
             return canon
     return None
@@ -220,7 +247,7 @@ def convert(text: str, obj: griffe.Object | None = None) -> str:
             if kind in ("func", "meth") and not title.endswith(")"):
                 title += "()"
         target = target.removesuffix("()")
-        path = _resolve(obj, target) if obj is not None else None
+        path = _resolve(obj, target, kind == "mod") if obj is not None else None
         if in_type:  # shown verbatim: plain words, no markup
             return title
         code = f"<code>{html.escape(title)}</code>"
