@@ -47,7 +47,8 @@ def docs_site(tmp_path_factory):
 
     Returns the finished ``subprocess.CompletedProcess`` with ``site`` (the output folder) attached.
     Skipped when the docs toolchain is not installed (it is in the ``docs`` extra), failed under
-    ``CI=true``. KaTeX is vendored first (``tools/vendor_katex.sh``, a no-op when present).
+    ``CI=true``. KaTeX is vendored first (``tools/vendor_katex.sh``, a no-op when present); where that
+    fails outside CI, ``katex_missing`` says why and the tests that need KaTeX skip.
     """
     missing = _missing_modules(DOCS_TOOLCHAIN)
     if missing and os.environ.get("CI"):
@@ -58,13 +59,15 @@ def docs_site(tmp_path_factory):
                     f"pip install -e '.[docs]'")
     vendor = subprocess.run(["bash", str(ROOT / "tools" / "vendor_katex.sh")], capture_output=True, text=True,
                             timeout=300)
-    if vendor.returncode != 0:
+    if vendor.returncode != 0 and os.environ.get("CI"):
         pytest.fail(f"tools/vendor_katex.sh failed (KaTeX is needed to typeset the site):\n{vendor.stderr}")
     site = tmp_path_factory.mktemp("docs") / "site"
     proc = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(site)],
                           cwd=ROOT, env={**os.environ, "NO_MKDOCS_2_WARNING": "1"}, capture_output=True,
                           text=True, timeout=300)
     proc.site = site
+    # Without KaTeX (no npm here, outside CI) the site still builds; the tests that typeset skip.
+    proc.katex_missing = None if vendor.returncode == 0 else vendor.stderr.strip() or "vendor_katex.sh failed"
     return proc
 
 

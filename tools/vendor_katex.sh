@@ -16,7 +16,12 @@ fi
 TMP="$(mktemp -d)"
 trap 'rm -rf "$TMP"' EXIT
 # npm pack checks the tarball against the registry's integrity hash.
-TARBALL="$(cd "$TMP" && npm pack --silent "katex@$KATEX_VERSION" 2>/dev/null | tail -n 1)"
+if ! TARBALL="$(cd "$TMP" && npm pack --silent "katex@$KATEX_VERSION" 2>"$TMP/npm.log" | tail -n 1)" \
+        || [ ! -f "$TMP/$TARBALL" ]; then
+    echo "vendor_katex.sh: npm pack katex@$KATEX_VERSION failed:" >&2
+    tail -n 20 "$TMP/npm.log" >&2
+    exit 1
+fi
 tar -xzf "$TMP/$TARBALL" -C "$TMP"
 rm -rf "$DEST.new"
 mkdir -p "$DEST.new/fonts"
