@@ -31,6 +31,9 @@ ARTIFACTS = ROOT / "test-artifacts" / "browser"
 
 PAGE_STATE = r"""
 (async () => {
+  // KaTeX typesets on page load (katex.js); give it up to 5 s before counting.
+  const pending = () => Array.from(document.querySelectorAll('.arithmatex')).some(el => !el.querySelector('.katex'));
+  for (let i = 0; i < 50 && pending(); i++) { await new Promise(r => setTimeout(r, 100)); }
   await document.fonts.ready;
   const imgs = Array.from(document.images);
   await Promise.all(imgs.map(img => img.complete ? null : new Promise(r => { img.onload = img.onerror = r; })));
