@@ -4,4 +4,6 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 PY="$(tools/setup_env.sh test,docs | tail -n 1)"
+tools/vendor_katex.sh     # KaTeX for the documentation site (npm package, pinned; no-op when present)
+tools/setup_browser.sh    # Debian's chromium for tests/test_browser.py (no-op when installed)
 exec "$PY" -m pytest "$@"

@@ -20,6 +20,7 @@ from .coloured_noise import (
     sample_coloured_noise,
 )
 from .integral import rough_integral
+from .io import load, load_metadata, save
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals, sample_levy_areas)
 from .level2 import level2_exp, level2_inv, level2_log, level2_mul
@@ -84,6 +85,10 @@ __all__ = [
     "lift_area_rate",
     "expected_area_rate",
     "ResolutionWarning",
+    # saving and loading (versioned .npz)
+    "save",
+    "load",
+    "load_metadata",
     # rough paths, group, Brownian lifts, norms, signatures
     "RoughPath",
     "chen_defect",

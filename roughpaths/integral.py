@@ -12,7 +12,7 @@ with the area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j` (``CONVENTIONS.
 :math:`\partial Y^a_j / \partial X^i`. For :math:`Y = F(X)`, :math:`Y' = DF(X)`.
 
 With a Stratonovich (geometric) lift the sums converge to the Stratonovich integral, with an Itô
-lift (:math:`\mathbb{X}^{Itô} = \mathbb{X}^{Strat} - \tfrac12 (t - s) I`) to the Itô integral.
+lift (:math:`\mathbb{X}^{\text{Itô}} = \mathbb{X}^{\text{Strat}} - \tfrac12 (t - s) I`) to the Itô integral.
 """
 
 from __future__ import annotations

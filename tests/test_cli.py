@@ -9,8 +9,6 @@ figures (PNG + npz), ``report.md`` and a self-contained ``report.html``.
 from __future__ import annotations
 
 import io
-import subprocess
-import sys
 
 import pytest
 
@@ -143,11 +141,10 @@ def test_help_and_list(capsys):
 
 
 # ------------------------------------------------------------------------------------ end to end
-def test_tiny_end_to_end_run(tmp_path):
-    """The whole job at tiny sizes, in a subprocess, as a user runs it."""
-    out = tmp_path / "paper"
-    proc = subprocess.run([sys.executable, "-m", "mechanics", "--tiny", "--output", str(out), "--seed", "3"],
-                          capture_output=True, text=True, timeout=600)
+def test_tiny_end_to_end_run(tiny_paper_run):
+    """The whole job at tiny sizes, in a subprocess, as a user runs it (``--tiny --seed 3``; the run is
+    shared with the browser test, see ``conftest.tiny_paper_run``)."""
+    proc, out = tiny_paper_run, tiny_paper_run.out
     assert proc.returncode in (0, 1), proc.stderr  # 1: a check failed at tiny sizes (numbers not meaningful)
     assert "Traceback" not in proc.stderr
     md = (out / "report.md").read_text()

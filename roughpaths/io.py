@@ -1,0 +1,302 @@
+r"""Save and load :class:`~roughpaths.RoughPath` and :class:`~roughpaths.Solution` objects.
+
+One object per file, in NumPy's ``.npz`` format (a zip archive of ``.npy`` arrays), so a file can
+also be read with plain :func:`numpy.load` and no pickling is ever involved (files are loaded with
+``allow_pickle=False`` and are safe to open from anywhere). Arrays are stored bit for bit: a
+round trip returns arrays whose bytes, dtype (``float64``) and shape are identical.
+
+File format, version 1
+----------------------
+An ``.npz`` archive with these entries:
+
+* ``__metadata__``: a 0-d unicode array holding one JSON object with the keys
+
+  - ``format``: ``"roughpaths-npz"``; ``format_version``: ``1``, an integer raised whenever a
+    reader of the previous version could misread a file (:func:`load` refuses a newer one);
+  - ``type``: ``"RoughPath"`` or ``"Solution"``;
+  - ``package``, ``package_version``, ``numpy_version``: who wrote the file; ``created``: the UTC
+    time, ISO 8601;
+  - ``conventions``: the area convention of the stored areas, ``XX[..., i, j]`` over
+    :math:`[s, t]` being :math:`\int_s^t (X^i_r - X^i_s)\,dX^j_r` (the ordering of ``iisignature``
+    and ``esig``), the Lévy area :math:`\tfrac12(\mathbb{X} - \mathbb{X}^T)` *with* the ½, and
+    ``areas`` stored per grid step (the project's ``docs/conventions.md``);
+  - ``seed``: the seed the data came from when the caller passes it to :func:`save` (an object
+    does not know its seed), else ``null``;
+  - ``user``: the caller's own JSON-serialisable ``metadata`` dict (``{}`` by default);
+  - for a ``RoughPath``: ``kind``, ``level``, ``dim``, ``n_steps``, ``batch_shape``; for a
+    ``Solution``: ``stats`` (tuples come back as tuples).
+
+* for a ``RoughPath``: the arrays ``times`` ``(N + 1,)``, ``increments`` ``(..., N, d)``,
+  ``areas`` ``(..., N, d, d)`` (absent for a level-1 path) and ``x0`` ``(..., d)``;
+* for a ``Solution``: the arrays ``times`` ``(K,)`` and ``states`` ``(..., K, e)``.
+
+Writes are atomic: the file is written under a temporary name in the target folder and renamed
+over the target only once complete, so a crash never leaves a half-written file under the name.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import zipfile
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from .rough_path import RoughPath
+from .solve import Solution
+
+__all__ = ["save", "load", "load_metadata", "FORMAT", "FORMAT_VERSION"]
+
+FORMAT = "roughpaths-npz"
+FORMAT_VERSION = 1
+_META_KEY = "__metadata__"
+_CONVENTIONS = {
+    "area": "XX[..., i, j] over [s, t] = int_s^t (X^i_r - X^i_s) dX^j_r (iisignature/esig ordering: "
+            "word (i, j) <-> entry [i, j])",
+    "levy_area": "A = (XX - XX^T) / 2, with the 1/2",
+    "areas": "per grid step: areas[..., k, :, :] is the area over [t_k, t_{k+1}]",
+    "reference": "docs/conventions.md",
+}
+_ARRAYS = {"RoughPath": ("times", "increments", "x0"), "Solution": ("times", "states")}
+
+
+def _package_version() -> str:
+    from . import __version__
+
+    return __version__
+
+
+def _to_json(value, where: str):
+    """``value`` as JSON-ready data; tuples tagged so that they come back as tuples."""
+    if isinstance(value, tuple):
+        return {"__tuple__": [_to_json(v, f"{where}[{i}]") for i, v in enumerate(value)]}
+    if isinstance(value, list):
+        return [_to_json(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, dict):
+        out = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise TypeError(f"{where} has the key {k!r} of type {type(k).__name__}; only str keys can be "
+                                f"saved (JSON).")
+            out[k] = _to_json(v, f"{where}[{k!r}]")
+        return out
+    if isinstance(value, np.generic):
+        value = value.item()
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    raise TypeError(f"{where} = {value!r} has type {type(value).__name__}, which cannot be saved as "
+                    f"metadata; use str, int, float, bool, None, or lists/tuples/dicts of them.")
+
+
+def _from_json(value):
+    if isinstance(value, dict):
+        if set(value) == {"__tuple__"}:
+            return tuple(_from_json(v) for v in value["__tuple__"])
+        return {k: _from_json(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_from_json(v) for v in value]
+    return value
+
+
+def save(obj, path, *, seed=None, metadata=None) -> Path:
+    """Write a :class:`~roughpaths.RoughPath` or :class:`~roughpaths.Solution` to a ``.npz`` file.
+
+    Parameters
+    ----------
+    obj : RoughPath or Solution
+        What to save (any batch shape; arrays are stored bit for bit).
+    path : str or os.PathLike
+        Target file; ``.npz`` is appended when the name has another suffix (as :func:`numpy.savez`
+        does). An existing file is replaced atomically.
+    seed : int, optional
+        The seed the data were generated from, recorded in the metadata (``None``: unknown).
+    metadata : dict, optional
+        Your own JSON-serialisable metadata (str keys; str, int, float, bool, None, lists, tuples,
+        dicts), returned by :func:`load_metadata` under ``"user"``.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    TypeError
+        ``obj`` is neither a ``RoughPath`` nor a ``Solution``, or the metadata is not serialisable.
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np
+    >>> from roughpaths import brownian_rough_path, save, load, load_metadata
+    >>> X = brownian_rough_path(np.linspace(0.0, 1.0, 9), 2, np.random.default_rng(7))
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     f = save(X, f"{tmp}/driver", seed=7)
+    ...     Y = load(f)
+    ...     meta = load_metadata(f)
+    >>> f.name, Y.kind, meta["seed"], meta["format_version"]
+    ('driver.npz', 'geometric', 7, 1)
+    >>> bool(np.array_equal(Y.areas, X.areas))
+    True
+    """
+    if isinstance(obj, RoughPath):
+        kind = "RoughPath"
+        arrays = {"times": obj.times, "increments": obj.increments, "x0": obj.x0}
+        if obj.areas is not None:
+            arrays["areas"] = obj.areas
+        extra = {"kind": obj.kind, "level": obj.level, "dim": obj.dim, "n_steps": obj.n_steps,
+                 "batch_shape": list(obj.batch_shape)}
+    elif isinstance(obj, Solution):
+        kind = "Solution"
+        arrays = {"times": obj.times, "states": obj.states}
+        extra = {"stats": _to_json(dict(obj.stats), "Solution.stats")}
+    else:
+        raise TypeError(f"save() writes a RoughPath or a Solution, got {type(obj).__name__}; for other arrays "
+                        f"use numpy.savez.")
+    if seed is not None and not isinstance(seed, (int, np.integer)):
+        raise TypeError(f"seed must be an int or None, got {seed!r} ({type(seed).__name__}).")
+    if metadata is not None and not isinstance(metadata, dict):
+        raise TypeError(f"metadata must be a dict or None, got {type(metadata).__name__}.")
+    meta = {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "type": kind,
+        "package": "roughpaths-mechanics",
+        "package_version": _package_version(),
+        "numpy_version": np.__version__,
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "conventions": _CONVENTIONS,
+        "seed": None if seed is None else int(seed),
+        "user": _to_json(metadata or {}, "metadata"),
+        **extra,
+    }
+    payload = {name: np.ascontiguousarray(a) for name, a in arrays.items()}
+    payload[_META_KEY] = np.array(json.dumps(meta, ensure_ascii=False))
+
+    target = Path(os.fspath(path))
+    if target.suffix != ".npz":
+        target = target.with_name(target.name + ".npz")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **payload)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return target
+
+
+def _open(path):
+    p = Path(os.fspath(path))
+    if not p.exists():
+        raise FileNotFoundError(f"no such file: {p}")
+    try:
+        data = np.load(p, allow_pickle=False)
+    except (ValueError, OSError, zipfile.BadZipFile, EOFError) as exc:
+        raise ValueError(f"{p} is not a readable .npz file ({exc}); it is not a file written by "
+                         f"roughpaths.save, or it is truncated or corrupt.") from None
+    if not isinstance(data, np.lib.npyio.NpzFile):
+        raise ValueError(f"{p} is a single .npy array, not an .npz file written by roughpaths.save.")
+    return p, data
+
+
+def _metadata(p: Path, data) -> dict:
+    if _META_KEY not in data.files:
+        raise ValueError(f"{p} has no {_META_KEY!r} entry, so it was not written by roughpaths.save (it holds "
+                         f"the arrays {sorted(data.files)}; read it with numpy.load).")
+    try:
+        meta = json.loads(str(data[_META_KEY][()]))
+    except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise ValueError(f"{p}: the metadata entry is unreadable ({exc}); the file is corrupt.") from None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        raise ValueError(f"{p}: the metadata does not declare format {FORMAT!r}; not a roughpaths file.")
+    version = meta.get("format_version")
+    if not isinstance(version, int) or version < 1:
+        raise ValueError(f"{p}: invalid format_version {version!r}; the file is corrupt.")
+    if version > FORMAT_VERSION:
+        raise ValueError(f"{p} uses format version {version} (written by {meta.get('package')} "
+                         f"{meta.get('package_version')}), newer than the version this roughpaths "
+                         f"{_package_version()} reads ({FORMAT_VERSION}); upgrade roughpaths-mechanics to load it.")
+    if meta.get("type") not in _ARRAYS:
+        raise ValueError(f"{p}: unknown object type {meta.get('type')!r} (expected one of {sorted(_ARRAYS)}).")
+    return meta
+
+
+def load_metadata(path) -> dict:
+    """The metadata of a file written by :func:`save` (see the module documentation for the keys).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    dict
+        Tuples saved in ``stats`` or ``user`` come back as tuples.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        The file is not one written by :func:`save`, is corrupt or truncated, or uses a newer format
+        version than this package reads.
+    """
+    p, data = _open(path)
+    with data:
+        meta = _metadata(p, data)
+    return _from_json(meta)
+
+
+def load(path):
+    """Read a :class:`~roughpaths.RoughPath` or :class:`~roughpaths.Solution` written by :func:`save`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    RoughPath or Solution
+        With arrays bitwise equal to the saved ones. A ``RoughPath`` is rebuilt through its
+        validating constructor (with its saved ``kind``), so a damaged file cannot produce an
+        inconsistent path.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        The file is not one written by :func:`save`, is corrupt or truncated, lacks an array, or
+        uses a newer format version than this package reads.
+    """
+    p, data = _open(path)
+    with data:
+        meta = _metadata(p, data)
+        kind = meta["type"]
+        names = _ARRAYS[kind] + (("areas",) if kind == "RoughPath" and meta.get("level") == 2 else ())
+        missing = [n for n in names if n not in data.files]
+        if missing:
+            raise ValueError(f"{p}: the {kind} arrays {missing} are missing; the file is corrupt.")
+        try:
+            arrays = {n: data[n] for n in names}
+        except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
+            raise ValueError(f"{p}: an array is unreadable ({exc}); the file is corrupt or truncated.") from None
+    for n, a in arrays.items():
+        if a.dtype != np.float64:
+            raise ValueError(f"{p}: array {n!r} has dtype {a.dtype}, expected float64; the file is corrupt.")
+    if kind == "Solution":
+        return Solution(times=arrays["times"], states=arrays["states"], stats=_from_json(meta.get("stats", {})))
+    try:
+        return RoughPath(arrays["increments"], arrays.get("areas"), times=arrays["times"], x0=arrays["x0"],
+                         kind=meta.get("kind"))
+    except ValueError as exc:
+        raise ValueError(f"{p}: the stored rough path is inconsistent ({exc}); the file is corrupt.") from None

@@ -1,0 +1,130 @@
+"""The documentation site and the main job's ``report.html`` display correctly in a real browser.
+
+Claims, checked in headless Chromium (Debian's ``chromium``; ``tools/setup_browser.sh`` installs it)
+on pages served from 127.0.0.1:
+
+* on every page of the built site (``mkdocs build --strict``): every formula was typeset by KaTeX
+  (each ``.arithmatex`` element holds a ``.katex`` rendering, none failed to parse), no raw TeX
+  delimiter (``$$``, ``\\(``, ``\\[``) or reStructuredText role is left in the visible text, the
+  KaTeX fonts loaded, every image loaded (``naturalWidth > 0``), and no console error, uncaught
+  exception or failed network load occurred (the site needs nothing outside it);
+* on ``report.html`` from a ``--tiny`` run of the main job: every embedded figure decodes
+  (``naturalWidth > 0``), one per figure that ran, no raw TeX or RST is in the text, and no console
+  error occurred.
+
+Screenshots are kept in ``test-artifacts/browser/`` (gitignored). Skipped when Chromium is missing,
+except under ``CI=true``, where that is a failure.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import pytest
+
+from _browser import Chromium, StaticServer, find_chromium
+
+ROOT = Path(__file__).resolve().parents[1]
+ARTIFACTS = ROOT / "test-artifacts" / "browser"
+
+PAGE_STATE = r"""
+(async () => {
+  // KaTeX typesets on page load (katex.js); give it up to 5 s before counting.
+  const pending = () => Array.from(document.querySelectorAll('.arithmatex')).some(el => !el.querySelector('.katex'));
+  for (let i = 0; i < 50 && pending(); i++) { await new Promise(r => setTimeout(r, 100)); }
+  await document.fonts.ready;
+  const imgs = Array.from(document.images);
+  await Promise.all(imgs.map(img => img.complete ? null : new Promise(r => { img.onload = img.onerror = r; })));
+  const text = document.body.innerText;
+  const raw = [];
+  for (const rx of [/\$\$/g, /\\\(/g, /\\\[/g, /:(?:math|class|func|meth|attr|mod|data|exc|obj):`/g, /\.\. math::/g]) {
+    for (const m of text.matchAll(rx)) { raw.push(text.slice(Math.max(0, m.index - 40), m.index + 40)); }
+  }
+  const math = Array.from(document.querySelectorAll('.arithmatex'));
+  return {
+    title: document.title,
+    formulas: math.length,
+    typeset: math.filter(el => el.querySelector('.katex')).length,
+    failed: document.querySelectorAll('.katex-failed, .katex-error').length,
+    katexFont: math.length ? document.fonts.check('16px KaTeX_Main') : true,
+    images: imgs.map(img => ({src: img.src.slice(0, 80), width: img.naturalWidth})),
+    raw: raw.slice(0, 10),
+  };
+})()
+"""
+
+
+@pytest.fixture(scope="module")
+def chromium():
+    exe = find_chromium()
+    if exe is None:
+        msg = "Chromium not found: tools/setup_browser.sh installs Debian's chromium (run by ./test.sh)"
+        if os.environ.get("CI"):
+            pytest.fail(msg)
+        pytest.skip(msg)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    with Chromium(exe) as browser:
+        yield browser
+
+
+def _check_page(browser, url: str, shot: str) -> dict:
+    page = browser.open(url)
+    state = page.evaluate(PAGE_STATE)
+    first_display = page.evaluate("(() => { const el = document.querySelector('div.arithmatex');"
+                                  " if (el) { el.scrollIntoView({block: 'center'}); } return !!el; })()")
+    page.screenshot(ARTIFACTS / f"{shot}.png")
+    if first_display:
+        page.screenshot(ARTIFACTS / f"{shot}-display-math.png")
+    state["errors"] = page.errors()
+    state["url"] = url
+    return state
+
+
+def test_docs_site_in_browser(docs_site, chromium):
+    assert docs_site.returncode == 0, docs_site.stderr[-4000:]
+    if docs_site.katex_missing:
+        pytest.skip(f"KaTeX could not be vendored, so the site cannot typeset: {docs_site.katex_missing}")
+    site = docs_site.site
+    pages = sorted(p.relative_to(site) for p in site.rglob("index.html"))
+    assert len(pages) >= 8, pages
+    total = 0
+    with StaticServer(site) as server:
+        for rel in pages:
+            url = server.url + rel.parent.as_posix().removeprefix(".") + ("/" if rel.parent != Path(".") else "")
+            shot = re.sub(r"\W+", "-", rel.parent.as_posix()).strip("-") or "home"
+            s = _check_page(chromium, url, shot)
+            where = f"{rel.parent} (screenshot test-artifacts/browser/{shot}.png)"
+            assert not s["errors"], f"{where}: console/network errors: {s['errors']}"
+            assert s["typeset"] == s["formulas"], f"{where}: {s['formulas'] - s['typeset']} formulas not typeset"
+            assert s["failed"] == 0, f"{where}: {s['failed']} formulas KaTeX could not parse"
+            assert s["katexFont"], f"{where}: KaTeX fonts did not load"
+            assert not s["raw"], f"{where}: raw TeX/RST in the text: {s['raw']}"
+            bad = [i for i in s["images"] if i["width"] == 0]
+            assert not bad, f"{where}: images that did not load: {bad}"
+            if rel.parts[0] == "api":
+                assert s["formulas"] >= 150, f"{where}: only {s['formulas']} formulas on an API page"
+            total += s["formulas"]
+    assert total >= 400
+
+
+def test_report_html_in_browser(tiny_paper_run, chromium):
+    out = tiny_paper_run.out
+    assert tiny_paper_run.returncode in (0, 1), tiny_paper_run.stderr[-4000:]
+    report = out / "report.html"
+    assert report.exists()
+    figures_run = len(re.findall(r"<img alt=", report.read_text(encoding="utf-8")))
+    with StaticServer(out) as server:
+        page = chromium.open(server.url + "report.html")
+        s = page.evaluate(PAGE_STATE)
+        page.screenshot(ARTIFACTS / "report.png")
+        page.screenshot(ARTIFACTS / "report-full.png", full_page=True)
+        errors = page.errors()
+    errors = [e for e in errors if "favicon.ico" not in e]  # the browser asks for one; the report has none
+    assert not errors, f"report.html: console/network errors: {errors}"
+    assert figures_run >= 1 and len(s["images"]) == figures_run
+    bad = [i for i in s["images"] if i["width"] == 0]
+    assert not bad, f"report.html: figures that did not decode: {bad}"
+    assert not s["raw"], f"report.html: raw TeX/RST in the text: {s['raw']}"
+    assert s["failed"] == 0
