@@ -21,8 +21,7 @@ import numpy as np
 
 from . import _signature_kernels as _k
 from ._validation import as_float_array, check_positive_int
-from .tensor_algebra import (_reversed_to_rowmajor, lyndon_coordinates, logsigdim, sigdim,
-                             tensor_log)
+from .tensor_algebra import (_log_flat, _lyndon_flat, _reversed_to_rowmajor, logsigdim, sigdim)
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
@@ -48,6 +47,41 @@ def _n_chunks(batch: int, n: int, min_points: int) -> int:
 
 def _check_depth(depth) -> int:
     return check_positive_int(depth, "depth")
+
+
+def _available_bytes() -> int:
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        import os
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return 1 << 62
+
+
+def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
+    """Refuse, before allocating, a request whose working arrays would not fit in memory.
+
+    The signature needs about 3 arrays of ``batch * sigdim`` floats (result, chunk partials,
+    layout permutation); the log-signature 2 more (log, scratch) plus the sparse Lyndon map, whose
+    top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built).
+    """
+    dim = sigdim(d, depth)
+    need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
+    if log and depth > 1 and d > 1:
+        need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+    avail = _available_bytes()
+    if need > avail:
+        what = "logsignature" if log else "signature"
+        raise ValueError(
+            f"depth={depth} with d={d} and {batch} path(s): the {what} needs about {need / 2**30:.1f} GiB "
+            f"(sigdim({d}, {depth}) = {dim} floats per path) but {avail / 2**30:.1f} GiB is available. "
+            f"Lower depth, process the batch in smaller pieces, or use fewer dimensions.")
 
 
 def _check_paths(paths) -> np.ndarray:
@@ -101,6 +135,7 @@ def signature(paths, depth: int) -> np.ndarray:
     x = _check_paths(paths)
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    _check_fits(flat.shape[0], d, depth)
     return _signature_flat(flat, depth).reshape(batch + (sigdim(d, depth),))
 
 
@@ -134,7 +169,11 @@ def logsignature(paths, depth: int) -> np.ndarray:
     if depth == 1 or d == 1:
         # d = 1: the free Lie algebra is R (a path's log-signature is its increment).
         return signature(x, 1)[..., :logsigdim(d, depth)]
-    return lyndon_coordinates(tensor_log(signature(x, depth), d), d)
+    batch, n = x.shape[:-2], x.shape[-2]
+    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    _check_fits(flat.shape[0], d, depth, log=True)
+    sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    return _lyndon_flat(_log_flat(sig, d, depth), d, depth).reshape(batch + (-1,))
 
 
 def rough_path_signature(X, depth: int) -> np.ndarray:
