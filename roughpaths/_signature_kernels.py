@@ -142,146 +142,50 @@ def sig2_kernel(x, nchunks):
     return out
 
 
+@njit(cache=True)
+def sig2_kernel_ser(x, nchunks):
+    """Serial twin of :func:`sig2_kernel` (same arithmetic, bitwise the same result)."""
+    nb, n, d = x.shape
+    npair = d * (d - 1) // 2
+    width = d + npair
+    part = np.zeros((nb * nchunks, width))
+    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
+    for t in range(nb * nchunks):
+        b = t // nchunks
+        c = t - b * nchunks
+        lo = min(c * seg, n - 1)
+        hi = min(lo + seg, n - 1)
+        if hi > lo:
+            _area_chunk(x, b, lo, hi, part[t])
+    out = np.empty((nb, d + d * d))
+    for b in range(nb):
+        tot = np.zeros(width)
+        for c in range(nchunks):
+            p = part[b * nchunks + c]
+            q = 0
+            for i in range(d):
+                for j in range(i + 1, d):
+                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
+                    q += 1
+            for i in range(d):
+                tot[i] += p[i]
+        for i in range(d):
+            out[b, i] = tot[i]
+        q = 0
+        for i in range(d):
+            out[b, d + i * d + i] = 0.5 * tot[i] * tot[i]
+            for j in range(i + 1, d):
+                sym = 0.5 * tot[i] * tot[j]
+                out[b, d + i * d + j] = sym + 0.5 * tot[d + q]
+                out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
+                q += 1
+    return out
+
+
 # ---------------------------------------------------------------------------------- depth >= 3
 # Internally level k is stored in *reversed* word order: word (i_1..i_k) at sum_j i_j d^(j-1), so
 # that a tensor product a_j ⊗ b_l is out[p + d^j q] = a[p] b[q] with a long, contiguous inner loop
 # over p (vectorised). The Python wrapper permutes to iisignature's order at the end.
-
-
-@njit(cache=True)
-def _sig_chunk_generic(x, b, lo, hi, d, m, offsets, s):
-    half = d ** (m - 1)
-    buf = np.empty(2 * half)
-    delta = np.empty(d)
-    scaled = np.empty(d)
-    for k in range(lo + 1, hi + 1):
-        for i in range(d):
-            delta[i] = x[b, k, i] - x[b, k - 1, i]
-        for lev in range(m, 1, -1):
-            inv = 1.0 / lev
-            for i in range(d):
-                buf[i] = delta[i] * inv
-            size = d
-            cur = 0
-            nxt = half
-            for j in range(1, lev - 1):
-                f = 1.0 / (lev - j)
-                o = offsets[j]
-                for q in range(d):
-                    scaled[q] = delta[q] * f
-                for p in range(size):
-                    t = buf[cur + p] + s[o + p]
-                    for q in range(d):
-                        buf[nxt + q * size + p] = t * scaled[q]
-                size *= d
-                cur, nxt = nxt, cur
-            o = offsets[lev - 1]
-            ok = offsets[lev]
-            for p in range(size):
-                t = buf[cur + p] + s[o + p]
-                for q in range(d):
-                    s[ok + q * size + p] += t * delta[q]
-        for i in range(d):
-            s[i] += delta[i]
-
-
-@njit(cache=True)
-def _sig_chunk_d2(x, b, lo, hi, m, offsets, s):
-    half = 2 ** (m - 1)
-    buf = np.empty(2 * half)
-    for k in range(lo + 1, hi + 1):
-        d0 = x[b, k, 0] - x[b, k - 1, 0]
-        d1 = x[b, k, 1] - x[b, k - 1, 1]
-        for lev in range(m, 1, -1):
-            inv = 1.0 / lev
-            buf[0] = d0 * inv
-            buf[1] = d1 * inv
-            size = 2
-            cur = 0
-            nxt = half
-            for j in range(1, lev - 1):
-                f = 1.0 / (lev - j)
-                o = offsets[j]
-                e0 = d0 * f
-                e1 = d1 * f
-                for p in range(size):
-                    t = buf[cur + p] + s[o + p]
-                    buf[nxt + p] = t * e0
-                    buf[nxt + size + p] = t * e1
-                size *= 2
-                cur, nxt = nxt, cur
-            o = offsets[lev - 1]
-            ok = offsets[lev]
-            for p in range(size):
-                t = buf[cur + p] + s[o + p]
-                s[ok + p] += t * d0
-                s[ok + size + p] += t * d1
-        s[0] += d0
-        s[1] += d1
-
-
-@njit(cache=True)
-def _sig_chunk_d3(x, b, lo, hi, m, offsets, s):
-    half = 3 ** (m - 1)
-    buf = np.empty(2 * half)
-    for k in range(lo + 1, hi + 1):
-        d0 = x[b, k, 0] - x[b, k - 1, 0]
-        d1 = x[b, k, 1] - x[b, k - 1, 1]
-        d2 = x[b, k, 2] - x[b, k - 1, 2]
-        for lev in range(m, 1, -1):
-            inv = 1.0 / lev
-            buf[0] = d0 * inv
-            buf[1] = d1 * inv
-            buf[2] = d2 * inv
-            size = 3
-            cur = 0
-            nxt = half
-            for j in range(1, lev - 1):
-                f = 1.0 / (lev - j)
-                o = offsets[j]
-                e0 = d0 * f
-                e1 = d1 * f
-                e2 = d2 * f
-                for p in range(size):
-                    t = buf[cur + p] + s[o + p]
-                    buf[nxt + p] = t * e0
-                    buf[nxt + size + p] = t * e1
-                    buf[nxt + 2 * size + p] = t * e2
-                size *= 3
-                cur, nxt = nxt, cur
-            o = offsets[lev - 1]
-            ok = offsets[lev]
-            for p in range(size):
-                t = buf[cur + p] + s[o + p]
-                s[ok + p] += t * d0
-                s[ok + size + p] += t * d1
-                s[ok + 2 * size + p] += t * d2
-        s[0] += d0
-        s[1] += d1
-        s[2] += d2
-
-
-@njit(cache=True)
-def _sig_chunk(x, b, lo, hi, d, m, offsets, s):
-    """``s <- `` signature of points ``lo..hi`` of path ``b`` (reversed layout), Horner-Chen form.
-
-    Per segment with increment ``D``, ``s <- s ⊗ exp(D)`` level by level from the top (so lower
-    levels are still the old ones): ``s_k += (((D/k + s_1) ⊗ D/(k-1) + s_2) ⊗ ... + s_{k-1}) ⊗ D``,
-    folded as ``B_1 = D/k``, ``B_{j+1} = (B_j + s_j) ⊗ D/(k-j)``, ``s_k += (B_{k-1} + s_{k-1}) ⊗ D``
-    (each ``B_j + s_j`` formed once and multiplied by all ``d`` letters in the same pass).
-    About ``d^m (1 + 2/(d-1))`` flops per point and no allocation inside the loop: one scratch
-    buffer holds two ping-pong halves addressed by integer offsets (swapping array references in
-    the loop would cost reference counting on every step). ``d = 2, 3`` have the letter loop
-    unrolled (about 2x faster than the generic loop).
-    """
-    for i in range(s.shape[0]):
-        s[i] = 0.0
-    if d == 2:
-        _sig_chunk_d2(x, b, lo, hi, m, offsets, s)
-    elif d == 3:
-        _sig_chunk_d3(x, b, lo, hi, m, offsets, s)
-    else:
-        _sig_chunk_generic(x, b, lo, hi, d, m, offsets, s)
 
 
 @njit(cache=True)
@@ -301,30 +205,6 @@ def mul_inplace(s, e, d, m, offsets):
                 base = ok + q * nj
                 for p in range(nj):
                     s[base + p] += s[oj + p] * eq
-
-
-@njit(cache=True, parallel=True)
-def sig_kernel(x, m, offsets, nchunks):
-    """Depth-``m`` signatures of a ``(B, n, d)`` batch, shape ``(B, sigdim)``, reversed layout."""
-    nb, n, d = x.shape
-    dim = offsets[m + 1]
-    part = np.zeros((nb * nchunks, dim))
-    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
-    for t in prange(nb * nchunks):
-        b = t // nchunks
-        c = t - b * nchunks
-        lo = min(c * seg, n - 1)
-        hi = min(lo + seg, n - 1)
-        if hi > lo:
-            _sig_chunk(x, b, lo, hi, d, m, offsets, part[t])
-    if nchunks == 1:
-        return part
-    out = np.empty((nb, dim))
-    for b in prange(nb):
-        out[b, :] = part[b * nchunks]
-        for c in range(1, nchunks):
-            mul_inplace(out[b], part[b * nchunks + c], d, m, offsets)
-    return out
 
 
 # ---------------------------------------------------------------------------------- rough paths
@@ -477,3 +357,145 @@ def lyndon_batch_par(z, lev_off, lidx, indptr, indices, data, out, out_off):
 def lyndon_batch_ser(z, lev_off, lidx, indptr, indices, data, out, out_off):
     for b in range(z.shape[0]):
         _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
+
+
+# ---------------------------------------------------------------------------------- lane kernel
+# Depth >= 3 signatures, SIMD across "lanes": LANES work units (a path, or a chunk of a long path)
+# advance together, one segment per step; every array is (entries, LANES) flattened, so each
+# innermost loop is LANES independent multiply-adds (vectorised whatever d and the level size).
+# A unit that has run out of segments gets zero increments (exp(0) = 1 leaves it bitwise intact),
+# so a unit's result depends only on its own data: the grouping and the number of threads never
+# change a bit of the result.
+LANES = 8
+
+
+@njit(cache=True)
+def _lane_group(x, ub, ulo, uhi, g, d, m, offsets, s, buf, delta, sc):
+    """Signatures (reversed layout, lanes last) of units ``g*LANES ..`` into ``s`` (sigdim*LANES)."""
+    L = LANES
+    nunits = ub.shape[0]
+    half = d ** (m - 1)
+    for r in range(s.shape[0]):
+        s[r] = 0.0
+    steps = 0
+    for l in range(L):
+        u = g * L + l
+        if u < nunits and uhi[u] - ulo[u] > steps:
+            steps = uhi[u] - ulo[u]
+    for t in range(steps):
+        for l in range(L):
+            u = g * L + l
+            if u < nunits and ulo[u] + t < uhi[u]:
+                b = ub[u]
+                k = ulo[u] + t + 1
+                for i in range(d):
+                    delta[i * L + l] = x[b, k, i] - x[b, k - 1, i]
+            else:
+                for i in range(d):
+                    delta[i * L + l] = 0.0
+        for lev in range(m, 1, -1):
+            inv = 1.0 / lev
+            for i in range(d * L):
+                buf[i] = delta[i] * inv
+            size = d
+            cur = 0
+            nxt = half * L
+            for j in range(1, lev - 1):
+                f = 1.0 / (lev - j)
+                o = offsets[j] * L
+                for r in range(size * L):
+                    buf[cur + r] += s[o + r]
+                for q in range(d):
+                    for l in range(L):
+                        sc[l] = delta[q * L + l] * f
+                    base = nxt + q * size * L
+                    for p in range(size):
+                        pl = p * L
+                        for l in range(L):
+                            buf[base + pl + l] = buf[cur + pl + l] * sc[l]
+                size *= d
+                cur, nxt = nxt, cur
+            o = offsets[lev - 1] * L
+            for r in range(size * L):
+                buf[cur + r] += s[o + r]
+            ok = offsets[lev] * L
+            for q in range(d):
+                base = ok + q * size * L
+                for p in range(size):
+                    pl = p * L
+                    for l in range(L):
+                        s[base + pl + l] += buf[cur + pl + l] * delta[q * L + l]
+        for r in range(d * L):
+            s[r] += delta[r]
+
+
+@njit(cache=True)
+def _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part):
+    L = LANES
+    dim = offsets[m + 1]
+    s = np.empty(dim * L)
+    buf = np.empty(2 * d ** (m - 1) * L)
+    delta = np.empty(d * L)
+    sc = np.empty(L)
+    _lane_group(x, ub, ulo, uhi, g, d, m, offsets, s, buf, delta, sc)
+    for l in range(L):
+        u = g * L + l
+        if u < ub.shape[0]:
+            for r in range(dim):
+                part[u, r] = s[r * L + l]
+
+
+@njit(cache=True)
+def _glue(part, nchunks, b, m, offsets, out):
+    d = offsets[2]
+    dim = offsets[m + 1]
+    for r in range(dim):
+        out[b, r] = part[b * nchunks, r]
+    for c in range(1, nchunks):
+        mul_inplace(out[b], part[b * nchunks + c], d, m, offsets)
+
+
+@njit(cache=True, parallel=True)
+def lane_parts_par(x, ub, ulo, uhi, m, offsets):
+    """Signature of every work unit (reversed layout), shape ``(units, sigdim)``."""
+    d = x.shape[2]
+    ngroups = (ub.shape[0] + LANES - 1) // LANES
+    part = np.empty((ub.shape[0], offsets[m + 1]))
+    for g in prange(ngroups):
+        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
+    return part
+
+
+@njit(cache=True)
+def lane_parts_ser(x, ub, ulo, uhi, m, offsets):
+    d = x.shape[2]
+    ngroups = (ub.shape[0] + LANES - 1) // LANES
+    part = np.empty((ub.shape[0], offsets[m + 1]))
+    for g in range(ngroups):
+        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
+    return part
+
+
+@njit(cache=True, parallel=True)
+def lane_sig_par(x, ub, ulo, uhi, nchunks, m, offsets):
+    """Depth-``m`` signatures of ``(B, n, d)`` paths (reversed layout), units glued by Chen."""
+    nb, n, d = x.shape
+    part = lane_parts_par(x, ub, ulo, uhi, m, offsets)
+    if nchunks == 1:
+        return part
+    out = np.empty((nb, offsets[m + 1]))
+    for b in prange(nb):
+        _glue(part, nchunks, b, m, offsets, out)
+    return out
+
+
+@njit(cache=True)
+def lane_sig_ser(x, ub, ulo, uhi, nchunks, m, offsets):
+    nb, n, d = x.shape
+    part = lane_parts_ser(x, ub, ulo, uhi, m, offsets)
+    if nchunks == 1:
+        return part
+    out = np.empty((nb, offsets[m + 1]))
+    for b in range(nb):
+        _glue(part, nchunks, b, m, offsets, out)
+    return out

@@ -11,12 +11,13 @@ Output layouts (see :mod:`roughpaths.tensor_algebra`):
   coordinate of ``[i,j]`` (``i < j``) is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`.
 
 Kernels are numba-compiled and cached (:mod:`roughpaths._signature_kernels`): level 2 is a fused
-one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment.
+one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment, vectorised across
+work units (paths, or chunks of a long path glued by Chen's identity). The split of the work depends
+on the input's size only, so results are bitwise identical for any number of threads.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from . import _signature_kernels as _k
@@ -25,10 +26,15 @@ from .tensor_algebra import (_log_flat, _lyndon_flat, _reversed_to_rowmajor, log
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
-# Cut a long path into parallel chunks (glued by Chen) only when the batch cannot feed the
-# threads and the path is long enough for the split to pay.
-_CHUNK_MIN_POINTS_L2 = 50_000
-_CHUNK_MIN_POINTS = 5_000
+# Work splitting depends on the input's size only (never on the thread count), so results are
+# bitwise identical for any number of threads. A path is cut into chunks (glued by Chen's identity)
+# only when the batch alone gives fewer than _TARGET_UNITS work units; a chunk has at least
+# _MIN_CHUNK segments. Inputs below _SERIAL_WORK flops-ish run on one thread (no start-up cost).
+_TARGET_UNITS = 64
+_MIN_CHUNK = 256
+_MIN_CHUNK_L2 = 8192
+_TARGET_UNITS_L2 = 16
+_SERIAL_WORK = 1 << 18
 
 
 def _offsets(dim: int, depth: int) -> np.ndarray:
@@ -38,11 +44,19 @@ def _offsets(dim: int, depth: int) -> np.ndarray:
     return off
 
 
-def _n_chunks(batch: int, n: int, min_points: int) -> int:
-    threads = numba.get_num_threads()
-    if threads <= 1 or batch >= threads or n < min_points:
+def _n_chunks(batch: int, n: int, target: int, min_chunk: int) -> int:
+    """Chunks per path: a function of the input's size only."""
+    if batch >= target or n - 1 < 2 * min_chunk:
         return 1
-    return max(1, min(threads // max(batch, 1), n // (min_points // 2)))
+    return max(1, min(-(-target // max(batch, 1)), (n - 1) // min_chunk))
+
+
+def _units(nb: int, n: int, nchunks: int) -> tuple:
+    """``(path, first point, last point)`` of every work unit, path-major."""
+    seg = -(-(n - 1) // nchunks)
+    ub = np.repeat(np.arange(nb, dtype=np.int64), nchunks)
+    lo = np.minimum(np.tile(np.arange(nchunks, dtype=np.int64), nb) * seg, n - 1)
+    return ub, lo, np.minimum(lo + seg, n - 1)
 
 
 def _check_depth(depth) -> int:
@@ -102,9 +116,14 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
         return np.zeros((nb, sigdim(d, depth)))
     if depth == 1:
         return x[:, -1, :] - x[:, 0, :]
+    dim = sigdim(d, depth)
+    serial = nb * n * dim < _SERIAL_WORK
     if depth == 2:
-        return _k.sig2_kernel(x, _n_chunks(nb, n, _CHUNK_MIN_POINTS_L2))
-    out = _k.sig_kernel(x, depth, _offsets(d, depth), _n_chunks(nb, n, _CHUNK_MIN_POINTS))
+        kern = _k.sig2_kernel_ser if serial else _k.sig2_kernel
+        return kern(x, _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2))
+    nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
+    kern = _k.lane_sig_ser if serial else _k.lane_sig_par
+    out = kern(x, *_units(nb, n, nchunks), nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
 
 
