@@ -33,7 +33,8 @@ from .norms import (
 from .rough_path import RoughPath, chen_defect
 from .solve import Solution, solve
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, expm_batched
-from .signature import logsignature, rough_path_signature, signature
+from .signature import (logsignature, logsignature_vjp, rough_path_signature, signature,
+                        signature_vjp)
 from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
 from .tensor_algebra import (
     from_level2,
@@ -97,6 +98,8 @@ __all__ = [
     "holder_distance",
     "signature",
     "logsignature",
+    "signature_vjp",
+    "logsignature_vjp",
     "rough_path_signature",
     "sigdim",
     "logsigdim",

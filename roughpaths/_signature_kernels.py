@@ -499,3 +499,298 @@ def lane_sig_ser(x, ub, ulo, uhi, nchunks, m, offsets):
     for b in range(nb):
         _glue(part, nchunks, b, m, offsets, out)
     return out
+
+
+# ---------------------------------------------------------------------------------- gradients
+# Vector-Jacobian products, reversed layout (word (i_1..i_k) at sum_j i_j d^(j-1)), so that a
+# word u w splits as index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
+# Backward through S = S_prev ⊗ exp(D) per segment (last to first):
+#   S_prev = S ⊗ exp(-D)                       (same Horner step, no storage of the forward pass)
+#   dL/dD  = VJP of D -> exp(D) applied to F = S_prev ▷ G   (left contraction)
+#   G_prev = G ◁ exp(D)                         (right contraction, Horner in the contraction)
+
+
+@njit(cache=True)
+def _horner_step(s, delta, d, m, offsets, buf):
+    """``s <- s ⊗ exp(delta)`` in place (reversed layout); ``buf`` scratch of ``2 d^(m-1)``."""
+    half = d ** (m - 1)
+    for lev in range(m, 1, -1):
+        inv = 1.0 / lev
+        for i in range(d):
+            buf[i] = delta[i] * inv
+        size = d
+        cur = 0
+        nxt = half
+        for j in range(1, lev - 1):
+            f = 1.0 / (lev - j)
+            o = offsets[j]
+            for p in range(size):
+                buf[cur + p] += s[o + p]
+            for q in range(d):
+                e = delta[q] * f
+                base = nxt + q * size
+                for p in range(size):
+                    buf[base + p] = buf[cur + p] * e
+            size *= d
+            cur, nxt = nxt, cur
+        o = offsets[lev - 1]
+        ok = offsets[lev]
+        for p in range(size):
+            buf[cur + p] += s[o + p]
+        for q in range(d):
+            e = delta[q]
+            base = ok + q * size
+            for p in range(size):
+                s[base + p] += buf[cur + p] * e
+    for i in range(d):
+        s[i] += delta[i]
+
+
+@njit(cache=True)
+def _lcon(x0, s, g, d, m, offsets, out):
+    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``."""
+    for j in range(1, m + 1):
+        oj = offsets[j]
+        nj = d ** j
+        for w in range(nj):
+            out[oj + w] = x0 * g[oj + w]
+        for i in range(1, m - j + 1):
+            ni = d ** i
+            oi = offsets[i]
+            ok = offsets[i + j]
+            for w in range(nj):
+                base = ok + ni * w
+                acc = 0.0
+                for u in range(ni):
+                    acc += s[oi + u] * g[base + u]
+                out[oj + w] += acc
+
+
+@njit(cache=True)
+def _rcon(x0, g, e, d, m, offsets, out):
+    """``out <- g ◁ (x0 + e)``: ``out_i[p] = x0 g_i[p] + sum_{j>=1} sum_q g_{i+j}[p q] e_j[q]``."""
+    for i in range(1, m + 1):
+        oi = offsets[i]
+        ni = d ** i
+        for p in range(ni):
+            out[oi + p] = x0 * g[oi + p]
+        for j in range(1, m - i + 1):
+            oj = offsets[j]
+            ok = offsets[i + j]
+            for q in range(d ** j):
+                eq = e[oj + q]
+                base = ok + ni * q
+                for p in range(ni):
+                    out[oi + p] += g[base + p] * eq
+
+
+@njit(cache=True)
+def _rcon_exp(g, delta, d, m, offsets, out, buf):
+    """``out <- g ◁ exp(delta)``: ``out_i = sum_j iota^j g_{i+j} / j!``, Horner in ``iota``.
+
+    ``iota`` contracts the last letter with ``delta``; for each ``i``: ``T = g_m``,
+    ``T <- g_k + iota(T) / (k + 1 - i)`` for ``k = m-1 .. i``. ``buf`` scratch of ``2 d^m``.
+    """
+    half = d ** m
+    for i in range(1, m + 1):
+        om = offsets[m]
+        cur = 0
+        nxt = half
+        for p in range(d ** m):
+            buf[p] = g[om + p]
+        for k in range(m - 1, i - 1, -1):
+            f = 1.0 / (k + 1 - i)
+            nk = d ** k
+            ok = offsets[k]
+            for p in range(nk):
+                buf[nxt + p] = g[ok + p]
+            for q in range(d):
+                e = delta[q] * f
+                base = cur + nk * q
+                for p in range(nk):
+                    buf[nxt + p] += buf[base + p] * e
+            cur, nxt = nxt, cur
+        oi = offsets[i]
+        for p in range(d ** i):
+            out[oi + p] = buf[cur + p]
+
+
+@njit(cache=True)
+def _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta):
+    """``gdelta <- d/d(delta) <f, exp(delta)>``; ``pw``, ``h`` scratch of sigdim."""
+    for q in range(d):
+        pw[q] = delta[q]
+    for j in range(2, m + 1):
+        o1 = offsets[j - 1]
+        oj = offsets[j]
+        n1 = d ** (j - 1)
+        inv = 1.0 / j
+        for q in range(d):
+            e = delta[q] * inv
+            for p in range(n1):
+                pw[oj + n1 * q + p] = pw[o1 + p] * e
+    for r in range(offsets[m + 1]):
+        h[r] = f[r]
+    for q in range(d):
+        gdelta[q] = 0.0
+    for j in range(m, 1, -1):
+        o1 = offsets[j - 1]
+        oj = offsets[j]
+        n1 = d ** (j - 1)
+        inv = 1.0 / j
+        for q in range(d):
+            acc = 0.0
+            e = delta[q] * inv
+            base = oj + n1 * q
+            for p in range(n1):
+                acc += h[base + p] * pw[o1 + p]
+                h[o1 + p] += h[base + p] * e
+            gdelta[q] += acc * inv
+    for q in range(d):
+        gdelta[q] += h[q]
+
+
+@njit(cache=True)
+def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
+    """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
+    dim = offsets[m + 1]
+    buf = np.empty(2 * d ** m)
+    f = np.empty(dim)
+    pw = np.empty(dim)
+    h = np.empty(dim)
+    gn = np.empty(dim)
+    delta = np.empty(d)
+    neg = np.empty(d)
+    gdelta = np.empty(d)
+    for k in range(hi, lo, -1):
+        for i in range(d):
+            delta[i] = x[b, k, i] - x[b, k - 1, i]
+            neg[i] = -delta[i]
+        _horner_step(s, neg, d, m, offsets, buf)
+        _lcon(1.0, s, g, d, m, offsets, f)
+        _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta)
+        for i in range(d):
+            gd[b, k - 1, i] = gdelta[i]
+        _rcon_exp(g, delta, d, m, offsets, gn, buf)
+        for r in range(dim):
+            g[r] = gn[r]
+
+
+@njit(cache=True)
+def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
+    """Cotangent of unit ``u``'s signature: ``P ▷ (G ◁ Q)``, P/Q the products of the units before/after."""
+    dim = offsets[m + 1]
+    b = u // nchunks
+    c = u - b * nchunks
+    q = np.zeros(dim)
+    for cc in range(c + 1, nchunks):
+        mul_inplace(q, part[b * nchunks + cc], d, m, offsets)
+    tmp = np.empty(dim)
+    _rcon(1.0, gtot[b], q, d, m, offsets, tmp)
+    pre = np.zeros(dim)
+    for cc in range(c):
+        mul_inplace(pre, part[b * nchunks + cc], d, m, offsets)
+    _lcon(1.0, pre, tmp, d, m, offsets, g)
+
+
+@njit(cache=True, parallel=True)
+def sig_vjp_par(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot):
+    """Cotangent of every segment increment, ``(B, n-1, d)``, given unit signatures and ``gtot`` (B, sigdim)."""
+    nb, n, d = x.shape
+    gd = np.zeros((nb, max(n - 1, 0), d))
+    for u in prange(ub.shape[0]):
+        g = np.empty(offsets[m + 1])
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+        s = part[u].copy()
+        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+    return gd
+
+
+@njit(cache=True)
+def sig_vjp_ser(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot):
+    nb, n, d = x.shape
+    gd = np.zeros((nb, max(n - 1, 0), d))
+    for u in range(ub.shape[0]):
+        g = np.empty(offsets[m + 1])
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+        s = part[u].copy()
+        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+    return gd
+
+
+@njit(cache=True)
+def _mul_rev(x0, xs, a, d, m, offsets, out):
+    """``out <- (x0 + xs) ⊗ a`` (``a`` with no scalar), reversed layout, levels 1..m."""
+    for k in range(1, m + 1):
+        ok = offsets[k]
+        for r in range(d ** k):
+            out[ok + r] = x0 * a[ok + r]
+        for i in range(1, k):
+            oi = offsets[i]
+            oj = offsets[k - i]
+            ni = d ** i
+            for q in range(d ** (k - i)):
+                aq = a[oj + q]
+                base = ok + ni * q
+                for p in range(ni):
+                    out[base + p] += xs[oi + p] * aq
+
+
+@njit(cache=True)
+def _log_vjp_one(a, g, d, m, offsets, ga):
+    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion."""
+    dim = offsets[m + 1]
+    r = np.zeros((m + 2, dim))
+    for u in range(dim):
+        r[m, u] = a[u] * ((-1.0) ** (m + 1) / m)
+    for n in range(m - 1, 0, -1):
+        c = (-1.0) ** (n + 1) / n
+        _mul_rev(c, r[n + 1], a, d, m, offsets, r[n])
+    gc = g.copy()
+    tmp = np.empty(dim)
+    for u in range(dim):
+        ga[u] = 0.0
+    for n in range(1, m):
+        c = (-1.0) ** (n + 1) / n
+        _lcon(c, r[n + 1], gc, d, m, offsets, tmp)
+        for u in range(dim):
+            ga[u] += tmp[u]
+        _rcon(0.0, gc, a, d, m, offsets, tmp)
+        for u in range(dim):
+            gc[u] = tmp[u]
+    cm = (-1.0) ** (m + 1) / m
+    for u in range(dim):
+        ga[u] += cm * gc[u]
+
+
+@njit(cache=True, parallel=True)
+def log_vjp_par(a, g, d, m, offsets):
+    """Row-wise :func:`_log_vjp_one` over a batch ``(B, sigdim)``."""
+    out = np.empty_like(a)
+    for b in prange(a.shape[0]):
+        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+    return out
+
+
+@njit(cache=True)
+def log_vjp_ser(a, g, d, m, offsets):
+    out = np.empty_like(a)
+    for b in range(a.shape[0]):
+        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+    return out
+
+
+@njit(cache=True)
+def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
+    """Transpose of one level of the Lyndon projection: ``gz[lidx] = M^{-T} gc`` (back substitution)."""
+    n = lidx.shape[0]
+    y = np.empty(n)
+    for b in range(gc.shape[0]):
+        for i in range(n):
+            y[i] = gc[b, out_off + i]
+        for r in range(n - 1, -1, -1):
+            yr = y[r]
+            for t in range(indptr[r], indptr[r + 1]):
+                y[indices[t]] -= data[t] * yr
+        for i in range(n):
+            gz[b, lev_off + lidx[i]] = y[i]

@@ -104,6 +104,18 @@ def _log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
     return kern(a, dim, depth, _offsets(dim, depth))
 
 
+def _lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Cotangent ``(B, sigdim)`` (row-major) of the Lie element, given that of its Lyndon coordinates."""
+    off = _offsets(dim, depth)
+    gz = np.zeros((gc.shape[0], int(off[depth + 1])))
+    start = 0
+    for k in range(1, depth + 1):
+        lidx, indptr, indices, data = lyndon_projection(dim, k)
+        _k.lyndon_vjp(gc, start, lidx, indptr, indices, data, gz, off[k])
+        start += lidx.shape[0]
+    return gz
+
+
 def _lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Lyndon coordinates of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
     off = _offsets(dim, depth)
