@@ -250,26 +250,29 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     Returns
     -------
     ndarray, shape ``(..., n, d)``
-        :math:`\partial \langle G, S(x) angle / \partial x`, the same quantity as
+        :math:`\partial \langle G, S(x) 
+angle / \partial x`, the same quantity as
         ``iisignature.sigbackprop(G, paths, m)``.
 
     Notes
     -----
     Backward through Chen's identity segment by segment, last to first: the signature before a
     segment is recovered as :math:`S \otimes \exp(-\Delta)` (nothing of the forward pass is
-    stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} hd G,
-    \exp(\Delta)angle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
+    stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} 
+hd G,
+    \exp(\Delta)
+angle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
     signatures per path. Long paths are cut into the same chunks as :func:`signature`.
 
     Examples
     --------
     >>> import numpy as np
     >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
-    >>> g = np.zeros(6); g[3] = 1.0                  # d/dx of the area word (1, 2) = ∫ X^1 dX^2
+    >>> g = np.zeros(6); g[3] = 1.0                  # gradient of the word (1, 2): ∫ X^1 dX^2
     >>> signature_vjp(x, 2, g)
-    array([[-1. , -1. ],
-           [ 0. ,  0. ],
-           [ 1. ,  0. ]])
+    array([[-1. , -0.5],
+           [ 0.5, -0.5],
+           [ 0.5,  1. ]])
     """
     depth = _check_depth(depth)
     x = _check_paths(paths)
@@ -293,7 +296,8 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     Returns
     -------
     ndarray, shape ``(..., n, d)``
-        :math:`\partial \langle G, \mathrm{logsig}(x) angle / \partial x`, the same quantity as
+        :math:`\partial \langle G, \mathrm{logsig}(x) 
+angle / \partial x`, the same quantity as
         ``iisignature.logsigbackprop(G, paths, prepare(d, m))``.
 
     Notes
