@@ -258,10 +258,8 @@ angle / \partial x`, the same quantity as
     -----
     Backward through Chen's identity segment by segment, last to first: the signature before a
     segment is recovered as :math:`S \otimes \exp(-\Delta)` (nothing of the forward pass is
-    stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} 
-hd G,
-    \exp(\Delta)
-angle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
+    stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} \rhd G,
+    \exp(\Delta)\rangle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
     signatures per path. Long paths are cut into the same chunks as :func:`signature`.
 
     Examples
