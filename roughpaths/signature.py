@@ -120,9 +120,11 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     dim = sigdim(d, depth)
     serial = nb * n * dim < _SERIAL_WORK
     if depth == 2:
+        serial = serial or nb * _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2) < 2
         kern = _k.sig2_kernel_ser if serial else _k.sig2_kernel
         return kern(x, _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2))
     nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
+    serial = serial or nb * nchunks <= _k.LANES            # one lane group: nothing to share
     kern = _k.lane_sig_ser if serial else _k.lane_sig_par
     out = kern(x, *_units(nb, n, nchunks), nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
@@ -228,7 +230,7 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     g_rev[:, perm] = g_row
     nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
     units = _units(nb, n, nchunks)
-    serial = nb * n * sigdim(d, depth) < _SERIAL_WORK
+    serial = nb * n * sigdim(d, depth) < _SERIAL_WORK or nb * nchunks < 2
     part = (_k.lane_parts_ser if serial else _k.lane_parts_par)(x, *units, depth, off)
     gd = (_k.sig_vjp_ser if serial else _k.sig_vjp_par)(x, *units, nchunks, depth, off, part, g_rev)
     return _increments_to_points(gd, n)
@@ -331,7 +333,7 @@ angle / \partial x`, the same quantity as
     sig_rev[:, perm] = sig
     g_log_rev = np.empty_like(g_log_row)
     g_log_rev[:, perm] = g_log_row
-    serial = sig.size < _SERIAL_WORK
+    serial = sig.size < _SERIAL_WORK or sig.shape[0] < 2
     g_sig_rev = (_k.log_vjp_ser if serial else _k.log_vjp_par)(sig_rev, g_log_rev, d, depth, off)
     return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
 

@@ -100,7 +100,7 @@ _SERIAL_ENTRIES = 1 << 15
 
 def _log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
-    kern = _k.log_batch_ser if a.size < _SERIAL_ENTRIES else _k.log_batch_par
+    kern = _k.log_batch_ser if a.size < _SERIAL_ENTRIES or a.shape[0] < 2 else _k.log_batch_par
     return kern(a, dim, depth, _offsets(dim, depth))
 
 
@@ -120,7 +120,7 @@ def _lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Lyndon coordinates of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
     off = _offsets(dim, depth)
     out = np.empty((z.shape[0], logsigdim(dim, depth)))
-    kern = _k.lyndon_batch_ser if z.size < _SERIAL_ENTRIES else _k.lyndon_batch_par
+    kern = _k.lyndon_batch_ser if z.size < _SERIAL_ENTRIES or z.shape[0] < 2 else _k.lyndon_batch_par
     start = 0
     for k in range(1, depth + 1):
         lidx, indptr, indices, data = lyndon_projection(dim, k)
