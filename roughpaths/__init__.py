@@ -38,7 +38,8 @@ from .driver import Driver
 from .solve import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
-from .signature import logsignature, rough_path_signature, signature
+from .signature import (logsignature, logsignature_vjp, rough_path_signature, signature,
+                        signature_vjp)
 from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
 from .tensor_algebra import (
     from_level2,
@@ -115,6 +116,8 @@ __all__ = [
     "holder_distance",
     "signature",
     "logsignature",
+    "signature_vjp",
+    "logsignature_vjp",
     "rough_path_signature",
     "sigdim",
     "logsigdim",

@@ -142,146 +142,50 @@ def sig2_kernel(x, nchunks):
     return out
 
 
+@njit(cache=True)
+def sig2_kernel_ser(x, nchunks):
+    """Serial twin of :func:`sig2_kernel` (same arithmetic, bitwise the same result)."""
+    nb, n, d = x.shape
+    npair = d * (d - 1) // 2
+    width = d + npair
+    part = np.zeros((nb * nchunks, width))
+    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
+    for t in range(nb * nchunks):
+        b = t // nchunks
+        c = t - b * nchunks
+        lo = min(c * seg, n - 1)
+        hi = min(lo + seg, n - 1)
+        if hi > lo:
+            _area_chunk(x, b, lo, hi, part[t])
+    out = np.empty((nb, d + d * d))
+    for b in range(nb):
+        tot = np.zeros(width)
+        for c in range(nchunks):
+            p = part[b * nchunks + c]
+            q = 0
+            for i in range(d):
+                for j in range(i + 1, d):
+                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
+                    q += 1
+            for i in range(d):
+                tot[i] += p[i]
+        for i in range(d):
+            out[b, i] = tot[i]
+        q = 0
+        for i in range(d):
+            out[b, d + i * d + i] = 0.5 * tot[i] * tot[i]
+            for j in range(i + 1, d):
+                sym = 0.5 * tot[i] * tot[j]
+                out[b, d + i * d + j] = sym + 0.5 * tot[d + q]
+                out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
+                q += 1
+    return out
+
+
 # ---------------------------------------------------------------------------------- depth >= 3
 # Internally level k is stored in *reversed* word order: word (i_1..i_k) at sum_j i_j d^(j-1), so
 # that a tensor product a_j ⊗ b_l is out[p + d^j q] = a[p] b[q] with a long, contiguous inner loop
 # over p (vectorised). The Python wrapper permutes to iisignature's order at the end.
-
-
-@njit(cache=True)
-def _sig_chunk_generic(x, b, lo, hi, d, m, offsets, s):
-    half = d ** (m - 1)
-    buf = np.empty(2 * half)
-    delta = np.empty(d)
-    scaled = np.empty(d)
-    for k in range(lo + 1, hi + 1):
-        for i in range(d):
-            delta[i] = x[b, k, i] - x[b, k - 1, i]
-        for lev in range(m, 1, -1):
-            inv = 1.0 / lev
-            for i in range(d):
-                buf[i] = delta[i] * inv
-            size = d
-            cur = 0
-            nxt = half
-            for j in range(1, lev - 1):
-                f = 1.0 / (lev - j)
-                o = offsets[j]
-                for q in range(d):
-                    scaled[q] = delta[q] * f
-                for p in range(size):
-                    t = buf[cur + p] + s[o + p]
-                    for q in range(d):
-                        buf[nxt + q * size + p] = t * scaled[q]
-                size *= d
-                cur, nxt = nxt, cur
-            o = offsets[lev - 1]
-            ok = offsets[lev]
-            for p in range(size):
-                t = buf[cur + p] + s[o + p]
-                for q in range(d):
-                    s[ok + q * size + p] += t * delta[q]
-        for i in range(d):
-            s[i] += delta[i]
-
-
-@njit(cache=True)
-def _sig_chunk_d2(x, b, lo, hi, m, offsets, s):
-    half = 2 ** (m - 1)
-    buf = np.empty(2 * half)
-    for k in range(lo + 1, hi + 1):
-        d0 = x[b, k, 0] - x[b, k - 1, 0]
-        d1 = x[b, k, 1] - x[b, k - 1, 1]
-        for lev in range(m, 1, -1):
-            inv = 1.0 / lev
-            buf[0] = d0 * inv
-            buf[1] = d1 * inv
-            size = 2
-            cur = 0
-            nxt = half
-            for j in range(1, lev - 1):
-                f = 1.0 / (lev - j)
-                o = offsets[j]
-                e0 = d0 * f
-                e1 = d1 * f
-                for p in range(size):
-                    t = buf[cur + p] + s[o + p]
-                    buf[nxt + p] = t * e0
-                    buf[nxt + size + p] = t * e1
-                size *= 2
-                cur, nxt = nxt, cur
-            o = offsets[lev - 1]
-            ok = offsets[lev]
-            for p in range(size):
-                t = buf[cur + p] + s[o + p]
-                s[ok + p] += t * d0
-                s[ok + size + p] += t * d1
-        s[0] += d0
-        s[1] += d1
-
-
-@njit(cache=True)
-def _sig_chunk_d3(x, b, lo, hi, m, offsets, s):
-    half = 3 ** (m - 1)
-    buf = np.empty(2 * half)
-    for k in range(lo + 1, hi + 1):
-        d0 = x[b, k, 0] - x[b, k - 1, 0]
-        d1 = x[b, k, 1] - x[b, k - 1, 1]
-        d2 = x[b, k, 2] - x[b, k - 1, 2]
-        for lev in range(m, 1, -1):
-            inv = 1.0 / lev
-            buf[0] = d0 * inv
-            buf[1] = d1 * inv
-            buf[2] = d2 * inv
-            size = 3
-            cur = 0
-            nxt = half
-            for j in range(1, lev - 1):
-                f = 1.0 / (lev - j)
-                o = offsets[j]
-                e0 = d0 * f
-                e1 = d1 * f
-                e2 = d2 * f
-                for p in range(size):
-                    t = buf[cur + p] + s[o + p]
-                    buf[nxt + p] = t * e0
-                    buf[nxt + size + p] = t * e1
-                    buf[nxt + 2 * size + p] = t * e2
-                size *= 3
-                cur, nxt = nxt, cur
-            o = offsets[lev - 1]
-            ok = offsets[lev]
-            for p in range(size):
-                t = buf[cur + p] + s[o + p]
-                s[ok + p] += t * d0
-                s[ok + size + p] += t * d1
-                s[ok + 2 * size + p] += t * d2
-        s[0] += d0
-        s[1] += d1
-        s[2] += d2
-
-
-@njit(cache=True)
-def _sig_chunk(x, b, lo, hi, d, m, offsets, s):
-    """``s <- `` signature of points ``lo..hi`` of path ``b`` (reversed layout), Horner-Chen form.
-
-    Per segment with increment ``D``, ``s <- s ⊗ exp(D)`` level by level from the top (so lower
-    levels are still the old ones): ``s_k += (((D/k + s_1) ⊗ D/(k-1) + s_2) ⊗ ... + s_{k-1}) ⊗ D``,
-    folded as ``B_1 = D/k``, ``B_{j+1} = (B_j + s_j) ⊗ D/(k-j)``, ``s_k += (B_{k-1} + s_{k-1}) ⊗ D``
-    (each ``B_j + s_j`` formed once and multiplied by all ``d`` letters in the same pass).
-    About ``d^m (1 + 2/(d-1))`` flops per point and no allocation inside the loop: one scratch
-    buffer holds two ping-pong halves addressed by integer offsets (swapping array references in
-    the loop would cost reference counting on every step). ``d = 2, 3`` have the letter loop
-    unrolled (about 2x faster than the generic loop).
-    """
-    for i in range(s.shape[0]):
-        s[i] = 0.0
-    if d == 2:
-        _sig_chunk_d2(x, b, lo, hi, m, offsets, s)
-    elif d == 3:
-        _sig_chunk_d3(x, b, lo, hi, m, offsets, s)
-    else:
-        _sig_chunk_generic(x, b, lo, hi, d, m, offsets, s)
 
 
 @njit(cache=True)
@@ -301,30 +205,6 @@ def mul_inplace(s, e, d, m, offsets):
                 base = ok + q * nj
                 for p in range(nj):
                     s[base + p] += s[oj + p] * eq
-
-
-@njit(cache=True, parallel=True)
-def sig_kernel(x, m, offsets, nchunks):
-    """Depth-``m`` signatures of a ``(B, n, d)`` batch, shape ``(B, sigdim)``, reversed layout."""
-    nb, n, d = x.shape
-    dim = offsets[m + 1]
-    part = np.zeros((nb * nchunks, dim))
-    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
-    for t in prange(nb * nchunks):
-        b = t // nchunks
-        c = t - b * nchunks
-        lo = min(c * seg, n - 1)
-        hi = min(lo + seg, n - 1)
-        if hi > lo:
-            _sig_chunk(x, b, lo, hi, d, m, offsets, part[t])
-    if nchunks == 1:
-        return part
-    out = np.empty((nb, dim))
-    for b in prange(nb):
-        out[b, :] = part[b * nchunks]
-        for c in range(1, nchunks):
-            mul_inplace(out[b], part[b * nchunks + c], d, m, offsets)
-    return out
 
 
 # ---------------------------------------------------------------------------------- rough paths
@@ -398,3 +278,519 @@ def stream_sum(x):
     for i in prange(n):
         total += x[i]
     return total
+
+
+# ---------------------------------------------------------------------------------- log, Lyndon
+# Row-major layout (iisignature's): (a_i ⊗ b_j)[p * d^j + q] = a_i[p] b_j[q].
+
+
+@njit(cache=True)
+def _log_one(a, d, m, offsets, r, t):
+    """``r <- log(1 + a)`` (row-major, truncated at ``m``) by Horner, ``t`` scratch of the same size.
+
+    ``log(1+a) = a (c_1 + a (c_2 + ... a (c_{m-1} + c_m a)))``, ``c_n = (-1)^(n+1)/n``, written
+    with ``a`` on the right: ``r_m = c_m a``, ``r_n = (c_n + r_{n+1}) ⊗ a``. ``r_n`` is multiplied
+    by ``a`` ``n - 1`` more times, so only its levels ``<= m - n + 1`` are formed.
+    """
+    for u in range(offsets[2]):
+        r[u] = a[u] * ((-1.0) ** (m + 1) / m)
+    for n in range(m - 1, 0, -1):
+        c = (-1.0) ** (n + 1) / n
+        kmax = m - n + 1
+        for k in range(1, kmax + 1):
+            ok = offsets[k]
+            for u in range(d ** k):
+                t[ok + u] = c * a[ok + u]
+            for i in range(1, k):
+                oi = offsets[i]
+                oj = offsets[k - i]
+                nj = d ** (k - i)
+                for p in range(d ** i):
+                    rp = r[oi + p]
+                    base = ok + p * nj
+                    for q in range(nj):
+                        t[base + q] += rp * a[oj + q]
+        for u in range(offsets[kmax + 1]):
+            r[u] = t[u]
+
+
+@njit(cache=True)
+def _lyndon_one(z, lev_off, lidx, indptr, indices, data, out, out_off):
+    for i in range(lidx.shape[0]):
+        v = z[lev_off + lidx[i]]
+        for t in range(indptr[i], indptr[i + 1]):
+            v -= data[t] * out[out_off + indices[t]]
+        out[out_off + i] = v
+
+
+# Each batch kernel exists twice, parallel and serial, with the same per-element code: small
+# inputs take the serial one (no thread start-up); results are bitwise the same either way.
+@njit(cache=True, parallel=True)
+def log_batch_par(a, d, m, offsets):
+    """Row-major ``log(1 + a)`` of each row of ``a`` (B, sigdim)."""
+    nb, dim = a.shape
+    out = np.empty((nb, dim))
+    for b in prange(nb):
+        t = np.empty(dim)
+        _log_one(a[b], d, m, offsets, out[b], t)
+    return out
+
+
+@njit(cache=True)
+def log_batch_ser(a, d, m, offsets):
+    nb, dim = a.shape
+    out = np.empty((nb, dim))
+    t = np.empty(dim)
+    for b in range(nb):
+        _log_one(a[b], d, m, offsets, out[b], t)
+    return out
+
+
+@njit(cache=True, parallel=True)
+def lyndon_batch_par(z, lev_off, lidx, indptr, indices, data, out, out_off):
+    """Lyndon coordinates of one level (forward substitution with the sparse ``M``), per row."""
+    for b in prange(z.shape[0]):
+        _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
+
+
+@njit(cache=True)
+def lyndon_batch_ser(z, lev_off, lidx, indptr, indices, data, out, out_off):
+    for b in range(z.shape[0]):
+        _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
+
+
+# ---------------------------------------------------------------------------------- lane kernel
+# Depth >= 3 signatures, SIMD across "lanes": LANES work units (a path, or a chunk of a long path)
+# advance together, one segment per step; every array is (entries, LANES) flattened, so each
+# innermost loop is LANES independent multiply-adds (vectorised whatever d and the level size).
+# A unit that has run out of segments gets zero increments (exp(0) = 1 leaves it bitwise intact),
+# so a unit's result depends only on its own data: the grouping and the number of threads never
+# change a bit of the result.
+LANES = 8
+
+
+@njit(cache=True)
+def _lane_group(x, ub, ulo, uhi, g, d, m, offsets, s, buf, delta, sc):
+    """Signatures (reversed layout, lanes last) of units ``g*LANES ..`` into ``s`` (sigdim*LANES)."""
+    L = LANES
+    nunits = ub.shape[0]
+    half = d ** (m - 1)
+    for r in range(s.shape[0]):
+        s[r] = 0.0
+    steps = 0
+    for l in range(L):
+        u = g * L + l
+        if u < nunits and uhi[u] - ulo[u] > steps:
+            steps = uhi[u] - ulo[u]
+    for t in range(steps):
+        for l in range(L):
+            u = g * L + l
+            if u < nunits and ulo[u] + t < uhi[u]:
+                b = ub[u]
+                k = ulo[u] + t + 1
+                for i in range(d):
+                    delta[i * L + l] = x[b, k, i] - x[b, k - 1, i]
+            else:
+                for i in range(d):
+                    delta[i * L + l] = 0.0
+        for lev in range(m, 1, -1):
+            inv = 1.0 / lev
+            for i in range(d * L):
+                buf[i] = delta[i] * inv
+            size = d
+            cur = 0
+            nxt = half * L
+            for j in range(1, lev - 1):
+                f = 1.0 / (lev - j)
+                o = offsets[j] * L
+                for r in range(size * L):
+                    buf[cur + r] += s[o + r]
+                for q in range(d):
+                    for l in range(L):
+                        sc[l] = delta[q * L + l] * f
+                    base = nxt + q * size * L
+                    for p in range(size):
+                        pl = p * L
+                        for l in range(L):
+                            buf[base + pl + l] = buf[cur + pl + l] * sc[l]
+                size *= d
+                cur, nxt = nxt, cur
+            o = offsets[lev - 1] * L
+            for r in range(size * L):
+                buf[cur + r] += s[o + r]
+            ok = offsets[lev] * L
+            for q in range(d):
+                base = ok + q * size * L
+                for p in range(size):
+                    pl = p * L
+                    for l in range(L):
+                        s[base + pl + l] += buf[cur + pl + l] * delta[q * L + l]
+        for r in range(d * L):
+            s[r] += delta[r]
+
+
+@njit(cache=True)
+def _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part):
+    L = LANES
+    dim = offsets[m + 1]
+    s = np.empty(dim * L)
+    buf = np.empty(2 * d ** (m - 1) * L)
+    delta = np.empty(d * L)
+    sc = np.empty(L)
+    _lane_group(x, ub, ulo, uhi, g, d, m, offsets, s, buf, delta, sc)
+    for l in range(L):
+        u = g * L + l
+        if u < ub.shape[0]:
+            for r in range(dim):
+                part[u, r] = s[r * L + l]
+
+
+@njit(cache=True)
+def _glue(part, nchunks, b, m, offsets, out):
+    d = offsets[2]
+    dim = offsets[m + 1]
+    for r in range(dim):
+        out[b, r] = part[b * nchunks, r]
+    for c in range(1, nchunks):
+        mul_inplace(out[b], part[b * nchunks + c], d, m, offsets)
+
+
+@njit(cache=True, parallel=True)
+def lane_parts_par(x, ub, ulo, uhi, m, offsets):
+    """Signature of every work unit (reversed layout), shape ``(units, sigdim)``."""
+    d = x.shape[2]
+    ngroups = (ub.shape[0] + LANES - 1) // LANES
+    part = np.empty((ub.shape[0], offsets[m + 1]))
+    for g in prange(ngroups):
+        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
+    return part
+
+
+@njit(cache=True)
+def lane_parts_ser(x, ub, ulo, uhi, m, offsets):
+    d = x.shape[2]
+    ngroups = (ub.shape[0] + LANES - 1) // LANES
+    part = np.empty((ub.shape[0], offsets[m + 1]))
+    for g in range(ngroups):
+        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
+    return part
+
+
+@njit(cache=True, parallel=True)
+def lane_sig_par(x, ub, ulo, uhi, nchunks, m, offsets):
+    """Depth-``m`` signatures of ``(B, n, d)`` paths (reversed layout), units glued by Chen."""
+    nb, n, d = x.shape
+    part = lane_parts_par(x, ub, ulo, uhi, m, offsets)
+    if nchunks == 1:
+        return part
+    out = np.empty((nb, offsets[m + 1]))
+    for b in prange(nb):
+        _glue(part, nchunks, b, m, offsets, out)
+    return out
+
+
+@njit(cache=True)
+def lane_sig_ser(x, ub, ulo, uhi, nchunks, m, offsets):
+    nb, n, d = x.shape
+    part = lane_parts_ser(x, ub, ulo, uhi, m, offsets)
+    if nchunks == 1:
+        return part
+    out = np.empty((nb, offsets[m + 1]))
+    for b in range(nb):
+        _glue(part, nchunks, b, m, offsets, out)
+    return out
+
+
+# ---------------------------------------------------------------------------------- gradients
+# Vector-Jacobian products, reversed layout (word (i_1..i_k) at sum_j i_j d^(j-1)), so that a
+# word u w splits as index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
+# Backward through S = S_prev ⊗ exp(D) per segment (last to first):
+#   S_prev = S ⊗ exp(-D)                       (same Horner step, no storage of the forward pass)
+#   dL/dD  = VJP of D -> exp(D) applied to F = S_prev ▷ G   (left contraction)
+#   G_prev = G ◁ exp(D)                         (right contraction, Horner in the contraction)
+
+
+@njit(cache=True)
+def _horner_step(s, delta, d, m, offsets, buf):
+    """``s <- s ⊗ exp(delta)`` in place (reversed layout); ``buf`` scratch of ``2 d^(m-1)``."""
+    half = d ** (m - 1)
+    for lev in range(m, 1, -1):
+        inv = 1.0 / lev
+        for i in range(d):
+            buf[i] = delta[i] * inv
+        size = d
+        cur = 0
+        nxt = half
+        for j in range(1, lev - 1):
+            f = 1.0 / (lev - j)
+            o = offsets[j]
+            for p in range(size):
+                buf[cur + p] += s[o + p]
+            for q in range(d):
+                e = delta[q] * f
+                base = nxt + q * size
+                for p in range(size):
+                    buf[base + p] = buf[cur + p] * e
+            size *= d
+            cur, nxt = nxt, cur
+        o = offsets[lev - 1]
+        ok = offsets[lev]
+        for p in range(size):
+            buf[cur + p] += s[o + p]
+        for q in range(d):
+            e = delta[q]
+            base = ok + q * size
+            for p in range(size):
+                s[base + p] += buf[cur + p] * e
+    for i in range(d):
+        s[i] += delta[i]
+
+
+@njit(cache=True)
+def _lcon(x0, s, g, d, m, offsets, out):
+    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``."""
+    for j in range(1, m + 1):
+        oj = offsets[j]
+        nj = d ** j
+        for w in range(nj):
+            out[oj + w] = x0 * g[oj + w]
+        for i in range(1, m - j + 1):
+            ni = d ** i
+            oi = offsets[i]
+            ok = offsets[i + j]
+            for w in range(nj):
+                base = ok + ni * w
+                acc = 0.0
+                for u in range(ni):
+                    acc += s[oi + u] * g[base + u]
+                out[oj + w] += acc
+
+
+@njit(cache=True)
+def _rcon(x0, g, e, d, m, offsets, out):
+    """``out <- g ◁ (x0 + e)``: ``out_i[p] = x0 g_i[p] + sum_{j>=1} sum_q g_{i+j}[p q] e_j[q]``."""
+    for i in range(1, m + 1):
+        oi = offsets[i]
+        ni = d ** i
+        for p in range(ni):
+            out[oi + p] = x0 * g[oi + p]
+        for j in range(1, m - i + 1):
+            oj = offsets[j]
+            ok = offsets[i + j]
+            for q in range(d ** j):
+                eq = e[oj + q]
+                base = ok + ni * q
+                for p in range(ni):
+                    out[oi + p] += g[base + p] * eq
+
+
+@njit(cache=True)
+def _rcon_exp(g, delta, d, m, offsets, out, buf):
+    """``out <- g ◁ exp(delta)``: ``out_i = sum_j iota^j g_{i+j} / j!``, Horner in ``iota``.
+
+    ``iota`` contracts the last letter with ``delta``; for each ``i``: ``T = g_m``,
+    ``T <- g_k + iota(T) / (k + 1 - i)`` for ``k = m-1 .. i``. ``buf`` scratch of ``2 d^m``.
+    """
+    half = d ** m
+    for i in range(1, m + 1):
+        om = offsets[m]
+        cur = 0
+        nxt = half
+        for p in range(d ** m):
+            buf[p] = g[om + p]
+        for k in range(m - 1, i - 1, -1):
+            f = 1.0 / (k + 1 - i)
+            nk = d ** k
+            ok = offsets[k]
+            for p in range(nk):
+                buf[nxt + p] = g[ok + p]
+            for q in range(d):
+                e = delta[q] * f
+                base = cur + nk * q
+                for p in range(nk):
+                    buf[nxt + p] += buf[base + p] * e
+            cur, nxt = nxt, cur
+        oi = offsets[i]
+        for p in range(d ** i):
+            out[oi + p] = buf[cur + p]
+
+
+@njit(cache=True)
+def _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta):
+    """``gdelta <- d/d(delta) <f, exp(delta)>``; ``pw``, ``h`` scratch of sigdim."""
+    for q in range(d):
+        pw[q] = delta[q]
+    for j in range(2, m + 1):
+        o1 = offsets[j - 1]
+        oj = offsets[j]
+        n1 = d ** (j - 1)
+        inv = 1.0 / j
+        for q in range(d):
+            e = delta[q] * inv
+            for p in range(n1):
+                pw[oj + n1 * q + p] = pw[o1 + p] * e
+    for r in range(offsets[m + 1]):
+        h[r] = f[r]
+    for q in range(d):
+        gdelta[q] = 0.0
+    for j in range(m, 1, -1):
+        o1 = offsets[j - 1]
+        oj = offsets[j]
+        n1 = d ** (j - 1)
+        inv = 1.0 / j
+        for q in range(d):
+            acc = 0.0
+            e = delta[q] * inv
+            base = oj + n1 * q
+            for p in range(n1):
+                acc += h[base + p] * pw[o1 + p]
+                h[o1 + p] += h[base + p] * e
+            gdelta[q] += acc * inv
+    for q in range(d):
+        gdelta[q] += h[q]
+
+
+@njit(cache=True)
+def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
+    """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
+    dim = offsets[m + 1]
+    buf = np.empty(2 * d ** m)
+    f = np.empty(dim)
+    pw = np.empty(dim)
+    h = np.empty(dim)
+    gn = np.empty(dim)
+    delta = np.empty(d)
+    neg = np.empty(d)
+    gdelta = np.empty(d)
+    for k in range(hi, lo, -1):
+        for i in range(d):
+            delta[i] = x[b, k, i] - x[b, k - 1, i]
+            neg[i] = -delta[i]
+        _horner_step(s, neg, d, m, offsets, buf)
+        _lcon(1.0, s, g, d, m, offsets, f)
+        _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta)
+        for i in range(d):
+            gd[b, k - 1, i] = gdelta[i]
+        _rcon_exp(g, delta, d, m, offsets, gn, buf)
+        for r in range(dim):
+            g[r] = gn[r]
+
+
+@njit(cache=True)
+def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
+    """Cotangent of unit ``u``'s signature: ``P ▷ (G ◁ Q)``, P/Q the products of the units before/after."""
+    dim = offsets[m + 1]
+    b = u // nchunks
+    c = u - b * nchunks
+    q = np.zeros(dim)
+    for cc in range(c + 1, nchunks):
+        mul_inplace(q, part[b * nchunks + cc], d, m, offsets)
+    tmp = np.empty(dim)
+    _rcon(1.0, gtot[b], q, d, m, offsets, tmp)
+    pre = np.zeros(dim)
+    for cc in range(c):
+        mul_inplace(pre, part[b * nchunks + cc], d, m, offsets)
+    _lcon(1.0, pre, tmp, d, m, offsets, g)
+
+
+@njit(cache=True, parallel=True)
+def sig_vjp_par(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot):
+    """Cotangent of every segment increment, ``(B, n-1, d)``, given unit signatures and ``gtot`` (B, sigdim)."""
+    nb, n, d = x.shape
+    gd = np.zeros((nb, max(n - 1, 0), d))
+    for u in prange(ub.shape[0]):
+        g = np.empty(offsets[m + 1])
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+        s = part[u].copy()
+        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+    return gd
+
+
+@njit(cache=True)
+def sig_vjp_ser(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot):
+    nb, n, d = x.shape
+    gd = np.zeros((nb, max(n - 1, 0), d))
+    for u in range(ub.shape[0]):
+        g = np.empty(offsets[m + 1])
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+        s = part[u].copy()
+        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+    return gd
+
+
+@njit(cache=True)
+def _mul_rev(x0, xs, a, d, m, offsets, out):
+    """``out <- (x0 + xs) ⊗ a`` (``a`` with no scalar), reversed layout, levels 1..m."""
+    for k in range(1, m + 1):
+        ok = offsets[k]
+        for r in range(d ** k):
+            out[ok + r] = x0 * a[ok + r]
+        for i in range(1, k):
+            oi = offsets[i]
+            oj = offsets[k - i]
+            ni = d ** i
+            for q in range(d ** (k - i)):
+                aq = a[oj + q]
+                base = ok + ni * q
+                for p in range(ni):
+                    out[base + p] += xs[oi + p] * aq
+
+
+@njit(cache=True)
+def _log_vjp_one(a, g, d, m, offsets, ga):
+    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion."""
+    dim = offsets[m + 1]
+    r = np.zeros((m + 2, dim))
+    for u in range(dim):
+        r[m, u] = a[u] * ((-1.0) ** (m + 1) / m)
+    for n in range(m - 1, 0, -1):
+        c = (-1.0) ** (n + 1) / n
+        _mul_rev(c, r[n + 1], a, d, m, offsets, r[n])
+    gc = g.copy()
+    tmp = np.empty(dim)
+    for u in range(dim):
+        ga[u] = 0.0
+    for n in range(1, m):
+        c = (-1.0) ** (n + 1) / n
+        _lcon(c, r[n + 1], gc, d, m, offsets, tmp)
+        for u in range(dim):
+            ga[u] += tmp[u]
+        _rcon(0.0, gc, a, d, m, offsets, tmp)
+        for u in range(dim):
+            gc[u] = tmp[u]
+    cm = (-1.0) ** (m + 1) / m
+    for u in range(dim):
+        ga[u] += cm * gc[u]
+
+
+@njit(cache=True, parallel=True)
+def log_vjp_par(a, g, d, m, offsets):
+    """Row-wise :func:`_log_vjp_one` over a batch ``(B, sigdim)``."""
+    out = np.empty_like(a)
+    for b in prange(a.shape[0]):
+        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+    return out
+
+
+@njit(cache=True)
+def log_vjp_ser(a, g, d, m, offsets):
+    out = np.empty_like(a)
+    for b in range(a.shape[0]):
+        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+    return out
+
+
+@njit(cache=True)
+def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
+    """Transpose of one level of the Lyndon projection: ``gz[lidx] = M^{-T} gc`` (back substitution)."""
+    n = lidx.shape[0]
+    y = np.empty(n)
+    for b in range(gc.shape[0]):
+        for i in range(n):
+            y[i] = gc[b, out_off + i]
+        for r in range(n - 1, -1, -1):
+            yr = y[r]
+            for t in range(indptr[r], indptr[r + 1]):
+                y[indices[t]] -= data[t] * yr
+        for i in range(n):
+            gz[b, lev_off + lidx[i]] = y[i]

@@ -11,25 +11,31 @@ Output layouts (see :mod:`roughpaths.tensor_algebra`):
   coordinate of ``[i,j]`` (``i < j``) is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`.
 
 Kernels are numba-compiled and cached (:mod:`roughpaths._signature_kernels`): level 2 is a fused
-one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment.
+one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment, vectorised across
+work units (paths, or chunks of a long path glued by Chen's identity). The split of the work depends
+on the input's size only, so results are bitwise identical for any number of threads.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from . import _signature_kernels as _k
 from .validation import as_float_array, check_positive_int
-from .tensor_algebra import (_reversed_to_rowmajor, lyndon_coordinates, logsigdim, sigdim,
-                             tensor_log)
+from .tensor_algebra import (_log_flat, _lyndon_flat, _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim,
+                             sigdim)
 
-__all__ = ["signature", "logsignature", "rough_path_signature"]
+__all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp", "logsignature_vjp"]
 
-# Cut a long path into parallel chunks (glued by Chen) only when the batch cannot feed the
-# threads and the path is long enough for the split to pay.
-_CHUNK_MIN_POINTS_L2 = 50_000
-_CHUNK_MIN_POINTS = 5_000
+# Work splitting depends on the input's size only (never on the thread count), so results are
+# bitwise identical for any number of threads. A path is cut into chunks (glued by Chen's identity)
+# only when the batch alone gives fewer than _TARGET_UNITS work units; a chunk has at least
+# _MIN_CHUNK segments. Inputs below _SERIAL_WORK flops-ish run on one thread (no start-up cost).
+_TARGET_UNITS = 64
+_MIN_CHUNK = 256
+_MIN_CHUNK_L2 = 8192
+_TARGET_UNITS_L2 = 16
+_SERIAL_WORK = 1 << 18
 
 
 def _offsets(dim: int, depth: int) -> np.ndarray:
@@ -39,15 +45,58 @@ def _offsets(dim: int, depth: int) -> np.ndarray:
     return off
 
 
-def _n_chunks(batch: int, n: int, min_points: int) -> int:
-    threads = numba.get_num_threads()
-    if threads <= 1 or batch >= threads or n < min_points:
+def _n_chunks(batch: int, n: int, target: int, min_chunk: int) -> int:
+    """Chunks per path: a function of the input's size only."""
+    if batch >= target or n - 1 < 2 * min_chunk:
         return 1
-    return max(1, min(threads // max(batch, 1), n // (min_points // 2)))
+    return max(1, min(-(-target // max(batch, 1)), (n - 1) // min_chunk))
+
+
+def _units(nb: int, n: int, nchunks: int) -> tuple:
+    """``(path, first point, last point)`` of every work unit, path-major."""
+    seg = -(-(n - 1) // nchunks)
+    ub = np.repeat(np.arange(nb, dtype=np.int64), nchunks)
+    lo = np.minimum(np.tile(np.arange(nchunks, dtype=np.int64), nb) * seg, n - 1)
+    return ub, lo, np.minimum(lo + seg, n - 1)
 
 
 def _check_depth(depth) -> int:
     return check_positive_int(depth, "depth")
+
+
+def _available_bytes() -> int:
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        import os
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return 1 << 62
+
+
+def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
+    """Refuse, before allocating, a request whose working arrays would not fit in memory.
+
+    The signature needs about 3 arrays of ``batch * sigdim`` floats (result, chunk partials,
+    layout permutation); the log-signature 2 more (log, scratch) plus the sparse Lyndon map, whose
+    top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built).
+    """
+    dim = sigdim(d, depth)
+    need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
+    if log and depth > 1 and d > 1:
+        need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+    avail = _available_bytes()
+    if need > avail:
+        what = "logsignature" if log else "signature"
+        raise ValueError(
+            f"depth={depth} with d={d} and {batch} path(s): the {what} needs about {need / 2**30:.1f} GiB "
+            f"(sigdim({d}, {depth}) = {dim} floats per path) but {avail / 2**30:.1f} GiB is available. "
+            f"Lower depth, process the batch in smaller pieces, or use fewer dimensions.")
 
 
 def _check_paths(paths) -> np.ndarray:
@@ -68,9 +117,16 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
         return np.zeros((nb, sigdim(d, depth)))
     if depth == 1:
         return x[:, -1, :] - x[:, 0, :]
+    dim = sigdim(d, depth)
+    serial = nb * n * dim < _SERIAL_WORK
     if depth == 2:
-        return _k.sig2_kernel(x, _n_chunks(nb, n, _CHUNK_MIN_POINTS_L2))
-    out = _k.sig_kernel(x, depth, _offsets(d, depth), _n_chunks(nb, n, _CHUNK_MIN_POINTS))
+        serial = serial or nb * _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2) < 2
+        kern = _k.sig2_kernel_ser if serial else _k.sig2_kernel
+        return kern(x, _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2))
+    nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
+    serial = serial or nb * nchunks <= _k.LANES            # one lane group: nothing to share
+    kern = _k.lane_sig_ser if serial else _k.lane_sig_par
+    out = kern(x, *_units(nb, n, nchunks), nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
 
 
@@ -101,6 +157,7 @@ def signature(paths, depth: int) -> np.ndarray:
     x = _check_paths(paths)
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    _check_fits(flat.shape[0], d, depth)
     return _signature_flat(flat, depth).reshape(batch + (sigdim(d, depth),))
 
 
@@ -134,7 +191,151 @@ def logsignature(paths, depth: int) -> np.ndarray:
     if depth == 1 or d == 1:
         # d = 1: the free Lie algebra is R (a path's log-signature is its increment).
         return signature(x, 1)[..., :logsigdim(d, depth)]
-    return lyndon_coordinates(tensor_log(signature(x, depth), d), d)
+    batch, n = x.shape[:-2], x.shape[-2]
+    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    _check_fits(flat.shape[0], d, depth, log=True)
+    sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    return _lyndon_flat(_log_flat(sig, d, depth), d, depth).reshape(batch + (-1,))
+
+
+def _check_grad(grad_output, batch: tuple, width: int, what: str) -> np.ndarray:
+    g = as_float_array(grad_output, "grad_output", min_ndim=1)
+    if g.shape != batch + (width,):
+        raise ValueError(f"grad_output has shape {g.shape}, expected {batch + (width,)}: the shape of "
+                         f"{what}(paths, depth) (batch axes of paths, then {width}).")
+    return np.ascontiguousarray(g.reshape((-1, width)))
+
+
+def _increments_to_points(gd: np.ndarray, n: int) -> np.ndarray:
+    """Cotangent of the points from that of the increments ``x_k - x_{k-1}``."""
+    gx = np.zeros((gd.shape[0], n, gd.shape[-1]))
+    gx[:, 1:] += gd
+    gx[:, :-1] -= gd
+    return gx
+
+
+def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndarray:
+    """``(B, n, d)`` cotangent of the points given the row-major ``(B, sigdim)`` cotangent of the signature."""
+    nb, n, d = x.shape
+    if n == 1 or nb == 0:
+        return np.zeros(x.shape)
+    if depth == 1:
+        gx = np.zeros(x.shape)
+        gx[:, -1] += g_row
+        gx[:, 0] -= g_row
+        return gx
+    off = _offsets(d, depth)
+    perm = _reversed_to_rowmajor(d, depth)
+    g_rev = np.empty_like(g_row)
+    g_rev[:, perm] = g_row
+    nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
+    units = _units(nb, n, nchunks)
+    serial = nb * n * sigdim(d, depth) < _SERIAL_WORK or nb * nchunks < 2
+    part = (_k.lane_parts_ser if serial else _k.lane_parts_par)(x, *units, depth, off)
+    gd = (_k.sig_vjp_ser if serial else _k.sig_vjp_par)(x, *units, nchunks, depth, off, part, g_rev)
+    return _increments_to_points(gd, n)
+
+
+def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
+    r"""Vector–Jacobian product of :func:`signature` with respect to the path points.
+
+    Parameters
+    ----------
+    paths : array_like, shape ``(..., n, d)``
+        As for :func:`signature`.
+    depth : int
+        Truncation level ``m >= 1``.
+    grad_output : array_like, shape ``(..., sigdim(d, m))``
+        A cotangent ``G`` of the signature (e.g. the gradient of a loss with respect to it),
+        in :func:`signature`'s layout.
+
+    Returns
+    -------
+    ndarray, shape ``(..., n, d)``
+        :math:`\partial \langle G, S(x) 
+angle / \partial x`, the same quantity as
+        ``iisignature.sigbackprop(G, paths, m)``.
+
+    Notes
+    -----
+    Backward through Chen's identity segment by segment, last to first: the signature before a
+    segment is recovered as :math:`S \otimes \exp(-\Delta)` (nothing of the forward pass is
+    stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} \rhd G,
+    \exp(\Delta)\rangle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
+    signatures per path. Long paths are cut into the same chunks as :func:`signature`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    >>> g = np.zeros(6); g[3] = 1.0                  # gradient of the word (1, 2): ∫ X^1 dX^2
+    >>> signature_vjp(x, 2, g)
+    array([[-1. , -0.5],
+           [ 0.5, -0.5],
+           [ 0.5,  1. ]])
+    """
+    depth = _check_depth(depth)
+    x = _check_paths(paths)
+    batch, (n, d) = x.shape[:-2], x.shape[-2:]
+    g = _check_grad(grad_output, batch, sigdim(d, depth), "signature")
+    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    _check_fits(flat.shape[0], d, depth, log=True)
+    return _signature_vjp_flat(flat, depth, g).reshape(x.shape)
+
+
+def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
+    r"""Vector–Jacobian product of :func:`logsignature` with respect to the path points.
+
+    Parameters
+    ----------
+    paths : array_like, shape ``(..., n, d)``
+    depth : int
+    grad_output : array_like, shape ``(..., logsigdim(d, m))``
+        Cotangent of the Lyndon coordinates returned by :func:`logsignature`.
+
+    Returns
+    -------
+    ndarray, shape ``(..., n, d)``
+        :math:`\partial \langle G, \mathrm{logsig}(x) 
+angle / \partial x`, the same quantity as
+        ``iisignature.logsigbackprop(G, paths, prepare(d, m))``.
+
+    Notes
+    -----
+    Chains three transposes: of the Lyndon projection (back substitution with the sparse
+    triangular map), of the truncated logarithm (backward through its Horner recursion), and
+    :func:`signature_vjp`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    >>> signature_vjp(x, 2, [0, 0, 0, 0.5, -0.5, 0]) == logsignature_vjp(x, 2, [0, 0, 1.0])
+    array([[ True,  True],
+           [ True,  True],
+           [ True,  True]])
+    """
+    depth = _check_depth(depth)
+    x = _check_paths(paths)
+    batch, (n, d) = x.shape[:-2], x.shape[-2:]
+    g = _check_grad(grad_output, batch, logsigdim(d, depth), "logsignature")
+    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    if depth == 1 or d == 1:
+        g_sig = np.zeros((flat.shape[0], sigdim(d, depth)))
+        g_sig[:, :d] = g
+        return _signature_vjp_flat(flat, depth, g_sig).reshape(x.shape)
+    _check_fits(flat.shape[0], d, depth, log=True)
+    off = _offsets(d, depth)
+    perm = _reversed_to_rowmajor(d, depth)
+    sig = _signature_flat(flat, depth)
+    g_log_row = _lyndon_flat_vjp(g, d, depth)
+    sig_rev = np.empty_like(sig)
+    sig_rev[:, perm] = sig
+    g_log_rev = np.empty_like(g_log_row)
+    g_log_rev[:, perm] = g_log_row
+    serial = sig.size < _SERIAL_WORK or sig.shape[0] < 2
+    g_sig_rev = (_k.log_vjp_ser if serial else _k.log_vjp_par)(sig_rev, g_log_rev, d, depth, off)
+    return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
 
 
 def rough_path_signature(X, depth: int) -> np.ndarray:

@@ -39,7 +39,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ._lyndon import bracket_string, lyndon_expansion, lyndon_projection, lyndon_words
+from . import _signature_kernels as _k
+from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix, lyndon_projection,
+                      lyndon_words)
 from .validation import as_float_array, check_positive_int, check_same_batch
 
 __all__ = [
@@ -69,14 +71,62 @@ def sigdim(dim: int, depth: int) -> int:
 
 
 def logsigdim(dim: int, depth: int) -> int:
-    """Number of Lyndon words of length ``1..depth`` over ``dim`` letters (free Lie algebra dimension).
+    r"""Number of Lyndon words of length ``1..depth`` over ``dim`` letters (free Lie algebra dimension).
+
+    Witt's formula :math:`\sum_{k=1}^{m} \frac1k \sum_{e \mid k} \mu(e)\, d^{k/e}` in exact
+    integer arithmetic (nothing is enumerated, so large depths are instant).
 
     >>> logsigdim(3, 4)
     32
+    >>> logsigdim(2, 60) > 10 ** 16
+    True
     """
     dim = check_positive_int(dim, "dim")
     depth = check_positive_int(depth, "depth")
-    return len(lyndon_words(dim, depth))
+    return sum(count_lyndon_words(dim, k) for k in range(1, depth + 1))
+
+
+def _offsets(dim: int, depth: int) -> np.ndarray:
+    """Start of each level in the flat layout: ``off[k]`` for ``k = 1..depth+1`` (``off[1] = 0``)."""
+    off = np.zeros(depth + 2, dtype=np.int64)
+    for k in range(1, depth + 1):
+        off[k + 1] = off[k] + dim ** k
+    return off
+
+
+# Below this many flat entries a batch is processed on one thread (no thread start-up).
+_SERIAL_ENTRIES = 1 << 15
+
+
+def _log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
+    kern = _k.log_batch_ser if a.size < _SERIAL_ENTRIES or a.shape[0] < 2 else _k.log_batch_par
+    return kern(a, dim, depth, _offsets(dim, depth))
+
+
+def _lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Cotangent ``(B, sigdim)`` (row-major) of the Lie element, given that of its Lyndon coordinates."""
+    off = _offsets(dim, depth)
+    gz = np.zeros((gc.shape[0], int(off[depth + 1])))
+    start = 0
+    for k in range(1, depth + 1):
+        lidx, indptr, indices, data = lyndon_projection(dim, k)
+        _k.lyndon_vjp(gc, start, lidx, indptr, indices, data, gz, off[k])
+        start += lidx.shape[0]
+    return gz
+
+
+def _lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Lyndon coordinates of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
+    off = _offsets(dim, depth)
+    out = np.empty((z.shape[0], logsigdim(dim, depth)))
+    kern = _k.lyndon_batch_ser if z.size < _SERIAL_ENTRIES or z.shape[0] < 2 else _k.lyndon_batch_par
+    start = 0
+    for k in range(1, depth + 1):
+        lidx, indptr, indices, data = lyndon_projection(dim, k)
+        kern(z, off[k], lidx, indptr, indices, data, out, start)
+        start += lidx.shape[0]
+    return out
 
 
 # ------------------------------------------------------------------------------ internals
@@ -209,8 +259,8 @@ def tensor_log(a, dim: int) -> np.ndarray:
     Shape ``(..., sigdim)``.
     """
     a, dim, depth = _check_element(a, "a", dim)
-    coeffs = [0.0] + [(-1.0) ** (n + 1) / n for n in range(1, depth + 1)]
-    return _join(_power_series(_split(a, dim, depth), coeffs, depth))
+    flat = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
+    return _log_flat(flat, dim, depth).reshape(a.shape)
 
 
 # ------------------------------------------------------------------------------ level 2
@@ -280,9 +330,8 @@ def lyndon_coordinates(z, dim: int) -> np.ndarray:
         Only the Lyndon-word entries of ``z`` are read, so ``z`` must really be Lie.
     """
     z, dim, depth = _check_element(z, "z", dim)
-    levels = _split(z, dim, depth)
-    proj = lyndon_projection(dim, depth)
-    return np.concatenate([levels[k][..., idx] @ t for k, (idx, t) in enumerate(proj)], axis=-1)
+    flat = np.ascontiguousarray(z.reshape(-1, z.shape[-1]))
+    return _lyndon_flat(flat, dim, depth).reshape(z.shape[:-1] + (-1,))
 
 
 def from_lyndon_coordinates(c, dim: int, depth: int) -> np.ndarray:
@@ -299,13 +348,15 @@ def from_lyndon_coordinates(c, dim: int, depth: int) -> np.ndarray:
     """
     dim = check_positive_int(dim, "dim")
     depth = check_positive_int(depth, "depth")
-    n = len(lyndon_words(dim, depth))
+    n = logsigdim(dim, depth)
     c = as_float_array(c, "c", last_dims=(n,))
+    flat = c.reshape(-1, n)
     out, start = [], 0
-    for e in lyndon_expansion(dim, depth):
-        out.append(c[..., start:start + e.shape[0]] @ e)
+    for k in range(1, depth + 1):
+        e = expansion_matrix(dim, k)                       # sparse (n_k, dim**k)
+        out.append(np.asarray((e.T @ flat[:, start:start + e.shape[0]].T).T))
         start += e.shape[0]
-    return np.concatenate(out, axis=-1)
+    return np.concatenate(out, axis=-1).reshape(c.shape[:-1] + (-1,))
 
 
 @lru_cache(maxsize=None)

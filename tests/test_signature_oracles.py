@@ -23,7 +23,7 @@ import pytest
 
 from roughpaths import RoughPath
 from roughpaths import _signature_kernels as kern
-from roughpaths.signature import logsignature, rough_path_signature, signature
+from roughpaths.signature import _units, logsignature, rough_path_signature, signature
 from roughpaths.tensor_algebra import (_reversed_to_rowmajor, lyndon_basis, sigdim, tensor_exp,
                                        tensor_log, tensor_product)
 
@@ -178,7 +178,9 @@ def test_chunked_kernels_match_iisignature(rng, m, nchunks):
         off = np.zeros(m + 2, dtype=np.int64)
         for k in range(1, m + 1):
             off[k + 1] = off[k] + d ** k
-        got = kern.sig_kernel(np.ascontiguousarray(x), m, off, nchunks)[:, _reversed_to_rowmajor(d, m)]
+        ub, lo, hi = _units(x.shape[0], x.shape[1], nchunks)
+        got = kern.lane_sig_par(np.ascontiguousarray(x), ub, lo, hi, nchunks, m, off)
+        got = got[:, _reversed_to_rowmajor(d, m)]
     np.testing.assert_allclose(got, ref, rtol=0, atol=TOL)
 
 
