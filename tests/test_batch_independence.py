@@ -156,3 +156,13 @@ def test_tensor_algebra_members_independent(data):
     prod = rp.tensor_product(g, g[::-1], 3)
     for i in range(z.shape[0]):
         assert _same(prod[i], rp.tensor_product(g[i], g[::-1][i], 3)), f"product, member {i}"
+
+
+@SETTINGS
+@given(batches((12, 3), max_members=5, poison=False), st.integers(1, 5))
+def test_logsignature_members_independent(data, depth):
+    paths, _ = data
+    paths = np.cumsum(paths, axis=-2)
+    s = rp.logsignature(paths, depth)
+    for i in range(paths.shape[0]):
+        assert _same(s[i], rp.logsignature(paths[i], depth)), f"member {i}"
