@@ -225,7 +225,7 @@ def piecewise_linear_lift(values, substeps: int, *, level: int = 2, times=None):
     >>> import numpy as np
     >>> pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.0]])
     >>> X = piecewise_linear_lift(pts, 4)                  # one coarse step: the unit square
-    >>> X.levy_area(0.0, 1.0)[0, 1]
+    >>> float(X.levy_area(0.0, 1.0)[0, 1])
     1.0
     """
     v = as_float_array(values, "values", min_ndim=2)

@@ -87,7 +87,7 @@ class RoughPathN:
     (3, 2, 3)
     >>> bool(np.allclose(X.signature(0.0, 3.0), signature(pts, 3)))    # Chen over the whole grid
     True
-    >>> X.to_rough_path().levy_area(0.0, 2.0)[0, 1]                   # the L-shaped path's Lévy area
+    >>> float(X.to_rough_path().levy_area(0.0, 2.0)[0, 1])            # the L-shaped path's Lévy area
     0.5
     """
 
@@ -268,16 +268,30 @@ class RoughPathN:
             self._cache["prefix"] = p
         return p
 
+    def _products(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Chen products of the steps ``i[q] .. j[q] - 1`` in time order, shape ``(..., nq, D)``."""
+        d, sig = self._dim, self._sig
+        lengths = j - i
+        acc = np.zeros(sig.shape[:-2] + (i.size, sig.shape[-1]))
+        for step in range(int(lengths.max(initial=0))):
+            live = step < lengths
+            cols = np.where(live, i + step, 0)
+            acc = np.where(live[:, None], tensor_product(acc, sig[..., cols, :], d), acc)
+        return acc
+
     def signature(self, s, t) -> np.ndarray:
         r"""The signature :math:`\mathbf{X}_{s,t}` over grid times ``s <= t`` (Chen), shape ``(..., *q, D)``.
 
-        Computed as :math:`\mathbf{X}_{t_0,s}^{-1}\otimes\mathbf{X}_{t_0,t}` from cached prefix products.
+        The product of the steps between ``s`` and ``t`` in time order (no prefix inverses, so no
+        cancellation error; ``O(max steps)`` vectorised products).
         """
         i, j = self.index_of(s, "s"), self.index_of(t, "t")
         if np.any(i > j):
             raise ValueError("s must not exceed t (s <= t); for the reversed direction use path.reverse().")
-        p = self._prefix()
-        return tensor_product(tensor_inverse(p[..., i, :], self._dim), p[..., j, :], self._dim)
+        q = np.broadcast_shapes(i.shape, j.shape)
+        i, j = np.broadcast_to(i, q).ravel(), np.broadcast_to(j, q).ravel()
+        out = self._products(i, j)
+        return out.reshape(self.batch_shape + q + (self._sig.shape[-1],))
 
     def increment(self, s, t) -> np.ndarray:
         """Increment :math:`X_{s,t}`, shape ``(..., *q, d)``."""
@@ -295,21 +309,15 @@ class RoughPathN:
     def restrict(self, times) -> "RoughPathN":
         """The same rough path on a coarser grid (a subset of :attr:`times`), by Chen products.
 
-        Each coarse step is the product of its fine steps in time order (no prefix inverses, so no
-        cancellation error). The new ``x0`` is the trace at ``times[0]``.
+        Each coarse step is the product of its fine steps in time order. The new ``x0`` is the trace at
+        ``times[0]``.
         """
         tt = check_times(times, "times")
         idx = self.index_of(tt, "times")
         if np.any(np.diff(idx) <= 0):
             raise ValueError("times contains the same grid point twice (to the grid tolerance); drop one.")
-        d, sig = self._dim, self._sig
-        lengths = np.diff(idx)
-        acc = sig[..., idx[:-1], :].copy()
-        for j in range(1, int(lengths.max())):
-            live = j < lengths
-            cols = np.where(live, idx[:-1] + j, idx[:-1])
-            prod = tensor_product(acc, sig[..., cols, :], d)
-            acc = np.where(live[:, None], prod, acc)
+        d = self._dim
+        acc = self._products(idx[:-1], idx[1:])
         return RoughPathN(acc, d, times=self._times[idx], x0=self.path[..., idx[0], :], check=False)
 
     def concatenate(self, other: "RoughPathN") -> "RoughPathN":
@@ -385,7 +393,11 @@ class RoughPathN:
 
     # ------------------------------------------------------------------ norms
     def _pair_norms(self, max_points):
-        """Per-level Euclidean norms ``|X^{(k)}_{t_i, t_j}|`` for all ``i < j``: ``(..., N, P, P)``."""
+        """Per-level Euclidean norms ``|X^{(k)}_{t_i, t_j}|`` for all ``i < j``: ``(..., N, P, P)``.
+
+        Uses ``X_{t_0,t_i}^{-1} ⊗ X_{t_0,t_j}`` from the prefix products (absolute error about
+        ``1e-16`` times the size of the prefixes, ample for norms).
+        """
         P = self.n_steps + 1
         if max_points is not None and P > max_points:
             raise ValueError(f"the all-pairs rough-path norms need O(points**2) memory; this grid has {P} "
