@@ -1,4 +1,4 @@
-"""roughpaths: level-2 geometric rough paths, signatures, Brownian lifts, norms and RDE solvers.
+"""roughpaths: level-2 (and level-N) geometric rough paths, fractional Brownian motion, signatures, Brownian lifts, norms and RDE solvers.
 
 Conventions are fixed once, in ``CONVENTIONS.md`` of the project: the area ``XX[i, j]`` is
 ``∫ (X^i - X^i_s) dX^j`` (iisignature ordering), the Lévy area is ``½(XX - XXᵀ)``, and the
@@ -34,10 +34,13 @@ from .norms import (
     rough_path_p_variation,
 )
 from .rough_path import RoughPath, chen_defect
+from .rough_path_n import RoughPathN
+from .fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
 from .driver import Driver
 from .solve import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
+from .solvers_level3 import Davie3, LogODE3
 from .signature import (logsignature, logsignature_vjp, rough_path_signature, signature,
                         signature_vjp)
 from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
@@ -68,6 +71,8 @@ __all__ = [
     "Heun",
     "Davie",
     "LogODE",
+    "LogODE3",
+    "Davie3",
     "SOLVERS",
     "expm_batched",
     "VectorFields",
@@ -93,6 +98,12 @@ __all__ = [
     # rough paths, group, Brownian lifts, norms, signatures
     "RoughPath",
     "chen_defect",
+    # level-N rough paths, fractional Brownian motion
+    "RoughPathN",
+    "fbm",
+    "fbm_rough_path",
+    "fgn_autocovariance",
+    "piecewise_linear_lift",
     "brownian_rough_path",
     "brownian_increments_and_areas",
     "refine",

@@ -19,6 +19,7 @@ import numpy as np
 from .validation import as_float_array, check_memory, check_same_batch
 from .driver import Driver
 from .rough_path import RoughPath
+from .rough_path_n import RoughPathN
 from .solvers import SOLVERS, Davie, Solver
 
 __all__ = ["solve", "Solution", "NonFiniteStateError"]
@@ -131,9 +132,10 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         accept a ``LiePoissonSystem``. Driving field ``i`` of the API (``0``-based) is
         :math:`V_{i+1}` of the maths; the maths' :math:`V_0` is the drift. The object must have
         ``dim_state`` (``e``) and ``dim_noise`` (``d``).
-    driver : RoughPath or Driver
+    driver : RoughPath, RoughPathN or Driver
         Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.driver.Driver` is
-        consumed block by block (memory for one block). Level 2 for level-2 solvers. Convention:
+        consumed block by block (memory for one block). Level 2 for level-2 solvers, a
+        :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``). Convention:
         area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
     y0 : array_like, shape ``(..., e)``
         Initial condition(s); the batch ``B_y`` broadcasts against ``B_X``.
@@ -197,8 +199,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     if executor is not None:
         return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
                             on_failure=on_failure, block_steps=block_steps)
-    if not isinstance(driver, (RoughPath, Driver)):
-        raise TypeError(f"driver must be a RoughPath or a Driver (e.g. roughpaths.BrownianDriver), got "
+    if not isinstance(driver, (RoughPath, RoughPathN, Driver)):
+        raise TypeError(f"driver must be a RoughPath, a RoughPathN or a Driver (e.g. roughpaths.BrownianDriver), got "
                         f"{type(driver).__name__}; build a path with RoughPath.from_path(values, times=...) "
                         f"or RoughPath(increments, areas, times=...).")
     if on_failure not in ("raise", "mask"):
@@ -243,9 +245,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         out[..., 0, :] = y
         slot = 1
 
-    use_area = solver.increment_level >= 2
     failed_step = np.full(batch, -1, dtype=np.int64)
-    blocks = (driver,) if isinstance(driver, RoughPath) else driver.blocks(block_steps)
+    blocks = driver.blocks(block_steps) if isinstance(driver, Driver) else (driver,)
     k0 = 0
     n_blocks = 0
     t_start = _time.perf_counter()
@@ -253,7 +254,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         kb = block.n_steps
         save = save_mask[k0 + 1:k0 + kb + 1]
         y, saved, first_bad = solver.integrate(fields, y, block.times, block.increments,
-                                               block.areas if use_area else None, save,
+                                               _higher_levels(block, solver.increment_level), save,
                                                stop_on_failure=(on_failure == "raise"))
         new_bad = (first_bad >= 0) & (failed_step < 0)
         if new_bad.any():
@@ -277,8 +278,17 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     return Solution(times=times[idx].copy(), states=out, failed_step=failed_step, stats=stats)
 
 
+def _higher_levels(block, increment_level):
+    """The ``dXX`` argument of contract item 8: None, the areas, or ``(areas, level-3 components)``."""
+    if increment_level < 2:
+        return None
+    if increment_level == 2:
+        return block.areas
+    return block.areas, block.step_level(3)
+
+
 def _index_of(driver, save_at):
-    if isinstance(driver, RoughPath):
+    if isinstance(driver, (RoughPath, RoughPathN)):
         return driver.index_of(save_at, "save_at")
     return RoughPath(np.zeros((driver.n_steps, driver.dim)), times=driver.times, check=False).index_of(
         save_at, "save_at")

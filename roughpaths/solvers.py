@@ -37,9 +37,11 @@ class Solver:
     A solver is a small object. :func:`~roughpaths.solve` relies on exactly the following, in this
     order (subclasses override what they need; the defaults serve vector-field RDEs):
 
-    1. ``increment_level`` (class attribute, 1 or 2): what a step consumes, the increment
-       :math:`X_{s,t}` alone (1) or also the area :math:`\mathbb{X}_{s,t}` (2). ``solve`` refuses a
-       driver of lower level; a level-1 solver never sees the areas of a level-2 driver.
+    1. ``increment_level`` (class attribute, 1, 2 or 3): what a step consumes, the increment
+       :math:`X_{s,t}` alone (1), also the area :math:`\mathbb{X}_{s,t}` (2), or also the level-3 step
+       signature (3, :mod:`roughpaths.solvers_level3`). ``solve`` refuses a driver of lower level; a
+       level-1 solver never sees the areas of a level-2 driver; the level-1/2 solvers here refuse a
+       level-3 driver (:class:`~roughpaths.RoughPathN`) rather than drop its level 3 silently.
     2. ``order`` and ``smooth_order`` (class attributes): the declared strong order on Brownian rough
        paths (Stratonovich lift, non-commuting fields) and the order on smooth drivers with exact
        increments and areas. Convergence tests fit these.
@@ -54,10 +56,12 @@ class Solver:
        :class:`~roughpaths.driver.Driver`) cannot drive this scheme. The default checks the level.
     7. ``step(fields, y, t, dt, dX, dXX)``: one step from ``y`` (``(..., e)``) over ``[t, t + dt]``
        with the increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` for a
-       level-1 solver), vectorised over the leading (broadcast) batch axes. Each batch member's
+       level-1 solver; for a level-3 solver the tuple ``(XX, XXX)`` of the step's level-2 and level-3
+       components, shapes ``(..., d, d)`` and ``(..., d, d, d)``), vectorised over the leading (broadcast) batch axes. Each batch member's
        result must depend on that member's data only (no reductions or shared scalings over the batch).
     8. ``integrate(fields, y, times, dX, dXX, save, stop_on_failure)``: advance a block of steps
        (``times`` of shape ``(K + 1,)``, ``dX`` ``(..., K, d)``, ``dXX`` ``(..., K, d, d)`` or ``None``,
+       or for ``increment_level = 3`` the tuple ``(XX (..., K, d, d), XXX (..., K, d, d, d))``,
        ``save`` a boolean mask ``(K,)`` of the steps after which the state is kept). Returns
        ``(y, saved, first_bad)``: the final state, the kept states ``(..., save.sum(), e)`` and, per
        batch member, the index of the first step after which the member was non-finite (``-1`` if
@@ -89,6 +93,12 @@ class Solver:
                              f"level 1 (no area); pass a level-2 RoughPath (e.g. a Brownian rough path with "
                              f"its Lévy area), or choose a level-1 solver (Heun(), Euler()) if dropping the "
                              f"area is intended.")
+        if driver.level > 2 and self.increment_level < 3:
+            raise ValueError(f"{self!r} uses the driver up to level {self.increment_level}, but the driver is a "
+                             f"level-{driver.level} rough path (p >= 3, e.g. fBM with H <= 1/3), whose level 3 "
+                             f"this scheme would drop; use a level-3 solver (LogODE3(), Davie3() from "
+                             f"roughpaths), or pass driver.to_rough_path() (its level-2 truncation) if the path "
+                             f"is p-rough with p < 3 and dropping level 3 is intended.")
 
     def step(self, fields, y, t, dt, dX, dXX):  # pragma: no cover - abstract
         """One step (contract item 7)."""
@@ -103,8 +113,13 @@ class Solver:
         slot = 0
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             for k in range(n):
-                y = self.step(fields, y, times[k], dts[k], dX[..., k, :],
-                              None if dXX is None else dXX[..., k, :, :])
+                if dXX is None:
+                    dxx = None
+                elif isinstance(dXX, tuple):
+                    dxx = tuple(a[(Ellipsis, k) + (slice(None),) * (a.ndim - dX.ndim + 1)] for a in dXX)
+                else:
+                    dxx = dXX[..., k, :, :]
+                y = self.step(fields, y, times[k], dts[k], dX[..., k, :], dxx)
                 bad = ~np.all(np.isfinite(y), axis=-1)
                 if bad.any():
                     first_bad[bad & (first_bad < 0)] = k

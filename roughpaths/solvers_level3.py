@@ -1,0 +1,265 @@
+r"""One-step RDE solvers that consume level-3 step signatures (rough paths with :math:`p\in[3, 4)`).
+
+They follow the contract of :class:`roughpaths.solvers.Solver` with ``increment_level = 3``:
+:func:`roughpaths.solve` passes each step's level-2 and level-3 components as the tuple
+``dXX = (XX, XXX)``, of shapes ``(..., d, d)`` and ``(..., d, d, d)`` (word ``(i, j, k)`` at
+``XXX[..., i, j, k]``), from a :class:`~roughpaths.RoughPathN` driver of level >= 3.
+
+The differential operators of words (``docs/conventions.md``): a word :math:`w = (i_1,\dots,i_k)` acts
+on the identity as :math:`V_w = V_{i_1}(V_{i_2}(\cdots V_{i_k}))` with :math:`V_i f = Df\cdot V_i`, i.e.
+
+.. math::
+    V_{(i,j)} = DV_j\cdot V_i, \qquad
+    V_{(i,j,k)} = D^2V_k[V_j, V_i] + DV_k\cdot DV_j\cdot V_i ,
+
+and the Taylor expansion of the flow over a step is :math:`Y + \sum_{|w|\le 3}\mathbf{X}^w V_w(Y)`.
+
+Second derivatives :math:`D^2V_k` come from ``hessians`` if given (``y -> (..., d, e, e, e)`` with
+``[..., k, a, b, c] =`` :math:`\partial_b\partial_c V_k^a`), else from central differences of the
+Jacobians along the fields, :math:`D(DV_k)[V_i] \approx (J_k(y + \varepsilon V_i) - J_k(y - \varepsilon V_i))/2\varepsilon`
+(``2d`` extra Jacobian evaluations per step, relative accuracy about ``1e-10`` for smooth fields);
+they vanish for :class:`~roughpaths.LinearVectorFields`, where every term is a matrix product.
+
+============  =====  =====================  ============  =========================================
+solver        level  order (BM; fBM H<1/2)  smooth order  note
+============  =====  =====================  ============  =========================================
+``LogODE3``   3      1.5; 4H - 1            3             flow of the level-3 log-signature field
+``Davie3``    3      1.5; 4H - 1            3             third-order Taylor (Davie-type) step
+============  =====  =====================  ============  =========================================
+
+The fBM rate :math:`4H - 1` is the pathwise rate :math:`(N+1)/p - 1` of a step-``N`` scheme with exact
+step signatures (Friz–Victoir, Thm 10.30), ``N = 3``, ``p`` just above ``1/H``; measured rates are in
+``tests/test_rough_strong_rates.py``. With a drift the space–time iterated integrals are approximated
+(as in :class:`~roughpaths.Davie`), which limits the smooth order to 2.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from ._linalg import expm_batched, matvec, vecmat
+from .solvers import Solver, _second_order
+
+__all__ = ["LogODE3", "Davie3"]
+
+#: Relative step of the central differences of the Jacobians (about the cube root of the float64 epsilon).
+FD_STEP = 6e-6
+
+
+def _split_levels(dXX, name):
+    if not (isinstance(dXX, tuple) and len(dXX) == 2):
+        raise TypeError(f"{name} is a level-3 solver: dXX must be the tuple (XX, XXX) of the step's level-2 "
+                        f"and level-3 components (roughpaths.solve passes it from a RoughPathN of level >= 3), "
+                        f"got {type(dXX).__name__}.")
+    return dXX
+
+
+def _log3(x, XX, XXX):
+    r"""Levels 2 and 3 of :math:`\log(1 + x + XX + XXX)`."""
+    xx = x[..., :, None] * x[..., None, :]
+    l2 = XX - 0.5 * xx
+    l3 = (XXX - 0.5 * (x[..., :, None, None] * XX[..., None, :, :] + XX[..., :, :, None] * x[..., None, None, :])
+          + (1.0 / 3.0) * xx[..., :, :, None] * x[..., None, None, :])
+    return l2, l3
+
+
+class _Level3(Solver):
+    increment_level = 3
+
+    def __init__(self, hessians=None):
+        if hessians is not None and not callable(hessians):
+            raise TypeError(f"hessians must be a callable y (..., e) -> (..., d, e, e, e) with [..., k, a, b, c] = "
+                            f"d_b d_c V_k^a, or None for central differences; got {type(hessians).__name__}.")
+        self.hessians = hessians
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()" if self.hessians is None else f"{type(self).__name__}(hessians=...)"
+
+    def check_driver(self, driver) -> None:
+        """Require a driver of level >= 3 (contract item 6)."""
+        if driver.level < 3:
+            raise ValueError(f"{self!r} is a level-3 solver and needs the driver's level-3 step signatures, but "
+                             f"the driver is level {driver.level}. Lift a fine sample with "
+                             f"roughpaths.piecewise_linear_lift(values, m, level=3) or fbm_rough_path(..., level=3), "
+                             f"or extend a geometric level-2 path with RoughPathN.from_rough_path(X, 3) (exact only "
+                             f"when p < 3); or use a level-2 solver (Davie(), LogODE()) on a level-2 path.")
+
+    # ---------------------------------------------------------------- word operators
+    def _third(self, fields, y, V, J, c):
+        r""":math:`\sum_{ijk} c^{ijk} V_{(i,j,k)}(y)` for non-linear fields, shape ``(..., e)``."""
+        d = J.shape[-3]
+        # DV_k · (Σ_ij c^{ijk} DV_j·V_i), summed over k in a fixed order
+        acc = None
+        for k in range(d):
+            u = _second_order(J, V, c[..., :, :, k])
+            term = (J[..., k, :, :] @ u[..., None])[..., 0]
+            acc = term if acc is None else acc + term
+        # Σ_k Σ_ij c^{ijk} D²V_k[V_j, V_i]
+        if self.hessians is not None:
+            Hs = np.asarray(self.hessians(y), dtype=np.float64)             # [..., k, a, b, c]
+            for i in range(d):
+                for k in range(d):
+                    w = (V @ c[..., i, :, k, None])[..., 0]                   # Σ_j c^{ijk} V_j
+                    acc = acc + np.einsum("...abc,...b,...c->...a", Hs[..., k, :, :, :], w, V[..., :, i])
+            return acc
+        scale = 1.0 + np.max(np.abs(y), axis=-1, keepdims=True)
+        for i in range(d):
+            vi = V[..., :, i]
+            size = np.max(np.abs(vi), axis=-1, keepdims=True)
+            eps = FD_STEP * scale / np.where(size > 0, size, 1.0)
+            Jp = fields.jacobians(y + eps * vi)
+            Jm = fields.jacobians(y - eps * vi)
+            for k in range(d):
+                G = (Jp[..., k, :, :] - Jm[..., k, :, :]) / (2.0 * eps[..., None])   # D(DV_k)[V_i]
+                w = (V @ c[..., i, :, k, None])[..., 0]
+                acc = acc + (G @ w[..., None])[..., 0]
+        return acc
+
+    @staticmethod
+    def _linear_products(fields):
+        cache = getattr(fields, "_level3_products", None)
+        if cache is None:
+            M = fields.matrices
+            d, e = M.shape[0], M.shape[1]
+            M1 = M.reshape(d, e * e)
+            M2 = np.einsum("jab,ibc->ijac", M, M)                              # [i, j] = M_j M_i
+            M3 = np.einsum("kab,ijbc->ijkac", M, M2)                           # [i, j, k] = M_k M_j M_i
+            cache = (M1, M2.reshape(d * d, e * e), M3.reshape(d ** 3, e * e))
+            try:
+                fields._level3_products = cache
+            except AttributeError:  # pragma: no cover - slotted fields
+                pass
+        return cache
+
+    @classmethod
+    def _linear_generator(cls, fields, x, c2, c3):
+        r""":math:`\sum_i x^i M_i + \sum c_2^{ij} M_jM_i + \sum c_3^{ijk} M_kM_jM_i`, shape ``(..., e, e)``."""
+        M1, M2, M3 = cls._linear_products(fields)
+        e = fields.dim_state
+        d = x.shape[-1]
+        G = vecmat(x, M1) + vecmat(c2.reshape(c2.shape[:-2] + (d * d,)), M2) \
+            + vecmat(c3.reshape(c3.shape[:-3] + (d ** 3,)), M3)
+        return G.reshape(G.shape[:-1] + (e, e))
+
+
+class LogODE3(_Level3):
+    r"""The log-ODE method at depth 3: the flow of the step's level-3 log-signature vector field.
+
+    With :math:`\ell = \log \mathbf{X}_{s,t} = x + \ell_2 + \ell_3` (truncated at level 3), one step
+    follows for unit time the flow of
+
+    .. math:: W = V_0 h + \sum_i x^i V_i + \sum_{ij}\ell_2^{ij} V_{(i,j)} + \sum_{ijk}\ell_3^{ijk} V_{(i,j,k)},
+
+    which, since :math:`\ell` is a Lie element, is the bracket expansion
+    :math:`\tfrac12\sum A^{ij}[V_i,V_j] + \sum \ell_3^{ijk}`-weighted brackets of brackets (the
+    second-order parts of the word operators cancel; the ``D²V`` terms are kept so that a slightly
+    non-geometric input is still integrated consistently).
+
+    * :class:`~roughpaths.LinearVectorFields` with a linear drift: exact flow
+      :math:`Y' = \exp(G)Y`, :math:`G = A_0h + \sum x^iM_i + \sum\ell_2^{ij}M_jM_i + \sum\ell_3^{ijk}M_kM_jM_i`.
+    * otherwise ``inner_steps`` RK4 steps of :math:`z' = W(z)` on ``[0, 1]``.
+
+    Parameters
+    ----------
+    inner_steps : int
+        RK4 sub-steps per step for non-linear fields (default 1).
+    hessians : callable, optional
+        ``y -> (..., d, e, e, e)``, :math:`\partial_b\partial_c V_k^a` at ``[..., k, a, b, c]``; central
+        differences of the Jacobians if omitted.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from roughpaths import LinearVectorFields, LogODE3, fbm_rough_path, solve
+    >>> V = LinearVectorFields(0.5 * np.random.default_rng(0).standard_normal((2, 3, 3)))
+    >>> X = fbm_rough_path(32, 0.3, rng=1, substeps=16, level=3, batch_shape=(4,))
+    >>> solve(V, X, np.ones(3), LogODE3()).final.shape
+    (4, 3)
+    """
+
+    order = 1.5
+    smooth_order = 3.0
+
+    def __init__(self, inner_steps: int = 1, hessians=None):
+        super().__init__(hessians)
+        if isinstance(inner_steps, bool) or not isinstance(inner_steps, numbers.Integral) or inner_steps < 1:
+            raise ValueError(f"inner_steps must be a positive integer, got {inner_steps!r}.")
+        self.inner_steps = int(inner_steps)
+
+    def __repr__(self) -> str:
+        h = "" if self.hessians is None else ", hessians=..."
+        return f"LogODE3(inner_steps={self.inner_steps}{h})"
+
+    def step(self, fields, y, t, dt, dX, dXX):
+        XX, XXX = _split_levels(dXX, "LogODE3")
+        l2, l3 = _log3(dX, XX, XXX)
+        if getattr(fields, "is_linear", False):
+            G = self._linear_generator(fields, dX, l2, l3)
+            if fields.has_drift:
+                G = G + dt * fields.drift_matrix
+            return matvec(expm_batched(G), y)
+
+        def W(z):
+            V = fields.fields(z)
+            J = fields.jacobians(z)
+            w = (V @ dX[..., None])[..., 0] + _second_order(J, V, l2) + self._third(fields, z, V, J, l3)
+            if fields.has_drift:
+                w = w + fields.drift(z) * dt
+            return w
+
+        u = 1.0 / self.inner_steps
+        z = y
+        for _ in range(self.inner_steps):
+            k1 = W(z)
+            k2 = W(z + 0.5 * u * k1)
+            k3 = W(z + 0.5 * u * k2)
+            k4 = W(z + u * k3)
+            z = z + (u / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        return z
+
+
+class Davie3(_Level3):
+    r"""Third-order Davie-type (Taylor) step: :math:`Y + \sum_{1\le|w|\le3}\mathbf{X}^w_{s,t}V_w(Y)`.
+
+    .. math:: Y' = Y + V_i x^i + (DV_j\cdot V_i)\,\mathbb{X}^{ij}
+              + \big(D^2V_k[V_j, V_i] + DV_k\cdot DV_j\cdot V_i\big)\,\mathbb{X}^{ijk}
+
+    with the full (not log) step signature. A drift is treated as in :class:`~roughpaths.Davie`
+    (trapezoidal rule at the Euler predictor and the cross term :math:`\tfrac12 h x^i DV_i\cdot V_0`).
+
+    Parameters
+    ----------
+    hessians : callable, optional
+        As for :class:`LogODE3`.
+    """
+
+    order = 1.5
+    smooth_order = 3.0
+
+    def step(self, fields, y, t, dt, dX, dXX):
+        XX, XXX = _split_levels(dXX, "Davie3")
+        if getattr(fields, "is_linear", False):
+            G = self._linear_generator(fields, dX, XX, XXX)
+            noise_and_more = matvec(G, y)
+            out = y + noise_and_more
+            if fields.has_drift:
+                A = fields.drift_matrix
+                M1 = self._linear_products(fields)[0]
+                e = fields.dim_state
+                Mx = vecmat(dX, M1).reshape(dX.shape[:-1] + (e, e))
+                f0 = matvec(A, y)
+                f1 = matvec(A, y + f0 * dt + matvec(Mx, y))
+                out = out + 0.5 * dt * (f0 + f1) + 0.5 * dt * matvec(Mx, f0)
+            return out
+        V = fields.fields(y)
+        J = fields.jacobians(y)
+        noise = (V @ dX[..., None])[..., 0]
+        out = y + noise + _second_order(J, V, XX) + self._third(fields, y, V, J, XXX)
+        if not fields.has_drift:
+            return out
+        f0 = fields.drift(y)
+        f1 = fields.drift(y + f0 * dt + noise)
+        cross = _second_order(J, f0[..., None], dX[..., None, :])
+        return out + 0.5 * dt * (f0 + f1) + 0.5 * dt * cross
