@@ -320,12 +320,16 @@ class VectorFields:
         f, fj = _parse_drift(extra, jacobian, self.dim_state, self.time_dependent)
         if f is None:
             return self
-        old, oldj = self._drift, self._drift_jac
         new = object.__new__(VectorFields)
         new.dim_state, new.dim_noise = self.dim_state, self.dim_noise
         new.time_dependent = self.time_dependent
         new._fields, new._jac = self._fields, self._jac
         new._raw = (self._raw[0], self._raw[1], extra) if hasattr(self, "_raw") else (None, None, extra)
+        return self._add_drift_to(new, f, fj)
+
+    def _add_drift_to(self, new, f, fj):
+        """Give ``new`` the drift of this family plus ``f`` (Jacobian ``fj``), check it and return it."""
+        old, oldj = self._drift, self._drift_jac
         if old is None:
             new._drift, new._drift_jac = f, fj
         else:
@@ -487,15 +491,7 @@ class LinearVectorFields(VectorFields):
             return self
         if _linear_part(f) is not None and self.is_linear:
             return LinearVectorFields(self.matrices, LinearDrift(self.drift_matrix + _linear_part(f).matrix))
-        old, oldj = self._drift, self._drift_jac
-        new = LinearVectorFields(self.matrices)
-        if old is None:
-            new._drift, new._drift_jac = f, fj
-        else:
-            new._drift = _Sum(old, f)
-            new._drift_jac = None if (oldj is None or fj is None) else _Sum(oldj, fj)
-        new._check_shapes()
-        return new
+        return self._add_drift_to(LinearVectorFields(self.matrices), f, fj)
 
     with_drift.__doc__ = VectorFields.with_drift.__doc__
 
