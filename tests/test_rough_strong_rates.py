@@ -15,12 +15,12 @@ is below ``(N+1)H - 1/2 + 0.35``; except for Davie3 it is also above ``(N+1)H - 
 higher, error at the finest grid at most half) than the level-2 one. Measured (reduced size, seed 7):
 at ``H = 0.4`` Davie 0.77, LogODE 0.73, Davie3 0.88, LogODE3 1.26 (``(N+1)H - 1/2`` = 0.7, 0.7, 1.1, 1.1);
 at ``H = 0.3`` Davie 0.45, LogODE 0.32, Davie3 0.62, LogODE3 0.70 (0.4, 0.4, 0.7, 0.7). The Taylor-type
-Davie3 sits below ``4H - 1/2``, about 0.15 above the pathwise ``4H - 1`` (full size, 256 paths, seed 8:
-0.94, 0.77, 0.62 at ``H = 0.45, 0.4, 0.35`` against ``4H - 1`` = 0.8, 0.6, 0.4, while LogODE3 gives
-1.26, 1.07, 0.89): its local error is the whole level-4 signature, whose even words (``x_i^4/24``,
-...) have non-zero mean and add up coherently over the steps, while the log-ODE's is only the
-level-4 log-signature. Its level-3 terms are right: on smooth drivers it has order 3
-(``tests/test_level3_solvers.py``).
+Davie3 sits below ``4H - 1/2``, above the pathwise ``4H - 1`` (full size, 256 paths, seed 8: 0.94, 0.77,
+0.62, 0.46 at ``H = 0.45, 0.4, 0.35, 0.3`` against ``4H - 1`` = 0.8, 0.6, 0.4, 0.2, while LogODE3 gives
+1.26, 1.07, 0.89, 0.70): its local error is the level-4 signature, whose even words have non-zero mean
+and add up coherently over the steps (asymptotic rate ``4H - 1``), while the log-ODE's is the level-4
+log-signature, of mean zero because fBM is reversible in law (see :mod:`roughpaths.solvers_level3`).
+Its level-3 terms are right: on smooth drivers it has order 3 (``tests/test_level3_solvers.py``).
 """
 
 import numpy as np
