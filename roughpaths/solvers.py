@@ -58,7 +58,8 @@ class Solver:
        with the increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` for a
        level-1 solver; for a level-3 solver the tuple ``(XX, XXX)`` of the step's level-2 and level-3
        components, shapes ``(..., d, d)`` and ``(..., d, d, d)``), vectorised over the leading
-       (broadcast) batch axes. Each batch member's result must depend on that member's data only (no reductions or shared scalings over the batch).
+       (broadcast) batch axes. Each batch member's result must depend on that member's data only
+       (no reductions or shared scalings over the batch).
     8. ``integrate(fields, y, times, dX, dXX, save, stop_on_failure)``: advance a block of steps
        (``times`` of shape ``(K + 1,)``, ``dX`` ``(..., K, d)``, ``dXX`` ``(..., K, d, d)`` or ``None``,
        or for ``increment_level = 3`` the tuple ``(XX (..., K, d, d), XXX (..., K, d, d, d))``,
