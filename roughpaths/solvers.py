@@ -52,7 +52,7 @@ class Solver:
        e.g. ``("casimirs",)`` for coadjoint schemes; empty for the generic schemes.
     5. ``check_fields(fields)``: return the object to integrate, or raise ``TypeError`` naming what
        this solver accepts. The default accepts :class:`~roughpaths.vector_fields.VectorFields`.
-    6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath`` or a
+    6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath``, ``RoughPathN`` or a
        :class:`~roughpaths.driver.Driver`) cannot drive this scheme. The default checks the level.
     7. ``step(fields, y, t, dt, dX, dXX)``: one step from ``y`` (``(..., e)``) over ``[t, t + dt]``
        with the increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` for a
