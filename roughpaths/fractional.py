@@ -95,7 +95,7 @@ def fgn_autocovariance(hurst, n: int) -> np.ndarray:
     return 0.5 * (np.abs(k + 1) ** (2 * H) - 2 * k ** (2 * H) + np.abs(k - 1) ** (2 * H))
 
 
-def _davies_harte(gamma_ext: np.ndarray, n_series: int, rng: np.random.Generator):
+def _davies_harte(gamma_ext: np.ndarray, n_series: int, rng: np.random.Generator, scale: float = 1.0):
     r"""``(n_series, K)`` unit-step fGn samples by circulant embedding, or None if the embedding is not PSD.
 
     ``gamma_ext`` is :math:`\gamma(0..K)` (``K + 1`` entries); the circulant's first row is
@@ -108,7 +108,7 @@ def _davies_harte(gamma_ext: np.ndarray, n_series: int, rng: np.random.Generator
     tol = 1e-10 * float(np.max(np.abs(lam)))
     if float(np.min(lam)) < -tol:
         return None
-    weight = np.sqrt(np.clip(lam, 0.0, None) / M)
+    weight = scale * np.sqrt(np.clip(lam, 0.0, None) / M)
     n_fft = (n_series + 1) // 2
     w = np.empty((n_fft, M), dtype=np.complex128)
     rng.standard_normal(out=w.view(np.float64))            # real, imaginary parts interleaved
@@ -190,14 +190,16 @@ def fbm(n_steps: int, hurst, *, rng, T: float = 1.0, dim: int = 1, batch_shape=(
     gamma = fgn_autocovariance(H, K + 1)
     x = None
     if method == "davies-harte":
-        x = _davies_harte(gamma, n_series, rng)
+        x = _davies_harte(gamma, n_series, rng, scale=(T / K) ** H)
     if x is None:
         x = _cholesky(gamma[:K], n_series, rng)
-    x *= (T / K) ** H
-    out = np.empty((n_series, K + 1))
-    out[:, 0] = 0.0
-    np.cumsum(x, axis=-1, out=out[:, 1:])
-    return np.ascontiguousarray(np.moveaxis(out.reshape(batch_shape + (d, K + 1)), -2, -1))
+        x *= (T / K) ** H
+    nb = n_series // d
+    out = np.empty((nb, K + 1, d))
+    out[:, 0, :] = 0.0
+    # cumulative sums written straight into the (batch, time, component) layout
+    np.cumsum(x.reshape(nb, d, K), axis=-1, out=np.swapaxes(out[:, 1:, :], -1, -2))
+    return out.reshape(batch_shape + (K + 1, d))
 
 
 def piecewise_linear_lift(values, substeps: int, *, level: int = 2, times=None):

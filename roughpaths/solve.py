@@ -135,8 +135,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     driver : RoughPath, RoughPathN or Driver
         Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.driver.Driver` is
         consumed block by block (memory for one block). Level 2 for level-2 solvers, a
-        :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``). Convention:
-        area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
+        :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``).
+        Convention: area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
     y0 : array_like, shape ``(..., e)``
         Initial condition(s); the batch ``B_y`` broadcasts against ``B_X``.
     solver : Solver instance or str, optional
@@ -200,8 +200,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
                             on_failure=on_failure, block_steps=block_steps)
     if not isinstance(driver, (RoughPath, RoughPathN, Driver)):
-        raise TypeError(f"driver must be a RoughPath, a RoughPathN or a Driver (e.g. roughpaths.BrownianDriver), got "
-                        f"{type(driver).__name__}; build a path with RoughPath.from_path(values, times=...) "
+        raise TypeError(f"driver must be a RoughPath, a RoughPathN or a Driver (e.g. roughpaths.BrownianDriver), "
+                        f"got {type(driver).__name__}; build a path with RoughPath.from_path(values, times=...) "
                         f"or RoughPath(increments, areas, times=...).")
     if on_failure not in ("raise", "mask"):
         raise ValueError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}.")

@@ -52,13 +52,14 @@ class Solver:
        e.g. ``("casimirs",)`` for coadjoint schemes; empty for the generic schemes.
     5. ``check_fields(fields)``: return the object to integrate, or raise ``TypeError`` naming what
        this solver accepts. The default accepts :class:`~roughpaths.vector_fields.VectorFields`.
-    6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath`` or a
+    6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath``, ``RoughPathN`` or a
        :class:`~roughpaths.driver.Driver`) cannot drive this scheme. The default checks the level.
     7. ``step(fields, y, t, dt, dX, dXX)``: one step from ``y`` (``(..., e)``) over ``[t, t + dt]``
        with the increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` for a
        level-1 solver; for a level-3 solver the tuple ``(XX, XXX)`` of the step's level-2 and level-3
-       components, shapes ``(..., d, d)`` and ``(..., d, d, d)``), vectorised over the leading (broadcast) batch axes. Each batch member's
-       result must depend on that member's data only (no reductions or shared scalings over the batch).
+       components, shapes ``(..., d, d)`` and ``(..., d, d, d)``), vectorised over the leading
+       (broadcast) batch axes. Each batch member's result must depend on that member's data only
+       (no reductions or shared scalings over the batch).
     8. ``integrate(fields, y, times, dX, dXX, save, stop_on_failure)``: advance a block of steps
        (``times`` of shape ``(K + 1,)``, ``dX`` ``(..., K, d)``, ``dXX`` ``(..., K, d, d)`` or ``None``,
        or for ``increment_level = 3`` the tuple ``(XX (..., K, d, d), XXX (..., K, d, d, d))``,

@@ -20,17 +20,25 @@ Jacobians along the fields, :math:`D(DV_k)[V_i] \approx (J_k(y + \varepsilon V_i
 (``2d`` extra Jacobian evaluations per step, relative accuracy about ``1e-10`` for smooth fields);
 they vanish for :class:`~roughpaths.LinearVectorFields`, where every term is a matrix product.
 
-============  =====  =====================  ============  =========================================
-solver        level  order (BM; fBM H<1/2)  smooth order  note
-============  =====  =====================  ============  =========================================
-``LogODE3``   3      1.5; 4H - 1            3             flow of the level-3 log-signature field
-``Davie3``    3      1.5; 4H - 1            3             third-order Taylor (Davie-type) step
-============  =====  =====================  ============  =========================================
+============  =====  ========================  ============  ======================================
+solver        level  order (BM; fBM H<1/2)     smooth order  note
+============  =====  ========================  ============  ======================================
+``LogODE3``   3      1.5; 4H - 1/2 (measured)  3             flow of the level-3 log-signature field
+``Davie3``    3      1; 4H - 1                 3             third-order Taylor (Davie-type) step
+============  =====  ========================  ============  ======================================
 
-The fBM rate :math:`4H - 1` is the pathwise rate :math:`(N+1)/p - 1` of a step-``N`` scheme with exact
-step signatures (Friz–Victoir, Thm 10.30), ``N = 3``, ``p`` just above ``1/H``; measured rates are in
-``tests/test_rough_strong_rates.py``. With a drift the space–time iterated integrals are approximated
-(as in :class:`~roughpaths.Davie`), which limits the smooth order to 2.
+Why the two differ on random drivers: a step's error is, to leading order, the level-4 part the scheme
+leaves out. For the log-ODE method that is the level-4 **log**-signature, whose mean vanishes for
+Brownian and fractional Brownian motion (their increments are reversible in law, and reversal maps the
+log-signature ``ℓ`` to ``−ℓ``), so the step errors cancel like a sum of centred terms: rate
+``(N+1)H − 1/2``, i.e. 1.5 for Brownian motion. For the Taylor step it is the level-4 **signature**, whose
+even words have non-zero mean (``E[X^4]/24`` for ``d = 1``: the scalar ``dY = Y∘dW`` already loses
+``h²/8`` per step in ``log Y``), which adds up coherently: rate ``4H − 1``, i.e. 1 for Brownian motion.
+That is the pathwise rate ``(N+1)/p − 1`` of a step-``N`` scheme with exact step signatures
+(Friz–Victoir, Thm 10.30, ``N = 3``, ``p`` just above ``1/H``), which both schemes satisfy. Measured
+rates are in ``tests/test_rough_strong_rates.py`` (pre-asymptotically Davie3 fits 0.15–0.25 above
+``4H − 1``). With a drift the space–time iterated integrals are approximated (as in
+:class:`~roughpaths.Davie`), which limits the smooth order to 2.
 """
 
 from __future__ import annotations
@@ -152,10 +160,11 @@ class LogODE3(_Level3):
 
     .. math:: W = V_0 h + \sum_i x^i V_i + \sum_{ij}\ell_2^{ij} V_{(i,j)} + \sum_{ijk}\ell_3^{ijk} V_{(i,j,k)},
 
-    which, since :math:`\ell` is a Lie element, is the bracket expansion
-    :math:`\tfrac12\sum A^{ij}[V_i,V_j] + \sum \ell_3^{ijk}`-weighted brackets of brackets (the
-    second-order parts of the word operators cancel; the ``D²V`` terms are kept so that a slightly
-    non-geometric input is still integrated consistently).
+    Since :math:`\ell` is a Lie element this is a bracket expansion: the level-2 part is
+    :math:`\tfrac12\sum A^{ij}[V_i, V_j]` and the level-3 part a combination of the brackets of brackets
+    :math:`[V_i, [V_j, V_k]]` (the Lyndon coordinates of :math:`\ell_3` times the brackets of their
+    words); the :math:`D^2V` parts of the word operators cancel in that sum. They are still computed, so
+    that a slightly non-geometric input is integrated consistently.
 
     * :class:`~roughpaths.LinearVectorFields` with a linear drift: exact flow
       :math:`Y' = \exp(G)Y`, :math:`G = A_0h + \sum x^iM_i + \sum\ell_2^{ij}M_jM_i + \sum\ell_3^{ijk}M_kM_jM_i`.
@@ -235,7 +244,7 @@ class Davie3(_Level3):
         As for :class:`LogODE3`.
     """
 
-    order = 1.5
+    order = 1.0
     smooth_order = 3.0
 
     def step(self, fields, y, t, dt, dX, dXX):

@@ -109,3 +109,42 @@ def test_levels_are_checked():
         Davie3().step(FIELDS, Y0, 0.0, 0.1, np.zeros(2), np.zeros((2, 2)))
     with pytest.raises(TypeError, match="hessians"):
         LogODE3(hessians=np.zeros(3))
+
+
+def _poly_fields():
+    def f(y):                                    # polynomial: elementwise-exact arithmetic
+        return np.stack([0.3 * y * y - y[..., ::-1], 0.2 * y[..., [1, 2, 0]] * y], axis=-1)
+
+    def jf(y):
+        e = y.shape[-1]
+        J = np.zeros(y.shape[:-1] + (2, e, e))
+        idx = np.arange(e)
+        J[..., 0, idx, idx] += 0.6 * y
+        J[..., 0, idx, idx[::-1]] -= 1.0
+        J[..., 1, idx, [1, 2, 0]] += 0.2 * y
+        J[..., 1, idx, idx] += 0.2 * y[..., [1, 2, 0]]
+        return J
+
+    return VectorFields(f, jf, dim_state=3, dim_noise=2, drift=lambda y: -0.1 * y)
+
+
+@pytest.mark.parametrize("kind", ["linear", "polynomial"])
+@pytest.mark.parametrize("solver", [Davie3(), LogODE3()], ids=repr)
+@pytest.mark.parametrize("seed", [0, 1])
+def test_batch_members_independent(kind, solver, seed):
+    """Each member's result is, bit for bit, its result alone (one member far out of scale, one NaN)."""
+    rng = np.random.default_rng(seed)
+    V = (LinearVectorFields(0.5 * rng.standard_normal((2, 3, 3)), drift=0.3 * rng.standard_normal((3, 3)))
+         if kind == "linear" else _poly_fields())
+    X = RoughPathN.from_path(np.cumsum(rng.normal(0, 0.1, (4, 17, 2)), axis=-2), 3)
+    sig = X.step_signatures.copy()
+    sig[1] *= 1e3                                                  # out of scale (not group-like: fine)
+    sig[3, 5, 0] = np.nan
+    with np.errstate(all="ignore"):
+        Y = RoughPathN(sig, 2, times=X.times, check=False)
+        sol = solve(V, Y, np.ones(3), solver, on_failure="mask")
+        for i in range(4):
+            alone = solve(V, RoughPathN(sig[i], 2, times=X.times, check=False), np.ones(3), solver,
+                          on_failure="mask")
+            assert np.array_equal(sol.states[i], alone.states, equal_nan=True), i
+    assert sol.failed_step[3] == 5 and sol.failed_step[0] == -1

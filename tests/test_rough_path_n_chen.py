@@ -97,3 +97,19 @@ def test_batch_axes_and_indexing():
     assert X.batch_shape == (2,) and X.n_steps == 16 and X.dim == 3 and X.level == 2
     np.testing.assert_allclose(X[1].signature(0.0, 2.0), iisignature.sig(V[1], 2), atol=1e-12)
     assert X.areas.shape == (2, 16, 3, 3) and X.increments.shape == (2, 16, 3)
+
+
+def test_group_roundtrips():
+    """perturb(s) then perturb(-s), and reversing twice, give the path back (to round-off)."""
+    X = RoughPathN.from_path(V, 3, times=T)
+    s = np.array([[0.0, 0.4, -0.2], [-0.4, 0.0, 0.7], [0.2, -0.7, 0.0]])
+    np.testing.assert_allclose(X.perturb(s).perturb(-s).step_signatures, X.step_signatures, atol=1e-12)
+    np.testing.assert_allclose(X.reverse().reverse().step_signatures, X.step_signatures, atol=1e-12)
+    np.testing.assert_allclose(X.reverse().reverse().times, T)
+    # the perturbation changes level 3 by ½(x⊗s h + s h⊗x) per step (exp(ℓ + s h) with level-1 x)
+    h = T[1] - T[0]
+    x = X.increments
+    d3 = X.perturb(s).step_level(3) - X.step_level(3)
+    expect = 0.5 * (x[..., :, None, None] * (s * h)[None, None, None] + (s * h)[None, None, :, :, None]
+                    * x[..., None, None, :])
+    np.testing.assert_allclose(d3, expect, atol=1e-12)
