@@ -5,8 +5,9 @@ with :math:`E[B^H_s B^H_t] = \tfrac12(s^{2H} + t^{2H} - |t-s|^{2H})`; its compon
 independent. For :math:`H<\tfrac12` it is not a semimartingale: Itô and Stratonovich calculus do not
 apply and an equation driven by it means the RDE driven by a rough-path lift.
 
-Sampling (:func:`fbm`)
-----------------------
+Sampling
+--------
+:func:`fbm` draws the path.
 The increments on a uniform grid of step ``h`` (fractional Gaussian noise) have autocovariance
 :math:`h^{2H}\gamma(k)`, :math:`\gamma(k) = \tfrac12(|k+1|^{2H} - 2|k|^{2H} + |k-1|^{2H})`
 (:func:`fgn_autocovariance`). ``method="davies-harte"`` embeds this Toeplitz covariance into a circulant of
@@ -16,8 +17,9 @@ gives **two** independent exact samples (real and imaginary parts). ``method="ch
 ``K x K`` covariance (``O(K^3)``, for short grids, and the fallback if the embedding ever had a
 negative eigenvalue beyond round-off). Both are exact in law; they use the random stream differently.
 
-Lift (:func:`piecewise_linear_lift`, :func:`fbm_rough_path`)
--------------------------------------------------------------
+Lift
+----
+:func:`piecewise_linear_lift` and :func:`fbm_rough_path` lift it.
 The rough path is the signature of the piecewise-linear interpolation of a sample on a **fine** grid
 (mesh :math:`\delta = h/m`, ``m`` substeps per coarse step), assembled on the coarse grid by Chen.
 

@@ -252,8 +252,7 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     Returns
     -------
     ndarray, shape ``(..., n, d)``
-        :math:`\partial \langle G, S(x) 
-angle / \partial x`, the same quantity as
+        :math:`\partial \langle G, S(x) \rangle / \partial x`, the same quantity as
         ``iisignature.sigbackprop(G, paths, m)``.
 
     Notes
@@ -296,8 +295,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     Returns
     -------
     ndarray, shape ``(..., n, d)``
-        :math:`\partial \langle G, \mathrm{logsig}(x) 
-angle / \partial x`, the same quantity as
+        :math:`\partial \langle G, \mathrm{logsig}(x) \rangle / \partial x`, the same quantity as
         ``iisignature.logsigbackprop(G, paths, prepare(d, m))``.
 
     Notes
