@@ -31,6 +31,7 @@ from .gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
 from .heavy_top import HeavyTop, heavy_top
 from .integrators import (
     ChordConvergenceError,
+    CoadjointSolver,
     ImplicitMidpoint,
     LieEuler,
     LieHeun,
@@ -39,7 +40,7 @@ from .integrators import (
     simulate,
     simulate_brownian,
 )
-from .lie_algebra import LieAlgebra, hat, se3, sl2r, so3, su2, vee
+from .lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra, hat, se3, sl2r, so3, su2, vee
 from .lie_poisson import Hamiltonian, LiePoissonSystem, QuadraticHamiltonian, check_inertia, girsanov_shift
 from .rigid_body import RigidBody, isotropic_xi, rigid_body
 from .wong_zakai import (
@@ -58,12 +59,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     # Lie algebras
-    "LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
+    "LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
     # Lie–Poisson systems
     "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     # integrators
-    "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
+    "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
     "simulate", "simulate_brownian", "check_on_orbit",
     # equilibria, phase portraits, Gibbs measures
     "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",

@@ -248,9 +248,7 @@ def _observable_sum(observable, window):
 
 def _run_chunk(spec: _Spec, first: int, last: int):
     """Simulate paths ``first .. last-1``; return their statistics (picklable)."""
-    from roughpaths.rough_path import RoughPath
-
-    from .integrators import simulate
+    from roughpaths import RoughPath, solve
 
     system = spec.system
     c = last - first
@@ -275,10 +273,10 @@ def _run_chunk(spec: _Spec, first: int, last: int):
         times = (step + np.arange(k + 1)) * spec.dt
         if areas is None:                                            # level 1: zero step Lévy area
             X = RoughPath.from_increments(dW, None, times=times)
-            _, states = simulate(system, mu, X, spec.method, levy_area=False)   # (c, k+1, n)
+            states = solve(system, X, mu, spec.method).states        # (c, k+1, n)
         else:
             X = RoughPath(dW, areas, times=times, kind="geometric", check=False)
-            _, states = simulate(system, mu, X, spec.method)        # (c, k+1, n)
+            states = solve(system, X, mu, spec.method).states        # (c, k+1, n)
         idx = step + np.arange(1, k + 1)                             # global step numbers of states[:, 1:]
         # averaged steps: idx > burn_in and idx % average_every == 0, as a strided slice (no copy)
         first_ok = max(spec.burn_in + 1, step + 1)
@@ -353,9 +351,18 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     >>> bool(np.array_equal(a.final_states, b.final_states))
     True
     """
+    from .integrators import CoadjointSolver, LieHeun
+
     if method is None:
-        from .integrators import LieHeun
         method = LieHeun()
+    if not isinstance(method, CoadjointSolver):
+        raise TypeError(f"method must be a coadjoint solver instance (LieEuler(), LieHeun(), ImplicitMidpoint()), "
+                        f"got {method!r}" + (f"; did you mean {method.__name__}()?" if isinstance(method, type)
+                                             else "."))
+    if method.levy_area != (levy_area is not None):                 # the driving level follows levy_area
+        import copy
+        method = copy.copy(method)
+        method.levy_area = levy_area is not None
     for attr in ("dim", "n_noise"):
         if not hasattr(system, attr):
             raise TypeError(f"system must be a LiePoissonSystem (needs .{attr}), got {type(system).__name__}.")

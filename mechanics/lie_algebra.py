@@ -30,7 +30,8 @@ import scipy.linalg
 from roughpaths.validation import as_float_array
 from roughpaths import expm_batched
 
-__all__ = ["LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee", "rodrigues_ad_star_exp", "se3_ad_star_exp"]
+__all__ = ["LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
+           "rodrigues_ad_star_exp", "se3_ad_star_exp"]
 
 
 def hat(x) -> np.ndarray:
@@ -312,13 +313,46 @@ def _sphere_casimir(mu):
     return np.einsum("...i,...i->...", mu, mu)[..., None]
 
 
-def so3() -> LieAlgebra:
+class SO3Algebra(LieAlgebra):
+    r"""so(3) ≅ (R³, ×) in the basis ``hat(e_i)`` (``c = ε_{ijk}``), with the Rodrigues exponential.
+
+    A type, so that solvers can choose their compiled so(3) kernels by ``isinstance`` (an
+    implementation detail behind :func:`roughpaths.solve`). Build it with :func:`so3`.
+    """
+
+    def __init__(self):
+        super().__init__(_levi_civita(), name="so3", basis=hat(np.eye(3)), casimirs=_sphere_casimir,
+                         casimir_names=("|mu|^2",), ad_star_exp=rodrigues_ad_star_exp)
+
+    def __reduce__(self):
+        return (SO3Algebra, ())
+
+
+class SE3Algebra(LieAlgebra):
+    r"""se(3) = so(3) ⋉ R³ in coordinates ``(omega, v)``, with its closed-form coadjoint exponential.
+
+    A type (see :class:`SO3Algebra`). Build it with :func:`se3`.
+    """
+
+    def __init__(self):
+        basis = np.zeros((6, 4, 4))
+        basis[:3, :3, :3] = hat(np.eye(3))
+        for i in range(3):
+            basis[3 + i, i, 3] = 1.0
+        alg = LieAlgebra.from_matrix_basis(basis, name="se3")
+        super().__init__(alg._c, name="se3", basis=basis, casimirs=_se3_casimirs,
+                         casimir_names=("|Gamma|^2", "Pi.Gamma"), ad_star_exp=se3_ad_star_exp, check=False)
+
+    def __reduce__(self):
+        return (SE3Algebra, ())
+
+
+def so3() -> SO3Algebra:
     r"""so(3) ≅ (R³, ×): :math:`[x, y] = x\times y`, ``c = ε_{ijk}``; matrix basis ``hat(e_i)``.
 
     Casimir :math:`|\mu|^2`; :meth:`LieAlgebra.Ad_star_exp` in closed form (Rodrigues).
     """
-    return LieAlgebra(_levi_civita(), name="so3", basis=hat(np.eye(3)), casimirs=_sphere_casimir,
-                      casimir_names=("|mu|^2",), ad_star_exp=rodrigues_ad_star_exp)
+    return SO3Algebra()
 
 
 def su2() -> LieAlgebra:
@@ -361,7 +395,7 @@ def se3_ad_star_exp(sigma, mu) -> np.ndarray:
     return np.concatenate([rodrigues_ad_star_exp(w, p), rodrigues_ad_star_exp(w, gam)], axis=-1)
 
 
-def se3() -> LieAlgebra:
+def se3() -> SE3Algebra:
     r"""se(3) = so(3) ⋉ R³, coordinates ``x = (omega, v)`` (6-vector), the heavy top's algebra.
 
     Matrix basis: :math:`\begin{pmatrix}\hat\omega & v\\ 0 & 0\end{pmatrix}` (4×4), so
@@ -370,13 +404,7 @@ def se3() -> LieAlgebra:
     :math:`\mathrm{ad}^*_{(\omega, v)}(\Pi,\Gamma) = (\Pi\times\omega + \Gamma\times v,\ \Gamma\times\omega)`.
     Casimirs :math:`|\Gamma|^2` and :math:`\Pi\cdot\Gamma` (not semisimple).
     """
-    basis = np.zeros((6, 4, 4))
-    basis[:3, :3, :3] = hat(np.eye(3))
-    for i in range(3):
-        basis[3 + i, i, 3] = 1.0
-    return LieAlgebra.from_matrix_basis(basis, name="se3", casimirs=_se3_casimirs,
-                                        casimir_names=("|Gamma|^2", "Pi.Gamma"),
-                                        ad_star_exp=se3_ad_star_exp)
+    return SE3Algebra()
 
 
 def sl2r() -> LieAlgebra:

@@ -177,7 +177,8 @@ class QuadraticHamiltonian(Hamiltonian):
         return 0.5 * np.einsum("...i,ij,...j->...", mu, self.q, mu) + mu @ self.linear
 
     def _grad(self, mu):
-        return mu @ self.q + self.linear
+        # stacked mat-vec, not (B, n) @ (n, n): a batch member's gradient must not depend on the batch
+        return (self.q.T @ np.asarray(mu, dtype=np.float64)[..., None])[..., 0] + self.linear
 
     def _hess(self, mu):
         return np.broadcast_to(self.q, np.shape(mu)[:-1] + self.q.shape)
@@ -336,6 +337,38 @@ class LiePoissonSystem:
         return self.xi.shape[0]
 
     @property
+    def dim_state(self) -> int:
+        """Dimension ``n`` of the state (for :func:`roughpaths.solve`; equals :attr:`dim`)."""
+        return self.algebra.dim
+
+    @property
+    def dim_noise(self) -> int:
+        """Dimension ``m`` of the driver (for :func:`roughpaths.solve`; equals :attr:`n_noise`)."""
+        return self.xi.shape[0]
+
+    def quadratic_velocity_data(self):
+        r"""Constants of :math:`w(\mu)` for a quadratic Hamiltonian :math:`h = \tfrac12\mu\cdot Q\mu + b\cdot\mu`.
+
+        :math:`w(\mu) = g + \vartheta M^{-1}(\mathrm{ad}^*_{g + f}\mu)` with :math:`g = Q\mu + b + \ell'`
+        (:math:`\ell'` the torque velocity), :math:`f` the change of the gradient inside the double
+        bracket (``0``, or :math:`-\ell'` with ``levy_in_dissipation=False``). Used by compiled kernels.
+
+        Returns
+        -------
+        dict with ``q (n, n)``, ``linear (n,)`` (:math:`b + \ell'`), ``dissipation_change (n,)`` (:math:`f`),
+        ``metric_inv (n, n)`` (identity by default) and ``theta``; ``None`` if ``h`` is not quadratic.
+        """
+        h = self.hamiltonian
+        if not h.is_quadratic:
+            return None
+        n = self.dim
+        minv = np.eye(n) if self._metric_inv is None else self._metric_inv
+        return {"q": np.ascontiguousarray(h.q, dtype=np.float64),
+                "linear": np.asarray(h.linear + self._shift, dtype=np.float64),
+                "dissipation_change": np.asarray(self._shift_dissipation - self._shift, dtype=np.float64),
+                "metric_inv": np.ascontiguousarray(minv, dtype=np.float64), "theta": self.theta}
+
+    @property
     def levy_velocity(self) -> np.ndarray:
         r""":math:`\ell = \tfrac12\sum_{i,j}\mathsf s^{ij}[\xi_i,\xi_j]` (rough-path-correct sign, with the ½), shape ``(n,)``."""
         return self._levy_velocity
@@ -396,7 +429,7 @@ class LiePoissonSystem:
         return self.hamiltonian.gradient(mu) + self._shift_dissipation
 
     def _sharp(self, v):
-        return v if self._metric_inv is None else v @ self._metric_inv
+        return v if self._metric_inv is None else (self._metric_inv.T @ v[..., None])[..., 0]
 
     def casimirs(self, mu) -> np.ndarray:
         """Casimirs of the algebra at ``mu``, shape ``(..., k)``."""
@@ -424,6 +457,10 @@ class LiePoissonSystem:
         :math:`\mathrm{ad}^*_{w(\mu)}\mu` (with ``levy_in_dissipation=False`` the second
         :math:`\nabla\tilde h` is :math:`\nabla h`). Shape ``(..., n)``."""
         return self._w(self._mu(mu))
+
+    def drift_velocity_jacobian(self, mu) -> np.ndarray:
+        r""":math:`Dw(\mu)`, shape ``(..., n, n)`` (``[..., a, b] = ∂w_a/∂μ_b``)."""
+        return self._w_jacobian(self._mu(mu))
 
     def _w(self, mu):
         g = self._grad_tilde(mu)
@@ -504,10 +541,12 @@ class LiePoissonSystem:
         Replacing :math:`A` by :math:`A + \mathsf s\,\Delta t` adds exactly :math:`\ell\,\Delta t`.
         """
         inc = np.asarray(increments, dtype=np.float64)
-        out = inc @ self.xi
+        out = (self.xi.T @ inc[..., None])[..., 0]                # stacked mat-vec: no coupling across the batch
         if levy_areas is not None:
-            out = out + 0.5 * np.einsum("...ij,ijk->...k", np.asarray(levy_areas, dtype=np.float64),
-                                        self._xi_brackets)
+            a = np.asarray(levy_areas, dtype=np.float64)
+            m = self.n_noise
+            brk = self._xi_brackets.reshape(m * m, self.dim).T
+            out = out + 0.5 * (brk @ a.reshape(a.shape[:-2] + (m * m, 1)))[..., 0]
         return out
 
 

@@ -123,7 +123,7 @@ def test_bad_drivers_and_shapes(rng):
     ito = RoughPath(X.increments, X.areas - 0.05 * np.eye(3), times=X.times, kind="ito")
     with pytest.raises(ValueError, match="geometric"):
         simulate(rb, [0, 0, 1.0], ito)
-    with pytest.raises(ValueError, match="dimension 2"):
+    with pytest.raises(ValueError, match="dimension d=2"):
         simulate(rb, [0, 0, 1.0], RoughPath.from_path(vals[:, :2]))
     with pytest.raises(ValueError, match="mu0 must have trailing shape"):
         simulate(rb, [0, 1.0], X)
