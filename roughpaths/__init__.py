@@ -5,7 +5,7 @@ Conventions are fixed once, in ``CONVENTIONS.md`` of the project: the area ``XX[
 Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """
 
-from .brownian import DEFAULT_SUBSTEPS, brownian_increments_and_areas, brownian_rough_path, refine
+from .brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path, refine
 from .coloured_noise import (
     ColouredNoiseLimit,
     ColouredNoiseSample,
@@ -86,6 +86,7 @@ __all__ = [
     "RoughPath",
     "chen_defect",
     "brownian_rough_path",
+    "BrownianDriver",
     "brownian_increments_and_areas",
     "refine",
     "DEFAULT_SUBSTEPS",

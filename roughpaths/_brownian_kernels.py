@@ -105,3 +105,82 @@ def _step_areas(dW, h, z, zeta, lam, m, davie, ito, out):
                 out[r, i, j] = sym + v
                 out[r, j, i] = sym - v
                 p += 1
+
+
+@njit(cache=True, nogil=True)
+def _block_areas(dW, h, buf, m, davie, ito, out):
+    """Level-2 step areas of a block ``(P, K)`` of path-steps from the per-step packed normals.
+
+    Same arithmetic as :func:`_step_areas`, with the layout of :class:`roughpaths.BrownianDriver`'s
+    area stream: ``buf[p, k]`` holds, in this order, the bridge normals ``z`` (``m d``,
+    substep-major, only if ``m > 1``), the space-time normals ``ζ`` (``m d``) and, for Davie's
+    method, the ``d(d-1)/2`` normals ``λ`` (``numpy.triu_indices`` order).
+
+    Parameters
+    ----------
+    dW : (P, K, d) float64
+        Step increments.
+    h : (K,) float64
+        Step sizes.
+    buf : (P, K, n_area) float64
+        Standard normals, ``n_area = (m d if m > 1 else 0) + m d + (d(d-1)/2 if davie else 0)``.
+    m : int
+        Substeps per step.
+    davie, ito : bool
+        Add Davie's independent Gaussian; subtract ``½ h I`` (Itô areas).
+    out : (P, K, d, d) float64
+        Receives ``A + ½ W⊗W (- ½ h I)``.
+    """
+    P, K, d = dW.shape
+    npair = d * (d - 1) // 2
+    inv_m = 1.0 / m
+    inv_s12 = 1.0 / np.sqrt(12.0)
+    lam_scale = 1.0 / np.sqrt(12.0 * m)
+    o_zeta = m * d if m > 1 else 0
+    o_lam = o_zeta + m * d
+    shift = np.zeros(d)
+    s = np.empty(d)
+    w = np.empty(d)
+    a = np.empty(d)
+    A = np.empty(max(npair, 1))
+    for p in range(P):
+        for r in range(K):
+            hr = h[r]
+            sq = np.sqrt(hr * inv_m)
+            sH = sq * inv_s12
+            if m > 1:
+                for j in range(d):
+                    acc = 0.0
+                    for k in range(m):
+                        acc += buf[p, r, k * d + j]
+                    shift[j] = sq * acc * inv_m - dW[p, r, j] * inv_m
+            for j in range(d):
+                s[j] = 0.0
+            for q in range(npair):
+                A[q] = 0.0
+            for k in range(m):
+                if m > 1:
+                    for j in range(d):
+                        w[j] = sq * buf[p, r, k * d + j] - shift[j]
+                else:
+                    for j in range(d):
+                        w[j] = dW[p, r, j]
+                for j in range(d):
+                    a[j] = sH * buf[p, r, o_zeta + k * d + j] + 0.5 * s[j]
+                    s[j] += w[j]
+                q = 0
+                for i in range(d):
+                    for j in range(i + 1, d):
+                        A[q] += a[i] * w[j] - a[j] * w[i]
+                        q += 1
+            c = hr * lam_scale
+            q = 0
+            for i in range(d):
+                Wi = dW[p, r, i]
+                out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
+                for j in range(i + 1, d):
+                    v = A[q] + (buf[p, r, o_lam + q] * c if davie else 0.0)
+                    sym = 0.5 * Wi * dW[p, r, j]
+                    out[p, r, i, j] = sym + v
+                    out[p, r, j, i] = sym - v
+                    q += 1

@@ -41,9 +41,11 @@ counting each pair ``i < j`` once), and its variance is :math:`h^2/4 - h^2/(12 m
 moment of ``(W, A)`` is then exact, also conditionally on ``W``
 (:math:`\mathrm{Var}(A_{ij}\mid W) = h^2/12 + h(W_i^2 + W_j^2)/12`), and so is the
 conditional mean; the residual law error is in the fourth and higher cumulants and decays like
-``1/m`` (d = 2, measured with 2·10⁶ samples: excess kurtosis 1.36 for ``m = 1`` and 2.00 for the
-default ``m = 8``, exact value 2; a Kolmogorov–Smirnov test with 4·10⁵ samples cannot tell the
-``m = 8`` law from the exact one). Its
+``1/m`` (d = 2, measured with 2·10⁶ samples: excess kurtosis 1.36 for the default ``m = 1``
+(Davie's own method) and 2.00 for ``m = 8``, exact value 2; a Kolmogorov–Smirnov test with
+4·10⁵ samples cannot tell the ``m = 8`` law from the exact one). The default ``m``,
+:data:`DEFAULT_SUBSTEPS` ``= 1``, is the same for every entry point (this module's functions,
+:class:`BrownianDriver`); it gives exact second moments at the lowest cost. Its
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
 component (the added Gaussian is independent of the path).
 
@@ -52,7 +54,7 @@ Cost per step: ``d`` normals for the increment, plus ``m d`` (bridge, only if ``
 The normals are drawn by ``rng`` (numpy, one thread) and the flops done by a fused numba kernel
 (:mod:`roughpaths._brownian_kernels`), so the time is essentially that of drawing the normals:
 areas cost about ``(d + 2 m d + d(d-1)/2) / d`` times the increments alone, i.e. ~3-4x for
-``m = 1`` and ~16-20x for the default ``m = 8`` (``benchmarks/bench_brownian.py``; 1000 paths x
+``m = 1`` and ~16-20x for ``m = 8`` (``benchmarks/bench_brownian.py``; 1000 paths x
 1000 steps, d = 3, m = 8: ~0.65 s against ~0.03 s for the increments). ``levy_area=None``
 returns the increments alone at the cost of ``d`` normals per step.
 
@@ -68,14 +70,17 @@ import numbers
 import numpy as np
 
 from .validation import as_float_array, check_positive_int, check_rng, check_times
-from ._brownian_kernels import _step_areas
+from ._brownian_kernels import _block_areas, _step_areas
+from ._random import PathStreams
+from .driver import Driver
 from .level2 import outer
 from .rough_path import RoughPath
 
-__all__ = ["brownian_increments_and_areas", "brownian_rough_path", "refine", "DEFAULT_SUBSTEPS"]
+__all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "refine", "DEFAULT_SUBSTEPS"]
 
-#: Default number of substeps per grid step for the Lévy-area sampler.
-DEFAULT_SUBSTEPS = 8
+#: Default number of substeps per grid step for the Lévy-area sampler, the same for every entry point
+#: (Davie's own method: exact second moments at the lowest cost).
+DEFAULT_SUBSTEPS = 1
 
 _LEVY_METHODS = ("davie", "foster")
 _KINDS = ("stratonovich", "ito")
@@ -478,3 +483,267 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
         fine_h = np.diff(fine_t)
         areas[..., np.arange(d), np.arange(d)] -= 0.5 * fine_h[:, None]
     return RoughPath(dw, areas, times=fine_t, x0=X.x0, kind=X.kind, check=False)
+
+
+# ---------------------------------------------------------------------------- the driver
+_BLOCK_BYTES = 32 << 20
+
+
+def _check_seed(seed) -> np.random.SeedSequence:
+    if isinstance(seed, np.random.SeedSequence):
+        return seed
+    if isinstance(seed, numbers.Integral) and not isinstance(seed, bool):
+        if seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {seed}.")
+        return np.random.SeedSequence(int(seed))
+    if isinstance(seed, np.random.Generator):
+        raise TypeError("seed must be an int or a numpy.random.SeedSequence, got a Generator: a Generator's "
+                        "state would make the paths depend on what was drawn before. Pass seed=<int> "
+                        "(or brownian_rough_path(times, dim, rng), which derives a seed from rng).")
+    raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
+
+
+def _grid(times, dt, n_steps, t0) -> np.ndarray:
+    if times is not None:
+        if dt is not None or n_steps is not None:
+            raise ValueError("pass either times=... or dt=... with n_steps=..., not both.")
+        return check_times(times, "times")
+    if dt is None or n_steps is None:
+        raise ValueError("the grid is missing: pass times=<increasing array> or dt=<step> and n_steps=<int>.")
+    n = check_positive_int(n_steps, "n_steps")
+    if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
+        raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
+                         f"non-uniform grid.")
+    return float(t0) + float(dt) * np.arange(n + 1, dtype=np.float64)
+
+
+def _phys_bytes() -> float:
+    try:
+        import os
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return float("inf")
+
+
+class BrownianDriver(Driver):
+    r"""Brownian motion lifted to a level-2 rough path, generated lazily in time blocks, per-path seeded.
+
+    :func:`roughpaths.solve` consumes it exactly like the ``RoughPath`` that :meth:`rough_path`
+    returns, one block of ``~block_bytes`` at a time. The areas are sampled as documented in this
+    module (``levy_area`` and ``substeps``; ``None`` gives a level-1 driver).
+
+    Parameters
+    ----------
+    dim : int
+        Dimension ``d >= 1``.
+    seed : int or numpy.random.SeedSequence
+        Root of the random streams (see *Stream* below). A ``Generator`` is refused: its state
+        would make the paths depend on earlier draws.
+    times : array_like, shape ``(N + 1,)``, optional
+        Strictly increasing grid (non-uniform allowed). Or give ``dt`` and ``n_steps``.
+    dt : float, optional
+        Uniform step (grid ``t0 + dt * arange(n_steps + 1)``).
+    n_steps : int, optional
+        Number of uniform steps.
+    t0 : float
+        Start of the uniform grid (default 0).
+    batch_shape : tuple of int
+        Independent paths, default ``()``; path ``i`` is the ``i``-th in C order of the batch.
+    levy_area : {"davie", "foster"} or None
+        Area method (default ``"davie"``, exact second moments). ``None``: increments only
+        (``level == 1``).
+    substeps : int
+        Substeps ``m`` per step of the area sampler, default :data:`DEFAULT_SUBSTEPS` ``= 1``
+        (Davie's own method). Larger ``m`` lowers the L² error (``h/√(6m)`` for davie,
+        ``h/√(12m)`` for foster) at ``~2 m d`` more normals per step.
+    kind : {"stratonovich", "ito"}
+        Stratonovich (``RoughPath.kind == "geometric"``) or Itô areas.
+    x0 : array_like, shape ``(d,)`` or ``(*batch_shape, d)``, optional
+        Starting point (default 0).
+    block_bytes : int
+        Target memory of one block (increments, areas and random buffers), default 32 MiB; it
+        sets the default of :meth:`blocks`, never the numbers.
+
+    Notes
+    -----
+    **Stream.** Let ``S = SeedSequence(seed)`` (or the given one) and ``i`` the flat index of a
+    path in ``batch_shape`` (C order). Path ``i`` uses two independent standard-normal streams,
+
+    * increments: ``Generator(PCG64(SeedSequence(S.entropy, spawn_key=S.spawn_key + (i, 0))))``;
+      step ``k`` takes the next ``d`` normals, times ``√h_k``;
+    * areas: the same with ``spawn_key=S.spawn_key + (i, 1)``; step ``k`` takes the next
+      ``(m d if m > 1) + m d + (d(d-1)/2 if davie)`` normals: the bridge normals, the
+      space-time normals and Davie's normals, in this order (see
+      :mod:`roughpaths._brownian_kernels`).
+
+    So a path's numbers depend only on ``seed``, ``i``, and (for the areas) ``levy_area`` and
+    ``substeps``: not on the block size, on which paths are generated together (:meth:`select`),
+    on the executor or process, nor on ``kind``; the increments do not depend on ``levy_area``
+    or ``substeps`` either. The normals are numpy's, bit for bit (numpy's ziggurat over
+    ``PCG64``), generated by a numba kernel over all paths (:mod:`roughpaths._random`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> drv = BrownianDriver(2, seed=7, dt=0.01, n_steps=100, batch_shape=(4,))
+    >>> drv.n_steps, drv.batch_shape, drv.level
+    (100, (4,), 2)
+    >>> X = drv.rough_path()
+    >>> blocks = list(drv.blocks(max_steps=30))
+    >>> [b.n_steps for b in blocks]
+    [30, 30, 30, 10]
+    >>> bool(np.array_equal(np.concatenate([b.areas for b in blocks], axis=1), X.areas))
+    True
+    >>> bool(np.array_equal(drv.select([1, 3]).rough_path().increments, X.increments[[1, 3]]))
+    True
+    """
+
+    def __init__(self, dim, *, seed, times=None, dt=None, n_steps=None, t0=0.0, batch_shape=(),
+                 levy_area="davie", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES):
+        self.dim = check_positive_int(dim, "dim")
+        self.seed_sequence = _check_seed(seed)
+        self.times = _grid(times, dt, n_steps, t0)
+        self.times.setflags(write=False)
+        self.batch_shape = _check_batch_shape(batch_shape)
+        self.levy_area = _check_levy_method(levy_area)
+        self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
+        self.kind = _check_kind(kind)
+        self.level = 1 if self.levy_area is None else 2
+        self.block_bytes = check_positive_int(block_bytes, "block_bytes")
+        self._paths = None                   # None: all paths 0..n-1 (nothing allocated before blocks())
+        if x0 is None:
+            self._x0 = np.zeros(self.dim)
+        else:
+            z = as_float_array(x0, "x0", last_dims=(self.dim,))
+            try:
+                np.broadcast_shapes(z.shape, self.batch_shape + (self.dim,))
+            except ValueError:
+                raise ValueError(f"x0 of shape {z.shape} does not broadcast to the batch shape "
+                                 f"{self.batch_shape} + (d={self.dim},).") from None
+            self._x0 = z.copy()
+
+    # ------------------------------------------------------------------ layout
+    @property
+    def n_paths(self) -> int:
+        """Number of paths (``prod(batch_shape)``)."""
+        return int(np.prod(self.batch_shape, dtype=np.int64))
+
+    @property
+    def path_indices(self) -> np.ndarray:
+        """Flat indices (in the original batch) of this driver's paths; they key the streams."""
+        return np.arange(self.n_paths, dtype=np.int64) if self._paths is None else self._paths.copy()
+
+    def _x0_flat(self) -> np.ndarray:
+        return np.broadcast_to(self._x0, self.batch_shape + (self.dim,)).reshape(-1, self.dim)
+
+    @property
+    def _n_area_normals(self) -> int:
+        if self.levy_area is None:
+            return 0
+        d, m = self.dim, self.substeps
+        return (m * d if m > 1 else 0) + m * d + (d * (d - 1) // 2 if self.levy_area == "davie" else 0)
+
+    def _bytes_per_path_step(self) -> int:
+        d = self.dim
+        return 8 * (2 * d + (d * d + self._n_area_normals if self.level == 2 else 0))
+
+    def default_block_steps(self) -> int:
+        """Steps per block used by :meth:`blocks` when ``max_steps`` is None (from ``block_bytes``)."""
+        per_step = max(1, self.n_paths) * self._bytes_per_path_step()
+        return max(1, min(self.n_steps, self.block_bytes // per_step))
+
+    def __repr__(self) -> str:
+        return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
+                f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
+
+    # ------------------------------------------------------------------ subsets
+    def select(self, paths) -> "BrownianDriver":
+        """A driver for a subset of this driver's paths, bitwise equal to those paths of this one.
+
+        Parameters
+        ----------
+        paths : slice, range or array_like of int
+            Flat indices into this driver's batch (C order). The result has ``batch_shape ==
+            (len(paths),)``; its ``x0`` is taken from this driver's.
+
+        Returns
+        -------
+        BrownianDriver
+        """
+        n = self.n_paths
+        if isinstance(paths, slice):
+            idx = np.arange(n)[paths]
+        else:
+            if isinstance(paths, range):
+                paths = np.arange(paths.start, paths.stop, paths.step)
+            idx = np.asarray(paths)
+            if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
+                raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, "
+                                f"got {paths!r}.")
+            if idx.size and (idx.min() < -n or idx.max() >= n):
+                raise ValueError(f"paths holds indices outside [0, {n}) (this driver has {n} paths), "
+                                 f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
+            idx = np.where(idx < 0, idx + n, idx).astype(np.int64)
+        new = object.__new__(BrownianDriver)
+        new.__dict__.update(self.__dict__)
+        new._paths = self.path_indices[idx]
+        new._x0 = self._x0_flat()[idx]
+        new.batch_shape = (int(idx.size),)
+        return new
+
+    # ------------------------------------------------------------------ generation
+    def blocks(self, max_steps=None):
+        """Yield consecutive ``RoughPath`` blocks of at most ``max_steps`` steps covering the grid.
+
+        The numbers do not depend on ``max_steps`` (see *Stream*); default
+        :meth:`default_block_steps`. Each call starts the streams afresh.
+        """
+        K = self.default_block_steps() if max_steps is None else check_positive_int(max_steps, "max_steps")
+        N, d, P = self.n_steps, self.dim, self.n_paths
+        need = float(P) * min(K, N) * self._bytes_per_path_step()
+        if need > 0.5 * _phys_bytes():
+            raise ValueError(f"one block of {min(K, N)} step(s) for {P} paths needs {need / 2**30:.1f} GiB, more "
+                             f"than half the machine's memory; pass a smaller max_steps or select(...) fewer paths.")
+        ss = self.seed_sequence
+        keys = np.zeros((P, 2), dtype=np.int64)
+        keys[:, 0] = self.path_indices
+        inc_streams = PathStreams(ss, keys)
+        area_streams = None
+        na = self._n_area_normals
+        if self.level == 2:
+            keys = keys.copy()
+            keys[:, 1] = 1
+            area_streams = PathStreams(ss, keys)
+        rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
+        h_all = np.diff(self.times)
+        x = np.array(self._x0_flat())
+        zbuf = np.empty(P * min(K, N) * max(na, 1)) if self.level == 2 else None
+        for k0 in range(0, N, K):
+            k1 = min(N, k0 + K)
+            k = k1 - k0
+            h = h_all[k0:k1]
+            dW = np.empty((P, k, d))
+            inc_streams.fill(dW.reshape(P, k * d))
+            dW *= np.sqrt(h)[:, None]
+            areas = None
+            if self.level == 2:
+                z = zbuf[:P * k * na].reshape(P, k * na)
+                area_streams.fill(z)
+                areas = np.empty((P, k, d, d))
+                _block_areas(dW, h, z.reshape(P, k, na), self.substeps,
+                             self.levy_area == "davie" and d > 1, self.kind == "ito", areas)
+            x0 = x.reshape(self.batch_shape + (d,))
+            block = RoughPath(dW.reshape(self.batch_shape + (k, d)),
+                              None if areas is None else areas.reshape(self.batch_shape + (k, d, d)),
+                              times=self.times[k0:k1 + 1], x0=x0.copy(), kind=rp_kind, check=False)
+            x += dW.sum(axis=1)
+            yield block
+
+    def rough_path(self) -> RoughPath:
+        """The whole driver as one ``RoughPath`` (refused, naming the size, if it would not fit in memory)."""
+        need = float(self.n_paths) * self.n_steps * 8 * (self.dim + (self.dim ** 2 if self.level == 2 else 0))
+        if need > 0.5 * _phys_bytes():
+            raise ValueError(f"the whole path needs {need / 2**30:.1f} GiB, more than half the machine's "
+                             f"memory; pass the driver to solve(...) (it is consumed block by block) or "
+                             f"iterate driver.blocks(), or select(...) fewer paths.")
+        return super().rough_path()
