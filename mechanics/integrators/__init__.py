@@ -7,7 +7,6 @@ schemes). Compiled so(3) kernels are chosen inside the solvers by the type of th
 
 from .base import ChordConvergenceError, CoadjointSolver, ImplicitMidpoint, LieEuler, LieHeun, check_on_orbit
 from .legacy import coadjoint_step, simulate, simulate_brownian
-from ._legacy_brownian import _standard_normal_into  # noqa: F401  (tests of the bulk sampler)
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
            "check_on_orbit", "simulate", "simulate_brownian", "coadjoint_step"]

@@ -292,3 +292,52 @@ def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure)
                    float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason,
                    bool(stop_on_failure))
     return np.ascontiguousarray(m.T), out, first_bad, reason
+
+
+@numba.njit(cache=True)
+def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
+    """Stochastic velocities out (B, K, 3) = Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], A = ½(XX - XXᵀ).
+
+    ``dX`` (B, K, m); ``dXX`` (B, K, m, m) or an empty array (level-1 driving: no area term);
+    ``xi`` (m, 3); ``brk`` (npair, 3) the brackets of the pairs ``pi < pj``.
+    """
+    nb, nk, nm = dX.shape
+    area = dXX.shape[0] > 0
+    for p in range(nb):
+        for k in range(nk):
+            e0 = 0.0
+            e1 = 0.0
+            e2 = 0.0
+            for i in range(nm):
+                x = dX[p, k, i]
+                e0 += x * xi[i, 0]
+                e1 += x * xi[i, 1]
+                e2 += x * xi[i, 2]
+            if area:
+                for r in range(pi.shape[0]):
+                    i, j = pi[r], pj[r]
+                    a = 0.5 * (dXX[p, k, i, j] - dXX[p, k, j, i])
+                    e0 += a * brk[r, 0]
+                    e1 += a * brk[r, 1]
+                    e2 += a * brk[r, 2]
+            out[p, k, 0] = e0
+            out[p, k, 1] = e1
+            out[p, k, 2] = e2
+
+
+def stochastic_velocities(system, dX, dXX, batch):
+    """``system.stochastic_velocity`` of a block for the so(3) kernels, shape ``(prod(batch), K, 3)``."""
+    nk, nm = dX.shape[-2:]
+    nb = int(np.prod(batch, dtype=np.int64))
+    dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, nm)).reshape(nb, nk, nm), dtype=np.float64)
+    if dXX is None:
+        dXX = np.empty((0, 0, 0, 0))
+    else:
+        dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, nm, nm)).reshape(nb, nk, nm, nm),
+                                   dtype=np.float64)
+    pi, pj = np.triu_indices(nm, 1)
+    brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
+    out = np.empty((nb, nk, 3))
+    _eta_from_increments(dX, dXX, np.ascontiguousarray(system.xi), brk, pi.astype(np.int64), pj.astype(np.int64),
+                         out)
+    return out

@@ -123,7 +123,7 @@ class CoadjointSolver(Solver):
                              f"areas would be discarded. Pass driver.to_level1() to drop them deliberately, or "
                              f"{type(self).__name__}() to use them.")
         kind = getattr(driver, "kind", "geometric")
-        if self.levy_area and kind != "geometric":
+        if self.levy_area and kind not in ("geometric", "stratonovich"):
             raise ValueError(f"the driver is a {kind!r} rough path; the coadjoint schemes solve the geometric "
                              f"(Stratonovich-type) RDE. Convert an Itô lift with XX + ½(t-s)I first.")
 
@@ -178,11 +178,11 @@ class CoadjointSolver(Solver):
         batch = y.shape[:-1]
         dts = np.diff(np.asarray(times, dtype=np.float64))
         nk = dts.size
-        eta = self._eta(system, dX, None if not self.levy_area else dXX)       # (B_X..., K, n)
         nsave = int(np.count_nonzero(save))
+        dXX = dXX if self.levy_area else None
         if isinstance(system.algebra, SO3Algebra) and system.hamiltonian.is_quadratic:
             nb = int(np.prod(batch, dtype=np.int64))
-            eta_b = np.broadcast_to(eta, batch + (nk, n)).reshape(nb, nk, n)
+            eta_b = _so3_kernels.stochastic_velocities(system, dX, dXX, batch)
             y2, saved, first_bad, reason = _so3_kernels.integrate_so3(
                 system.quadratic_velocity_data(), self._code, getattr(self, "tol", 1e-13),
                 getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
@@ -194,6 +194,7 @@ class CoadjointSolver(Solver):
             chord = np.zeros(batch, dtype=bool)
             slot = 0
             y2 = y
+            eta = self._eta(system, dX, dXX)                                    # (B_X..., K, n)
             for k in range(nk):
                 y2, ok, conv = self._advance(system, y2, float(dts[k]), eta[..., k, :])
                 new = ~ok & (first_bad < 0)

@@ -5,7 +5,7 @@ deprecated                             use instead
 =====================================  =========================================================
 ``simulate(system, mu0, X, method)``   ``roughpaths.solve(system, X, mu0, LieHeun())``
 ``simulate(..., levy_area=False)``     ``roughpaths.solve(system, X1, mu0, LieHeun(levy_area=False))``
-``simulate_brownian(...)``             ``roughpaths.solve(system, <Brownian driver>, mu0, LieHeun())``
+``simulate_brownian(...)``             ``roughpaths.solve(system, BrownianDriver(...), mu0, LieHeun())``
 ``coadjoint_step(...)``                ``solver.step(system, mu, t, dt, dX, dXX)``
 =====================================  =========================================================
 """
@@ -17,7 +17,7 @@ import warnings
 
 import numpy as np
 
-from roughpaths import NonFiniteStateError, RoughPath, solve
+from roughpaths import BrownianDriver, NonFiniteStateError, RoughPath, solve
 from roughpaths.validation import as_float_array, check_positive_int, check_rng
 
 from ..lie_poisson import LiePoissonSystem
@@ -97,15 +97,14 @@ def simulate(system: LiePoissonSystem, mu0, driver: RoughPath, method=LieHeun(),
 def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rng, *, n_paths=None,
                       method=LieHeun(), levy_area=True, area_substeps: int = 1, save_every: int = 1,
                       chunk_steps=None, orbit=None):
-    r"""Deprecated: ``roughpaths.solve`` with a Brownian driver; returns ``(times (K,), states (P, K, n))``.
+    r"""Deprecated: ``roughpaths.solve(system, BrownianDriver(...), mu0, method)``; returns ``(times (K,), states (P, K, n))``.
 
-    Stream: the unit normals of every path-step in C order ``(step, path, draw)`` from ``rng`` (``dW``
-    (m), with the area ``H`` (m) and ``lambda`` (m(m-1)/2); Davie's area), whatever ``chunk_steps``.
-    ``levy_area`` in ``{True, False, "davie", "foster"}``.
+    The driver is ``roughpaths.BrownianDriver(m, seed=int(rng.integers(2**63)), dt=dt, n_steps=n_steps,
+    batch_shape=(n_paths,), levy_area=..., substeps=area_substeps)`` (``levy_area`` ``True`` means
+    ``"davie"``, ``False`` level-1 driving); its stream depends only on that seed, the path index and
+    the area method, never on ``chunk_steps`` (the block size handed to :func:`roughpaths.solve`).
     """
     _warn("simulate_brownian", "roughpaths.solve(system, roughpaths.BrownianDriver(...), mu0, LieHeun())")
-    from ._legacy_brownian import _LegacyBrownianStream
-
     rng = check_rng(rng)
     if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating)) or not np.isfinite(dt) or dt <= 0:
         raise ValueError(f"dt must be a positive finite number, got {dt!r}.")
@@ -125,12 +124,16 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
     mu0 = np.array(np.broadcast_to(mu0, (n_paths, system.dim)))
     if orbit is not None:
         check_on_orbit(system, mu0, orbit)
-    m = system.n_noise
-    if chunk_steps is None:
-        chunk_steps = max(1, min(n_steps, (1 << 19) // (8 * n_paths * (m * m + m + system.dim))))
-    chunk_steps = check_positive_int(chunk_steps, "chunk_steps")
-    stream = _LegacyBrownianStream(rng, n_paths, n_steps, dt, m, levy_area, area_substeps, chunk_steps)
-    return _run(system, stream, mu0, solver, stream.times[::save_every])
+    if chunk_steps is not None:
+        chunk_steps = check_positive_int(chunk_steps, "chunk_steps")
+    method_name = None if levy_area is False else ("davie" if levy_area is True else levy_area)
+    driver = BrownianDriver(system.n_noise, seed=int(rng.integers(2 ** 63)), dt=dt, n_steps=n_steps,
+                            batch_shape=(n_paths,), levy_area=method_name, substeps=area_substeps)
+    try:
+        sol = solve(system, driver, mu0, solver, save_at=driver.times[::save_every], block_steps=chunk_steps)
+    except NonFiniteStateError as exc:
+        raise FloatingPointError(f"{exc} (the Hamiltonian or its gradient may have returned NaN/inf)") from exc
+    return sol.times, sol.states
 
 
 def coadjoint_step(system: LiePoissonSystem, mu, dt: float, eta, method=LieHeun(), *, step_index: int = 0,
