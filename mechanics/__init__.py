@@ -35,7 +35,8 @@ from .integrators import (
     simulate_brownian,
 )
 from .lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra, hat, se3, sl2r, so3, su2, vee
-from .lie_poisson import Hamiltonian, LiePoissonSystem, QuadraticHamiltonian, check_inertia, girsanov_shift
+from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
+from .lie_poisson import LiePoissonSystem, girsanov_shift, levy_velocity
 from .rigid_body import RigidBody, isotropic_xi, rigid_body
 from .wong_zakai import (
     PlanarExample,
@@ -55,7 +56,7 @@ __all__ = [
     # Lie algebras
     "LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
     # Lie–Poisson systems
-    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia",
+    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     # integrators
     "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",

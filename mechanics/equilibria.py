@@ -40,6 +40,8 @@ from scipy.optimize import brentq
 
 from roughpaths.validation import as_float_array, check_antisymmetric
 
+from .lie_poisson import check_inertia, levy_velocity
+
 __all__ = [
     "Equilibrium",
     "LevelSets",
@@ -59,25 +61,7 @@ def as_inverse_inertia(inertia, name: str = "inertia") -> np.ndarray:
 
     Raises ``ValueError`` for non-symmetric, non-positive-definite or wrongly shaped input.
     """
-    arr = as_float_array(inertia, name)
-    if arr.shape == (3,):
-        if np.any(arr <= 0):
-            raise ValueError(f"{name} must have positive principal moments, got {arr.tolist()}; "
-                             f"a rigid body needs 𝕀 = diag(I1, I2, I3) with every Ik > 0.")
-        return np.diag(1.0 / arr)
-    if arr.shape != (3, 3):
-        raise ValueError(f"{name} must be 3 principal moments (shape (3,)) or a 3x3 symmetric "
-                         f"positive-definite matrix, got shape {arr.shape}.")
-    scale = max(float(np.max(np.abs(arr))), 1e-300)
-    asym = float(np.max(np.abs(arr - arr.T)))
-    if asym > 1e-12 * scale:
-        raise ValueError(f"{name} must be symmetric, but |𝕀 - 𝕀ᵀ| = {asym:.3g}; "
-                         f"pass 0.5 * ({name} + {name}.T) if the asymmetry is round-off.")
-    sym = 0.5 * (arr + arr.T)
-    w = np.linalg.eigvalsh(sym)
-    if w[0] <= 0:
-        raise ValueError(f"{name} must be positive definite, its eigenvalues are {w.tolist()}.")
-    return np.linalg.inv(sym)
+    return np.linalg.inv(check_inertia(inertia, name, dim=3))
 
 
 def _as_c(c, name: str = "c") -> np.ndarray:
@@ -118,7 +102,7 @@ def isotropic_levy_shift(sigma, s, convention: str = "rp") -> np.ndarray:
     s = check_antisymmetric(s, "s", dim=3)
     if s.ndim != 2:
         raise ValueError(f"s must be a single 3x3 antisymmetric matrix, got shape {s.shape}.")
-    c = sig * sig * np.array([s[1, 2], -s[0, 2], s[0, 1]])
+    c = levy_velocity(s, sig * np.eye(3))
     if convention == "rp":
         return c
     if convention == "paper":
@@ -131,6 +115,11 @@ def modified_hamiltonian(Pi, inertia, c=None) -> np.ndarray:
     A = as_inverse_inertia(inertia)
     c = _as_c(c)
     P = as_float_array(Pi, "Pi", last_dims=(3,))
+    return _modified_hamiltonian(P, A, c)
+
+
+def _modified_hamiltonian(P, A, c):
+    """The one formula for ``h̃ = ½ Π·AΠ + c·Π`` on so(3)* (``A = 𝕀⁻¹``), used by the Gibbs measure too."""
     return 0.5 * np.einsum("...i,ij,...j->...", P, A, P) + P @ c
 
 
@@ -510,7 +499,7 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
     A = as_inverse_inertia(inertia)
     c = _as_c(c)
     r = _check_radius(radius)
-    eqs = rigid_body_equilibria(_inertia_from_inverse(A), c, radius=r, theta=theta)
+    eqs = rigid_body_equilibria(np.linalg.inv(A), c, radius=r, theta=theta)
     emin, emax = eqs[0].energy, eqs[-1].energy
     if np.ndim(levels) == 0:
         n = int(levels)
@@ -547,10 +536,6 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
         curves.append(_join_polylines(pieces, tol=1e-6 * r))
     return LevelSets(levels=lv, curves=curves, separatrix=sep, equilibria=eqs, radius=r,
                      energy_range=(emin, emax))
-
-
-def _inertia_from_inverse(A):
-    return np.linalg.inv(A)
 
 
 def _project_to_level(x, A, c, r, level, iters=4):

@@ -61,7 +61,7 @@ from roughpaths import solve
 
 from .integrators import CoadjointSolver, LieHeun
 from .lie_algebra import so3
-from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
+from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia, levy_velocity
 from .rigid_body import rigid_body
 
 __all__ = [
@@ -78,26 +78,11 @@ __all__ = [
 
 
 def levy_torque(s, xi) -> np.ndarray:
-    r"""Lévy torque :math:`c = \tfrac12\sum_{i,j}s^{ij}\,\xi_i\times\xi_j` (rough-path sign), shape ``(3,)``.
+    r"""Deprecated alias of :func:`mechanics.lie_poisson.levy_velocity` (so(3)): :math:`c = \tfrac12\sum_{i,j}s^{ij}\,\xi_i\times\xi_j`."""
+    import warnings
 
-    Parameters
-    ----------
-    s : array_like ``(m, m)``, antisymmetric perturbation in the coordinates of the driver of ``ξ``.
-    xi : array_like ``(m, 3)``, noise vectors (rows).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 1.0, -1.0
-    >>> levy_torque(s, 2.0 * np.eye(3))      # σ² (s23, -s13, s12)
-    array([ 0., -4.,  0.])
-    """
-    s = as_float_array(s, "s", ndim=2)
-    xi = as_float_array(xi, "xi", ndim=2, last_dims=(s.shape[0], 3))
-    if s.shape[0] != s.shape[1]:
-        raise ValueError(f"s must be square, got shape {s.shape}.")
-    cr = np.cross(xi[:, None, :], xi[None, :, :])
-    return 0.5 * np.einsum("ij,ijk->k", s, cr)
+    warnings.warn("levy_torque is deprecated; use mechanics.levy_velocity(s, xi).", DeprecationWarning, stacklevel=2)
+    return levy_velocity(s, xi)
 
 
 @dataclass(frozen=True)
@@ -117,7 +102,7 @@ class RigidBodyWongZakai:
         ``c = ½ Σ N^{ij} ξ_i×ξ_j`` with ``ξ_i = σe_i``.
     perturbation_B : ndarray ``(m, m)`` or None
         ``M⁻¹ N M⁻ᵀ`` (``M`` square invertible): the same perturbation in ``B`` coordinates, i.e.
-        ``levy_torque(perturbation_B, limit_xi) == torque``.
+        ``levy_velocity(perturbation_B, limit_xi) == torque``.
     """
 
     limit: ColouredNoiseLimit
@@ -158,7 +143,7 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
         raise ValueError(f"sigma must be a finite number >= 0, got {sigma!r}.")
     cxi = sg * np.eye(3)
     lxi = (sg * lim.scaling).T.copy()
-    c = levy_torque(lim.levy_perturbation, cxi)
+    c = levy_velocity(lim.levy_perturbation, cxi)
     M = lim.scaling
     sB = None
     if M.shape[0] == M.shape[1] and np.linalg.cond(M) < 1e12:

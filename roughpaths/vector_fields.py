@@ -202,17 +202,6 @@ class VectorFields:
             return np.asarray(self._drift_jac(y), dtype=np.float64)
         return _central_jacobian(self._drift, y)
 
-    def second_order_term(self, y, area, fields=None, jacobians=None) -> np.ndarray:
-        r""":math:`\sum_{i,j} \mathbb{X}^{ij}\, DV_j\cdot V_i(y)`, shape ``(..., e)``.
-
-        ``area`` has shape ``(..., d, d)`` (broadcast against ``y``); this is the level-2 term of the
-        Davie step. Precomputed ``fields(y)`` / ``jacobians(y)`` may be passed to avoid recomputing.
-        """
-        V = self.fields(y) if fields is None else fields
-        J = self.jacobians(y) if jacobians is None else jacobians
-        W = V @ area                                   # [..., b, j] = Σ_i V_i^b XX^{ij}
-        return np.einsum("...jab,...bj->...a", J, W)
-
     # ------------------------------------------------------------------ brackets
     def _check_index(self, i, name):
         if isinstance(i, bool) or not isinstance(i, numbers.Integral) or not 0 <= i < self.dim_noise:

@@ -32,8 +32,8 @@ s[0, 2], s[2, 0] = 25.0, -25.0                     # the paper's s13 = 25
 
 # %%
 body = rigid_body(inertia, sigma=sigma, s=s, theta=theta)
-print("Lévy torque c = ½ Σ s^{ij} ξ_i × ξ_j =", body.levy_torque_vector)
-assert np.allclose(body.levy_torque_vector, sigma**2 * np.array([s[1, 2], -s[0, 2], s[0, 1]]))
+print("Lévy torque c = ½ Σ s^{ij} ξ_i × ξ_j =", body.levy_velocity)
+assert np.allclose(body.levy_velocity, sigma**2 * np.array([s[1, 2], -s[0, 2], s[0, 1]]))
 print("h̃ at the north pole:", float(body.modified_energy([0.0, 0.0, 1.0])))
 
 # %% [markdown]
@@ -42,7 +42,7 @@ print("h̃ at the north pole:", float(body.modified_energy([0.0, 0.0, 1.0])))
 # `(𝕀⁻¹ − λ) Π = −c`, `|Π| = 1` (the paper's sentence "(0, 3σ²s13, …)" is not it).
 
 # %%
-eqs = rigid_body_equilibria(inertia, body.levy_torque_vector, theta=theta)
+eqs = rigid_body_equilibria(inertia, body.levy_velocity, theta=theta)
 for eq in eqs:
     print(eq)
 north = min((q for q in eqs if q.kind == "minimum" and q.point[2] > 0), key=lambda q: -q.point[2])
@@ -67,7 +67,7 @@ mean, se = path_means.mean(axis=0), path_means.std(axis=0, ddof=1) / np.sqrt(P)
 # so we compare with the Gibbs mean conditioned on `Π3 > 0`.
 
 # %%
-g = GibbsMeasure(inertia, body.levy_torque_vector, sigma=sigma, theta=theta)
+g = GibbsMeasure(inertia, body.levy_velocity, sigma=sigma, theta=theta)
 f = lambda x: np.concatenate([x * (x[..., 2:3] > 0), (x[..., 2:3] > 0) * 1.0], axis=-1)
 e = g.expectation(f)
 gibbs_mean = e[:3] / e[3]

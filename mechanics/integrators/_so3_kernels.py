@@ -21,15 +21,17 @@ import math
 import numba
 import numpy as np
 
+from ..lie_algebra import SMALL_ANGLE2, taylor_coefficients
+
+_taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
+
 # ---------------------------------------------------------------------- numba kernel (so(3), quadratic h)
 @numba.njit(cache=True, inline="always")
 def _rod(s0, s1, s2, m0, m1, m2):
     # exp(ad*_s) m = m - a s×m + b s×(s×m), a = sin t / t, b = (1 - cos t)/t²
     t2 = s0 * s0 + s1 * s1 + s2 * s2
-    if t2 < 1e-2:
-        # Taylor to t^8: truncation < t^10/11! < 3e-18, i.e. exact in float64; no transcendental calls
-        a = 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0)))
-        b = 0.5 - t2 / 24.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0)))
+    if t2 < SMALL_ANGLE2:
+        a, b, _ = _taylor(t2)                # exact in float64 there; no transcendental calls
     else:
         t = math.sqrt(t2)
         a = math.sin(t) / t
@@ -216,11 +218,10 @@ def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, thet
                 s2 = (w2 + g2 + n20 * v0 + n21 * v1 + n22 * v2) * hdt + e2
             # exp(ad*_s) m = m - a s×m + b s×(s×m), Taylor to t^8 (exact in float64 for t² < 1e-2)
             t2 = s0 * s0 + s1 * s1 + s2 * s2
-            big = not (t2 < 1e-2)                   # also NaN: redone (and diagnosed) by the scalar step
+            big = not (t2 < SMALL_ANGLE2)           # also NaN: redone (and diagnosed) by the scalar step
             bad[p] = big
             nbad += big
-            a = 1.0 - t2 * (1.0 / 6.0) * (1.0 - t2 * (1.0 / 20.0) * (1.0 - t2 * (1.0 / 42.0) * (1.0 - t2 * (1.0 / 72.0))))
-            b = 0.5 - t2 * (1.0 / 24.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0) * (1.0 - t2 * (1.0 / 90.0))))
+            a, b, _ = _taylor(t2)
             c0 = s1 * m2 - s2 * m1
             c1 = s2 * m0 - s0 * m2
             c2 = s0 * m1 - s1 * m0
