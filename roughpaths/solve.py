@@ -255,7 +255,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     if k0 != n:
         raise RuntimeError(f"the driver's blocks covered {k0} of its {n} steps; its blocks() is broken.")
     if on_failure == "mask" and (failed_step >= 0).any():
-        mark = (failed_step[..., None] >= 0) & (idx[None, :] > failed_step[..., None])
+        mark = (failed_step[..., None] >= 0) & (idx > failed_step[..., None])      # batch + (K,)
         out[mark] = np.nan
     stats = {"solver": repr(solver), "n_steps": n, "n_blocks": n_blocks, "batch_shape": batch,
              "wall_time": _time.perf_counter() - t_start}

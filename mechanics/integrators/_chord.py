@@ -39,6 +39,13 @@ def chord_solve(system, mu, dt, eta, tol, max_iter):
         mu_a, s_a = mu[active], sigma[active]
         with np.errstate(all="ignore"):
             mu1 = alg.Ad_star_exp(s_a, mu_a)
+        fin = np.all(np.isfinite(mu1), axis=-1)
+        if not np.all(fin):                      # overflowed members fail; the others go on alone
+            done[active[~fin]] = True
+            active, mu_a, s_a, mu1 = active[fin], mu_a[fin], s_a[fin], mu1[fin]
+            if active.size == 0:
+                break
+        with np.errstate(all="ignore"):
             resid = s_a - system.drift_velocity(0.5 * (mu_a + mu1)) * dt - eta[active]
             delta = (jinv[active] @ resid[..., None])[..., 0]
             s_a = s_a - delta
