@@ -35,8 +35,9 @@ adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` 
 discrete Proposition 2.1.
 
 Implementation: for a :class:`~mechanics.lie_algebra.SO3Algebra` with a quadratic Hamiltonian,
-:meth:`CoadjointSolver.integrate` runs compiled block kernels (:mod:`mechanics.integrators._so3_kernels`);
-otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
+:meth:`CoadjointSolver.integrate` runs compiled block kernels (:mod:`mechanics.integrators._so3_kernels`),
+for an :class:`~mechanics.lie_algebra.SE3Algebra` (the heavy top) with the explicit schemes those of
+:mod:`mechanics.integrators._se3_kernels`; otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
 :func:`roughpaths.expm_batched` per member otherwise). Either way a batch member's result depends
 on its own data only; a member that fails is reported through ``first_bad`` (contract item 8).
 """
@@ -50,9 +51,9 @@ import numpy as np
 from roughpaths import Solver
 from roughpaths.validation import as_float_array, check_positive_int
 
-from ..lie_algebra import SO3Algebra
+from ..lie_algebra import SE3Algebra, SO3Algebra
 from ..lie_poisson import LiePoissonSystem
-from . import _so3_kernels
+from . import _se3_kernels, _so3_kernels
 from ._chord import chord_solve
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
@@ -188,6 +189,17 @@ class CoadjointSolver(Solver):
                 getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
             y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
             first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
+        elif isinstance(system.algebra, SE3Algebra) and system.hamiltonian.is_quadratic and self._code in (0, 1):
+            nb = int(np.prod(batch, dtype=np.int64))
+            d = dX.shape[-1]
+            dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
+            if dXX is not None:
+                dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
+                                           dtype=np.float64)
+            y2, saved, first_bad = _se3_kernels.integrate_se3(system, self._code, y.reshape(nb, n), dX, dXX, dts,
+                                                              save, stop_on_failure)
+            y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
+            chord = np.zeros(batch, dtype=bool)
         else:
             saved = np.full(batch + (nsave, n), np.nan)
             first_bad = np.full(batch, -1, dtype=np.int64)
