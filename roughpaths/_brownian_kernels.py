@@ -107,6 +107,7 @@ def _step_areas(dW, h, z, zeta, lam, m, davie, ito, out):
                 p += 1
 
 
+
 @njit(cache=True, nogil=True)
 def _block_areas(dW, h, buf, m, davie, ito, out):
     """Level-2 step areas of a block ``(P, K)`` of path-steps from the per-step packed normals.
@@ -115,6 +116,11 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
     area stream: ``buf[p, k]`` holds, in this order, the bridge normals ``z`` (``m d``,
     substep-major, only if ``m > 1``), the space-time normals ``ζ`` (``m d``) and, for Davie's
     method, the ``d(d-1)/2`` normals ``λ`` (``numpy.triu_indices`` order).
+
+    Written as one loop nest with a branch for ``m = 1`` (Davie's own method:
+    ``A = H ∧ W + λ``, no substep loop): a per-step helper function taking the arrays measured
+    3-5x slower (array reference counting per call), the ``m = 1`` branch ~1.5x faster than
+    the general loop.
 
     Parameters
     ----------
@@ -134,46 +140,52 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
     P, K, d = dW.shape
     npair = d * (d - 1) // 2
     inv_m = 1.0 / m
-    inv_s12 = 1.0 / np.sqrt(12.0)
-    lam_scale = 1.0 / np.sqrt(12.0 * m)
     o_zeta = m * d if m > 1 else 0
     o_lam = o_zeta + m * d
-    shift = np.zeros(d)
-    s = np.empty(d)
-    w = np.empty(d)
-    a = np.empty(d)
+    shift, s, w, a = np.zeros(d), np.empty(d), np.empty(d), np.empty(d)
     A = np.empty(max(npair, 1))
+    sHs = np.sqrt(h * (inv_m / 12.0))            # √(δ/12), δ = h/m
+    cs = h / np.sqrt(12.0 * m)                   # Davie's scale h/√(12 m)
     for p in range(P):
         for r in range(K):
             hr = h[r]
+            sH = sHs[r]
+            c = cs[r]
+            if m == 1:
+                q = 0
+                for i in range(d):
+                    Wi = dW[p, r, i]
+                    Hi = sH * buf[p, r, i]
+                    out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
+                    for j in range(i + 1, d):
+                        Wj = dW[p, r, j]
+                        v = Hi * Wj - sH * buf[p, r, j] * Wi
+                        if davie:
+                            v += buf[p, r, o_lam + q] * c
+                        sym = 0.5 * Wi * Wj
+                        out[p, r, i, j] = sym + v
+                        out[p, r, j, i] = sym - v
+                        q += 1
+                continue
             sq = np.sqrt(hr * inv_m)
-            sH = sq * inv_s12
-            if m > 1:
-                for j in range(d):
-                    acc = 0.0
-                    for k in range(m):
-                        acc += buf[p, r, k * d + j]
-                    shift[j] = sq * acc * inv_m - dW[p, r, j] * inv_m
             for j in range(d):
+                acc = 0.0
+                for k in range(m):
+                    acc += buf[p, r, k * d + j]
+                shift[j] = sq * acc * inv_m - dW[p, r, j] * inv_m
                 s[j] = 0.0
             for q in range(npair):
                 A[q] = 0.0
             for k in range(m):
-                if m > 1:
-                    for j in range(d):
-                        w[j] = sq * buf[p, r, k * d + j] - shift[j]
-                else:
-                    for j in range(d):
-                        w[j] = dW[p, r, j]
                 for j in range(d):
+                    w[j] = sq * buf[p, r, k * d + j] - shift[j]
                     a[j] = sH * buf[p, r, o_zeta + k * d + j] + 0.5 * s[j]
                     s[j] += w[j]
                 q = 0
-                for i in range(d):
+                for i in range(d):         # (g - gᵀ)_{ij}, g = Σ_k a_k ⊗ w_k
                     for j in range(i + 1, d):
                         A[q] += a[i] * w[j] - a[j] * w[i]
                         q += 1
-            c = hr * lam_scale
             q = 0
             for i in range(d):
                 Wi = dW[p, r, i]

@@ -189,3 +189,15 @@ def test_sizes_are_checked_before_allocating():
         BrownianDriver(2, seed=0, dt=0.1, n_steps=2, batch_shape=(3,)).select([0.5])
     with pytest.raises(ValueError, match="max_steps"):
         next(BrownianDriver(2, seed=0, dt=0.1, n_steps=2).blocks(0))
+
+
+@pytest.mark.parametrize("method, m", [("davie", 2), (None, 1)])
+def test_numpy_fallback_driver_gives_the_same_bits(monkeypatch, method, m):
+    import roughpaths._random as rnd
+    kw = dict(seed=12, dt=0.1, n_steps=9, batch_shape=(3,), levy_area=method, substeps=m)
+    fast = BrownianDriver(2, **kw).rough_path()
+    monkeypatch.setattr(rnd, "_FAST_OK", [False])
+    slow_blocks = list(BrownianDriver(2, **kw).blocks(4))
+    np.testing.assert_array_equal(np.concatenate([b.increments for b in slow_blocks], axis=-2), fast.increments)
+    if method is not None:
+        np.testing.assert_array_equal(np.concatenate([b.areas for b in slow_blocks], axis=-3), fast.areas)
