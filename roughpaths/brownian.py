@@ -51,12 +51,15 @@ component (the added Gaussian is independent of the path).
 
 Cost per step: ``d`` normals for the increment, plus ``m d`` (bridge, only if ``m > 1``),
 ``m d`` (space-time areas) and ``d(d-1)/2`` (Davie) normals and ``O(m d^2)`` flops for the area.
-The normals are drawn by ``rng`` (numpy, one thread) and the flops done by a fused numba kernel
-(:mod:`roughpaths._brownian_kernels`), so the time is essentially that of drawing the normals:
-areas cost about ``(d + 2 m d + d(d-1)/2) / d`` times the increments alone, i.e. ~3-4x for
-``m = 1`` and ~16-20x for ``m = 8`` (``benchmarks/bench_brownian.py``; 1000 paths x
-1000 steps, d = 3, m = 8: ~0.65 s against ~0.03 s for the increments). ``levy_area=None``
-returns the increments alone at the cost of ``d`` normals per step.
+The normals come from per-path streams (numpy's ziggurat over ``PCG64``, run by a numba kernel
+over all paths, :mod:`roughpaths._random`) and the flops from a numba kernel
+(:mod:`roughpaths._brownian_kernels`), so the time is essentially that of drawing the normals
+(``benchmarks/bench_brownian.py`` measures it against the former samplers).
+``levy_area=None`` returns the increments alone at the cost of ``d`` normals per step.
+
+Every entry point samples the same stream: :class:`BrownianDriver` (lazy, in time blocks) and
+the one-shot :func:`brownian_rough_path` / :func:`brownian_increments_and_areas`, which
+materialise a driver seeded from their ``rng``.
 
 References: J. Foster, T. Lyons, H. Oberhauser, *An optimal polynomial approximation of Brownian
 motion*, SIAM J. Numer. Anal. 58 (2020); A. Davie, *KMT theory applied to approximations of SDE*
@@ -70,7 +73,7 @@ import numbers
 import numpy as np
 
 from .validation import as_float_array, check_positive_int, check_rng, check_times
-from ._brownian_kernels import _block_areas, _step_areas
+from ._brownian_kernels import _block_areas
 from ._random import PathStreams
 from .driver import Driver
 from .level2 import outer
@@ -84,9 +87,6 @@ DEFAULT_SUBSTEPS = 1
 
 _LEVY_METHODS = ("davie", "foster")
 _KINDS = ("stratonovich", "ito")
-# Rows (steps) per chunk of random draws: chunk = _CHUNK_FLOATS // (4 m d + d²) (buffers ~16 MB).
-# The chunking fixes which normals go to which step: changing it changes the samples of a seed.
-_CHUNK_FLOATS = 1 << 22
 
 
 # ---------------------------------------------------------------------------- validation
@@ -133,6 +133,16 @@ def _check_dt(dt, n_steps: int) -> np.ndarray:
     return arr
 
 
+def _seed_from_rng(rng) -> np.random.SeedSequence:
+    """The driver seed of the wrappers: drawn from a Generator (2 draws), or an int/SeedSequence as is."""
+    if isinstance(rng, np.random.Generator):
+        return np.random.SeedSequence([int(v) for v in rng.integers(0, 2**63, size=2, dtype=np.int64)])
+    if isinstance(rng, np.random.SeedSequence) or (isinstance(rng, numbers.Integral) and not isinstance(rng, bool)):
+        return _check_seed(rng)
+    raise TypeError(f"rng must be a numpy.random.Generator (or an int seed / SeedSequence), got "
+                    f"{type(rng).__name__}; pass rng=numpy.random.default_rng(seed).")
+
+
 # ---------------------------------------------------------------------------- kernels
 def _wedge(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``u ∧ v = u⊗v - v⊗u``, batched."""
@@ -169,47 +179,6 @@ def _antisym_normal(rng: np.random.Generator, shape: tuple, d: int) -> np.ndarra
     return out
 
 
-def _sample_areas(rng, dW: np.ndarray, dt: np.ndarray, method: str, m: int, ito: bool,
-                  out: np.ndarray) -> None:
-    """Step areas for rows ``dW (R, d)`` with step sizes ``dt (R,)``, written into ``out (R, d, d)``.
-
-    Draws, chunk by chunk, the bridge normals ``(c, m, d)`` (only if ``m > 1``), the space-time
-    normals ``(c, m, d)`` and, for ``"davie"``, ``(c, d(d-1)/2)`` normals, in this order, then
-    calls the fused numba kernel (:func:`roughpaths._brownian_kernels._step_areas`). The chunk
-    size and the draw order are those of the original numpy implementation, so a seed gives the
-    same random numbers as before; the areas agree with it to round-off.
-    """
-    R, d = dW.shape
-    P = d * (d - 1) // 2
-    davie = method == "davie" and P > 0
-    chunk = max(1, _CHUNK_FLOATS // (m * d * 4 + d * d))
-    c0 = min(chunk, R)
-    zbuf = np.empty(c0 * m * d) if m > 1 else None
-    hbuf = np.empty(c0 * m * d)
-    lbuf = np.empty(c0 * P) if davie else None
-    no_z = np.empty((0, 1, d))
-    no_lam = np.empty((0, max(P, 1)))
-    for lo in range(0, R, chunk):
-        hi = min(R, lo + chunk)
-        n = hi - lo
-        if m > 1:
-            z = zbuf[:n * m * d]
-            rng.standard_normal(out=z)
-            z = z.reshape(n, m, d)
-        else:
-            z = no_z
-        zeta = hbuf[:n * m * d]
-        rng.standard_normal(out=zeta)
-        zeta = zeta.reshape(n, m, d)
-        if davie:
-            lam = lbuf[:n * P]
-            rng.standard_normal(out=lam)
-            lam = lam.reshape(n, P)
-        else:
-            lam = no_lam
-        _step_areas(dW[lo:hi], dt[lo:hi], z, zeta, lam, m, davie, ito, out[lo:hi])
-
-
 # ---------------------------------------------------------------------------- public API
 def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy_area="davie",
                                   substeps=DEFAULT_SUBSTEPS, kind="stratonovich"):
@@ -217,8 +186,11 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
 
     Parameters
     ----------
-    rng : numpy.random.Generator
-        Source of randomness (results are reproducible from its seed).
+    rng : numpy.random.Generator, int or numpy.random.SeedSequence
+        Source of randomness. The numbers are those of :class:`BrownianDriver` (see its *Stream*)
+        with ``seed = SeedSequence([a, b])``, ``a, b = rng.integers(0, 2**63, size=2)`` (one call
+        advances ``rng`` by these two draws only); an int or ``SeedSequence`` is used as the
+        driver's seed directly.
     n_steps : int
         Number of steps ``N >= 1``.
     dt : float or array_like, shape ``(N,)``
@@ -248,9 +220,11 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
 
     Notes
     -----
-    The increments are drawn first from ``rng``, so for the same seed ``dW`` is identical
-    whatever ``levy_area``, ``substeps`` or ``kind``; chunking a long horizon into several calls
-    with one generator gives independent, exactly distributed chunks.
+    The increments and the areas come from separate per-path streams (:class:`BrownianDriver`),
+    so for the same seed ``dW`` is identical whatever ``levy_area``, ``substeps`` or ``kind``;
+    chunking a long horizon into several calls with one generator gives independent, exactly
+    distributed chunks (for a stream that does not depend on the chunking, iterate
+    ``BrownianDriver(...).blocks()``).
 
     Examples
     --------
@@ -266,24 +240,16 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     >>> bool(np.array_equal(dW, dW2)), none is None
     (True, True)
     """
-    rng = check_rng(rng, "rng")
+    seed = _seed_from_rng(rng)
     n_steps = check_positive_int(n_steps, "n_steps")
     dim = check_positive_int(dim, "dim")
     batch_shape = _check_batch_shape(batch_shape)
     h = _check_dt(dt, n_steps)
-    method = _check_levy_method(levy_area)
-    m = check_positive_int(substeps, "substeps")
-    kind = _check_kind(kind)
-
-    shape = batch_shape + (n_steps, dim)
-    dW = rng.standard_normal(shape) * np.sqrt(h)[:, None]
-    if method is None:
-        return dW, None
-    rows = dW.reshape(-1, dim)
-    hrows = np.ascontiguousarray(np.broadcast_to(h, batch_shape + (n_steps,)).reshape(-1))
-    areas = np.empty(shape + (dim,))
-    _sample_areas(rng, rows, hrows, method, m, kind == "ito", areas.reshape(-1, dim, dim))
-    return dW, areas
+    drv = BrownianDriver(dim, seed=seed, times=np.concatenate([[0.0], np.cumsum(h)]), batch_shape=batch_shape,
+                         levy_area=levy_area, substeps=substeps, kind=kind)
+    drv._h = h                               # the given step sizes exactly (not differences of their sums)
+    X = drv.rough_path()
+    return X.increments, X.areas
 
 
 def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich", levy_area="davie",
@@ -296,8 +262,9 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
         Strictly increasing grid (non-uniform allowed).
     dim : int
         Dimension ``d``.
-    rng : numpy.random.Generator
-        Source of randomness.
+    rng : numpy.random.Generator, int or numpy.random.SeedSequence
+        Source of randomness: the path is ``BrownianDriver(dim, seed=..., times=times, ...)
+        .rough_path()`` with the seed derived as in :func:`brownian_increments_and_areas`.
     batch_shape : tuple of int, optional
         Independent paths, default ``()``.
     kind : {"stratonovich", "ito"}
@@ -323,24 +290,9 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
     >>> float(X.geometric_defect().max()) < 1e-15
     True
     """
-    t = check_times(times, "times")
-    rng = check_rng(rng, "rng")
-    dim = check_positive_int(dim, "dim")
-    batch_shape = _check_batch_shape(batch_shape)
-    kind = _check_kind(kind)
-    dW, areas = brownian_increments_and_areas(rng, t.size - 1, np.diff(t), dim, batch_shape=batch_shape,
-                                              levy_area=levy_area, substeps=substeps, kind=kind)
-    if x0 is None:
-        z = np.zeros(batch_shape + (dim,))
-    else:
-        z = as_float_array(x0, "x0", last_dims=(dim,))
-        try:
-            z = np.array(np.broadcast_to(z, batch_shape + (dim,)))
-        except ValueError:
-            raise ValueError(f"x0 of shape {z.shape} does not broadcast to the batch shape "
-                             f"{batch_shape} + (d={dim},).") from None
-    rp_kind = None if areas is None else ("geometric" if kind == "stratonovich" else "ito")
-    return RoughPath(dW, areas, times=t, x0=z, kind=rp_kind, check=False)
+    seed = _seed_from_rng(rng)
+    return BrownianDriver(dim, seed=seed, times=times, batch_shape=batch_shape, kind=kind, levy_area=levy_area,
+                          substeps=substeps, x0=x0).rough_path()
 
 
 # ---------------------------------------------------------------------------- refinement
@@ -392,7 +344,8 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     factor : int
         Substeps per step, ``>= 1`` (``1`` returns ``X`` unchanged).
     rng : numpy.random.Generator
-        Source of randomness.
+        Source of randomness, drawn from directly (not the driver's per-path streams: the
+        refined path depends on the whole batch and on ``factor``'s sequence of splits).
 
     Returns
     -------
@@ -606,6 +559,8 @@ class BrownianDriver(Driver):
         self.seed_sequence = _check_seed(seed)
         self.times = _grid(times, dt, n_steps, t0)
         self.times.setflags(write=False)
+        # step sizes: exactly dt on a uniform grid, else the grid differences
+        self._h = np.full(self.n_steps, float(dt)) if times is None else np.diff(self.times)
         self.batch_shape = _check_batch_shape(batch_shape)
         self.levy_area = _check_levy_method(levy_area)
         self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
@@ -717,7 +672,7 @@ class BrownianDriver(Driver):
             keys[:, 1] = 1
             area_streams = PathStreams(ss, keys)
         rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
-        h_all = np.diff(self.times)
+        h_all = self._h
         x = np.array(self._x0_flat())
         zbuf = np.empty(P * min(K, N) * max(na, 1)) if self.level == 2 else None
         davie = self.levy_area == "davie" and d > 1

@@ -201,3 +201,18 @@ def test_numpy_fallback_driver_gives_the_same_bits(monkeypatch, method, m):
     np.testing.assert_array_equal(np.concatenate([b.increments for b in slow_blocks], axis=-2), fast.increments)
     if method is not None:
         np.testing.assert_array_equal(np.concatenate([b.areas for b in slow_blocks], axis=-3), fast.areas)
+
+
+def test_one_shot_wrappers_sample_the_driver_stream():
+    from roughpaths import brownian_increments_and_areas, brownian_rough_path
+    times = [0.0, 0.3, 0.5, 1.0]
+    X = brownian_rough_path(times, 2, 17, batch_shape=(3,), levy_area="foster", substeps=2)
+    Y = BrownianDriver(2, seed=17, times=times, batch_shape=(3,), levy_area="foster", substeps=2).rough_path()
+    np.testing.assert_array_equal(X.areas, Y.areas)
+    rng, twin = np.random.default_rng(5), np.random.default_rng(5)
+    dW, XX = brownian_increments_and_areas(rng, 4, 0.25, 3, batch_shape=(2,))
+    seed = np.random.SeedSequence([int(v) for v in twin.integers(0, 2**63, size=2, dtype=np.int64)])
+    Z = BrownianDriver(3, seed=seed, dt=0.25, n_steps=4, batch_shape=(2,)).rough_path()
+    np.testing.assert_array_equal(dW, Z.increments)
+    np.testing.assert_array_equal(XX, Z.areas)
+    assert rng.random() == twin.random()           # the wrapper advanced rng by exactly two draws
