@@ -1,6 +1,6 @@
 r"""Brownian motion lifted to a level-2 rough path (Stratonovich or Itô), sampled on a grid.
 
-Conventions (``CONVENTIONS.md``)
+Conventions (``docs/conventions.md``)
 --------------------------------
 * area ``XX[..., i, j]`` over a step ``[s, t]`` is :math:`\int_s^t (W^i_r - W^i_s)\,\circ dW^j_r`
   (``iisignature`` ordering);
@@ -72,10 +72,10 @@ import numbers
 
 import numpy as np
 
-from .validation import as_float_array, check_positive_int, check_rng, check_times
+from .validation import as_float_array, check_positive_int, check_rng
 from ._brownian_kernels import _block_areas
 from ._random import PathStreams
-from .driver import Driver
+from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from .level2 import outer
 from .rough_path import RoughPath
 
@@ -90,20 +90,6 @@ _KINDS = ("stratonovich", "ito")
 
 
 # ---------------------------------------------------------------------------- validation
-def _check_batch_shape(batch_shape) -> tuple:
-    if isinstance(batch_shape, numbers.Integral) and not isinstance(batch_shape, bool):
-        batch_shape = (batch_shape,)
-    try:
-        shape = tuple(batch_shape)
-    except TypeError:
-        raise TypeError(f"batch_shape must be a tuple of integers, got {batch_shape!r}; "
-                        f"pass e.g. batch_shape=(1000,).") from None
-    for n in shape:
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
-            raise ValueError(f"batch_shape must hold non-negative integers, got {shape!r}.")
-    return tuple(int(n) for n in shape)
-
-
 def _check_kind(kind) -> str:
     if kind not in _KINDS:
         raise ValueError(f"kind must be 'stratonovich' or 'ito', got {kind!r}.")
@@ -442,43 +428,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
 _BLOCK_BYTES = 2 << 20
 
 
-def _check_seed(seed) -> np.random.SeedSequence:
-    if isinstance(seed, np.random.SeedSequence):
-        return seed
-    if isinstance(seed, numbers.Integral) and not isinstance(seed, bool):
-        if seed < 0:
-            raise ValueError(f"seed must be a non-negative integer, got {seed}.")
-        return np.random.SeedSequence(int(seed))
-    if isinstance(seed, np.random.Generator):
-        raise TypeError("seed must be an int or a numpy.random.SeedSequence, got a Generator: a Generator's "
-                        "state would make the paths depend on what was drawn before. Pass seed=<int> "
-                        "(or brownian_rough_path(times, dim, rng), which derives a seed from rng).")
-    raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
-
-
-def _grid(times, dt, n_steps, t0) -> np.ndarray:
-    if times is not None:
-        if dt is not None or n_steps is not None:
-            raise ValueError("pass either times=... or dt=... with n_steps=..., not both.")
-        return check_times(times, "times")
-    if dt is None or n_steps is None:
-        raise ValueError("the grid is missing: pass times=<increasing array> or dt=<step> and n_steps=<int>.")
-    n = check_positive_int(n_steps, "n_steps")
-    if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
-        raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
-                         f"non-uniform grid.")
-    return float(t0) + float(dt) * np.arange(n + 1, dtype=np.float64)
-
-
-def _phys_bytes() -> float:
-    try:
-        import os
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-        return float("inf")
-
-
-class BrownianDriver(Driver):
+class BrownianDriver(SeededDriver):
     r"""Brownian motion lifted to a level-2 rough path, generated lazily in time blocks, per-path seeded.
 
     :func:`roughpaths.solve` consumes it exactly like the ``RoughPath`` that :meth:`rough_path`
@@ -555,44 +505,17 @@ class BrownianDriver(Driver):
 
     def __init__(self, dim, *, seed, times=None, dt=None, n_steps=None, t0=0.0, batch_shape=(),
                  levy_area="davie", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES):
-        self.dim = check_positive_int(dim, "dim")
-        self.seed_sequence = _check_seed(seed)
-        self.times = _grid(times, dt, n_steps, t0)
-        self.times.setflags(write=False)
-        # step sizes: exactly dt on a uniform grid, else the grid differences
-        self._h = np.full(self.n_steps, float(dt)) if times is None else np.diff(self.times)
-        self.batch_shape = _check_batch_shape(batch_shape)
+        self._init_common(dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes)
         self.levy_area = _check_levy_method(levy_area)
         self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
         self.kind = _check_kind(kind)
         self.level = 1 if self.levy_area is None else 2
-        self.block_bytes = check_positive_int(block_bytes, "block_bytes")
-        self._paths = None                   # None: all paths 0..n-1 (nothing allocated before blocks())
-        if x0 is None:
-            self._x0 = np.zeros(self.dim)
-        else:
-            z = as_float_array(x0, "x0", last_dims=(self.dim,))
-            try:
-                np.broadcast_shapes(z.shape, self.batch_shape + (self.dim,))
-            except ValueError:
-                raise ValueError(f"x0 of shape {z.shape} does not broadcast to the batch shape "
-                                 f"{self.batch_shape} + (d={self.dim},).") from None
-            self._x0 = z.copy()
+        self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
+
+    def _starts(self) -> dict:
+        return {"_x0": self.dim}
 
     # ------------------------------------------------------------------ layout
-    @property
-    def n_paths(self) -> int:
-        """Number of paths (``prod(batch_shape)``)."""
-        return int(np.prod(self.batch_shape, dtype=np.int64))
-
-    @property
-    def path_indices(self) -> np.ndarray:
-        """Flat indices (in the original batch) of this driver's paths; they key the streams."""
-        return np.arange(self.n_paths, dtype=np.int64) if self._paths is None else self._paths.copy()
-
-    def _x0_flat(self) -> np.ndarray:
-        return np.broadcast_to(self._x0, self.batch_shape + (self.dim,)).reshape(-1, self.dim)
-
     @property
     def _n_area_normals(self) -> int:
         if self.levy_area is None:
@@ -604,49 +527,9 @@ class BrownianDriver(Driver):
         d = self.dim
         return 8 * (2 * d + (d * d + self._n_area_normals if self.level == 2 else 0))
 
-    def default_block_steps(self) -> int:
-        """Steps per block used by :meth:`blocks` when ``max_steps`` is None (from ``block_bytes``)."""
-        per_step = max(1, self.n_paths) * self._bytes_per_path_step()
-        return max(1, min(self.n_steps, self.block_bytes // per_step))
-
     def __repr__(self) -> str:
         return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
                 f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
-
-    # ------------------------------------------------------------------ subsets
-    def select(self, paths) -> "BrownianDriver":
-        """A driver for a subset of this driver's paths, bitwise equal to those paths of this one.
-
-        Parameters
-        ----------
-        paths : slice, range or array_like of int
-            Flat indices into this driver's batch (C order). The result has ``batch_shape ==
-            (len(paths),)``; its ``x0`` is taken from this driver's.
-
-        Returns
-        -------
-        BrownianDriver
-        """
-        n = self.n_paths
-        if isinstance(paths, slice):
-            idx = np.arange(n)[paths]
-        else:
-            if isinstance(paths, range):
-                paths = np.arange(paths.start, paths.stop, paths.step)
-            idx = np.asarray(paths)
-            if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
-                raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, "
-                                f"got {paths!r}.")
-            if idx.size and (idx.min() < -n or idx.max() >= n):
-                raise ValueError(f"paths holds indices outside [0, {n}) (this driver has {n} paths), "
-                                 f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
-            idx = np.where(idx < 0, idx + n, idx).astype(np.int64)
-        new = object.__new__(BrownianDriver)
-        new.__dict__.update(self.__dict__)
-        new._paths = self.path_indices[idx]
-        new._x0 = self._x0_flat()[idx]
-        new.batch_shape = (int(idx.size),)
-        return new
 
     # ------------------------------------------------------------------ generation
     def blocks(self, max_steps=None):
@@ -655,12 +538,8 @@ class BrownianDriver(Driver):
         The numbers do not depend on ``max_steps`` (see *Stream*); default
         :meth:`default_block_steps`. Each call starts the streams afresh.
         """
-        K = self.default_block_steps() if max_steps is None else check_positive_int(max_steps, "max_steps")
+        K = self._block_size(max_steps)
         N, d, P = self.n_steps, self.dim, self.n_paths
-        need = float(P) * min(K, N) * self._bytes_per_path_step()
-        if need > 0.5 * _phys_bytes():
-            raise ValueError(f"one block of {min(K, N)} step(s) for {P} paths needs {need / 2**30:.1f} GiB, more "
-                             f"than half the machine's memory; pass a smaller max_steps or select(...) fewer paths.")
         ss = self.seed_sequence
         keys = np.zeros((P, 2), dtype=np.int64)
         keys[:, 0] = self.path_indices
@@ -673,7 +552,7 @@ class BrownianDriver(Driver):
             area_streams = PathStreams(ss, keys)
         rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
         h_all = self._h
-        x = np.array(self._x0_flat())
+        x = np.array(self._flat(self._x0, d))
         zbuf = np.empty(P * min(K, N) * max(na, 1)) if self.level == 2 else None
         davie = self.levy_area == "davie" and d > 1
         for k0 in range(0, N, K):
@@ -695,12 +574,3 @@ class BrownianDriver(Driver):
                               times=self.times[k0:k1 + 1], x0=x0.copy(), kind=rp_kind, check=False)
             x += dW.sum(axis=1)
             yield block
-
-    def rough_path(self) -> RoughPath:
-        """The whole driver as one ``RoughPath`` (refused, naming the size, if it would not fit in memory)."""
-        need = float(self.n_paths) * self.n_steps * 8 * (self.dim + (self.dim ** 2 if self.level == 2 else 0))
-        if need > 0.5 * _phys_bytes():
-            raise ValueError(f"the whole path needs {need / 2**30:.1f} GiB, more than half the machine's "
-                             f"memory; pass the driver to solve(...) (it is consumed block by block) or "
-                             f"iterate driver.blocks(), or select(...) fewer paths.")
-        return super().rough_path()
