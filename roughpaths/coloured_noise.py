@@ -43,11 +43,14 @@ import numpy as np
 
 from .validation import as_float_array, check_positive_int, check_rng, check_times
 from .rough_path import RoughPath
+from ._random import PathStreams
+from ._seeded import SeededDriver
 from ._coloured_noise_kernels import _ou_lift_kernel
 from .coloured_noise_law import (ColouredNoiseLimit, _check_AD, _check_eps, _substep_factor, coloured_noise_limit,
                                  expected_area_rate, lift_area_rate, ou_step_law, paper_coloured_noise_matrices)
 
 __all__ = [
+    "ColouredNoiseDriver",
     "ResolutionWarning",
     "ColouredNoiseLimit",
     "ColouredNoiseSample",
@@ -313,3 +316,144 @@ def iter_coloured_noise(A, D, eps, h, n_steps, *, rng, n_paths=1, y0="stationary
         _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc, area, yg, binc, barea)
         done += S
         yield inc, area, binc, barea, yg
+
+
+# ------------------------------------------------------------------------------- driver
+class ColouredNoiseDriver(SeededDriver):
+    r"""The lift of ``B^ε = ∫ y/ε dt`` as a lazily generated, per-path seeded driver.
+
+    Same law, sub-stepping and Hermite area as :func:`sample_coloured_noise`; consumed by
+    :func:`roughpaths.solve` like the ``RoughPath`` that :meth:`rough_path` returns
+    (dimension ``n``, kind ``"geometric"``).
+
+    Parameters
+    ----------
+    A, D, eps : as in :func:`sample_coloured_noise`
+    seed : int or numpy.random.SeedSequence
+        Root of the per-path streams (see *Stream*).
+    times : array_like, shape ``(N + 1,)``, optional
+        Increasing grid; or ``dt`` and ``n_steps`` (uniform, from ``t0``).
+    dt, n_steps, t0 : optional
+        Uniform grid ``t0 + dt * arange(n_steps + 1)``.
+    batch_shape : tuple of int
+        Independent paths; path ``i`` is the ``i``-th in C order.
+    y0 : "stationary" or array_like ``(..., n)``
+        Start: a draw from ``N(0, Σ)`` (from the path's stream) or a given value.
+    substeps, max_substep : as in :func:`sample_coloured_noise` (``substeps`` resolved from the
+        largest step).
+    block_bytes : int
+        Target memory of one block (default 2 MiB); never changes the numbers.
+
+    Notes
+    -----
+    **Stream.** With ``S = SeedSequence(seed)`` and ``i`` the path's flat index, path ``i`` draws
+    the standard normals of ``Generator(PCG64(SeedSequence(S.entropy, spawn_key=S.spawn_key +
+    (i,))))``: first ``n`` for a stationary start (``y0 = L z``, ``LLᵀ = Σ``), then per step and
+    per sub-step ``n + m`` normals (the exact ``(ỹ_δ, ΔB̃)`` draw of the sub-step). The numbers of
+    a path depend only on ``seed``, ``i`` and the model (``A``, ``D``, ``ε``, grid, ``substeps``):
+    not on the block size, :meth:`select`, or the process.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.array([[1.0, 1.0], [-1.0, 1.0]])
+    >>> drv = ColouredNoiseDriver(A, np.eye(2), 0.1, seed=3, dt=0.05, n_steps=20, batch_shape=(4,))
+    >>> X = drv.rough_path()
+    >>> X.batch_shape, X.dim, X.kind, drv.substeps
+    ((4,), 2, 'geometric', 15)
+    >>> Y = np.concatenate([b.areas for b in drv.blocks(max_steps=3)], axis=1)
+    >>> bool(np.array_equal(Y, X.areas))
+    True
+    """
+
+    def __init__(self, A, D, eps, *, seed, times=None, dt=None, n_steps=None, t0=0.0, batch_shape=(),
+                 y0="stationary", substeps=None, max_substep: float = 0.5, block_bytes=2 << 20):
+        A, D = _check_AD(A, D)
+        self.eps = _check_eps(eps)
+        self._init_common(A.shape[0], seed, times, dt, n_steps, t0, batch_shape, block_bytes)
+        self.A, self.D = A, D
+        self.limit = coloured_noise_limit(A, D)
+        self.level = 2
+        self.noise_dim = D.shape[1]
+        self.substeps = _resolve_substeps(A, self.eps, float(self._h.max()), substeps, max_substep)
+        if isinstance(y0, str):
+            if y0 != "stationary":
+                raise ValueError(f"y0 must be 'stationary' or an array of shape (..., {self.dim}), got {y0!r}.")
+            self._y0 = None
+        else:
+            self._y0 = self._check_start(y0, "y0", self.dim)
+
+    def _starts(self) -> dict:
+        return {"_y0": self.dim}
+
+    def _bytes_per_path_step(self) -> int:
+        n, m = self.dim, self.noise_dim
+        return 8 * (2 * n + n * n + m + m * m + self.substeps * (n + m))
+
+    def __repr__(self) -> str:
+        return (f"ColouredNoiseDriver(n={self.dim}, m={self.noise_dim}, eps={self.eps}, n_steps={self.n_steps}, "
+                f"batch_shape={self.batch_shape}, substeps={self.substeps})")
+
+    def _start(self):
+        """The path streams and the start ``y0`` ``(P, n)`` (its normals drawn first if stationary)."""
+        n, P = self.dim, self.n_paths
+        streams = PathStreams(self.seed_sequence, self.path_indices[:, None])
+        if self._y0 is None:
+            z0 = np.empty((P, n))
+            streams.fill(z0)
+            return streams, z0 @ np.linalg.cholesky(self.limit.Sigma).T
+        return streams, np.array(self._flat(self._y0, n))
+
+    def initial_state(self) -> np.ndarray:
+        """The start ``y0`` of every path, shape ``(*batch_shape, n)`` (the stationary draw or the given value)."""
+        return self._start()[1].reshape(self.batch_shape + (self.dim,))
+
+    def blocks(self, max_steps=None):
+        """Yield consecutive ``RoughPath`` blocks of ``B^ε`` (see :meth:`blocks_with_brownian`)."""
+        for path, _, _ in self.blocks_with_brownian(max_steps):
+            yield path
+
+    def blocks_with_brownian(self, max_steps=None):
+        """Yield ``(path, brownian, y)`` per block: the lift of ``B^ε``, the coupled ``B`` and ``y``.
+
+        ``brownian`` is the level-2 piecewise-linear (sub-step Chen) lift of the driving ``B``
+        (dimension ``m``); ``y`` has shape ``(*batch_shape, k, n)``, the OU state at the end of
+        each step of the block. The numbers do not depend on ``max_steps``.
+        """
+        K = self._block_size(max_steps)
+        N, n, m, P, ms = self.n_steps, self.dim, self.noise_dim, self.n_paths, self.substeps
+        streams, y = self._start()
+        Ainv = np.linalg.inv(self.A)
+        cache = {}
+        bshape = self.batch_shape
+        xb, xw = np.zeros((P, n)), np.zeros((P, m))
+        zbuf = np.empty(P * min(K, N) * ms * (n + m))
+        for k0 in range(0, N, K):
+            k1 = min(N, k0 + K)
+            k = k1 - k0
+            z = zbuf[:P * k * ms * (n + m)].reshape(P, k, ms, n + m)
+            streams.fill(z.reshape(P, -1))
+            inc, area = np.empty((P, k, n)), np.empty((P, k, n, n))
+            yg, binc, barea = np.empty((P, k, n)), np.empty((P, k, m)), np.empty((P, k, m, m))
+            h = self._h[k0:k1]
+            lo = 0
+            while lo < k:                     # runs of equal step size share one transition factor
+                hi = lo + 1
+                while hi < k and h[hi] == h[lo]:
+                    hi += 1
+                key = float(h[lo])
+                delta = key / (ms * self.eps ** 2)
+                if key not in cache:
+                    cache[key] = _substep_factor(self.A, self.D, delta)
+                Phi, L = cache[key]
+                _ou_lift_kernel(y, z[:, lo:hi], Phi, L, Ainv, self.D, self.eps, delta, inc[:, lo:hi],
+                                area[:, lo:hi], yg[:, lo:hi], binc[:, lo:hi], barea[:, lo:hi])
+                lo = hi
+            t = self.times[k0:k1 + 1]
+            path = RoughPath(inc.reshape(bshape + (k, n)), area.reshape(bshape + (k, n, n)), times=t,
+                             x0=xb.reshape(bshape + (n,)).copy(), kind="geometric", check=False)
+            bro = RoughPath(binc.reshape(bshape + (k, m)), barea.reshape(bshape + (k, m, m)), times=t,
+                            x0=xw.reshape(bshape + (m,)).copy(), kind="geometric", check=False)
+            xb += inc.sum(axis=1)
+            xw += binc.sum(axis=1)
+            yield path, bro, yg.reshape(bshape + (k, n))
