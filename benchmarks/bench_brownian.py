@@ -17,6 +17,8 @@ Two tables, same run, medians of ``--repeats`` calls (the machine is shared: rea
    * ``driver``: ``BrownianDriver(...).blocks()`` iterated to the end (normals, increments and
      areas arrays, the ``RoughPath`` blocks a solver consumes; seeding included).
 
+3. d = 2: the driver with Davie's areas against the exact sampler (``levy_area="exact"``).
+
 Usage::
 
     python benchmarks/bench_brownian.py [--paths 1000] [--steps 1000] [--repeats 5]
@@ -69,6 +71,7 @@ def main(argv=None):
     # warm-up (JIT, self-checks)
     _drive(2, 3, d, "davie", 2)
     _drive(2, 3, d, "foster", 1)
+    _drive(2, 3, 2, "exact", 1)
     _mech_old(2, 3, d, True)
     brownian_increments_and_areas(np.random.default_rng(0), 2, 0.1, d, batch_shape=(2,))
 
@@ -103,6 +106,10 @@ def main(argv=None):
         t_dr = _median_time(lambda: _drive(P, N, d, method, m), rep)
         print(f"{name:>14} | {1e9 * t_mech / ps:8.1f} {1e9 * t_rp / ps:8.1f} {1e9 * t_dr / ps:8.1f} | "
               f"{t_dr / t_mech:15.2f} {t_dr / t_rp:13.2f}")
+    t_dav = _median_time(lambda: _drive(P, N, 2, "davie", 1), rep)
+    t_ex = _median_time(lambda: _drive(P, N, 2, "exact", 1), rep)
+    print(f"\nd = 2, driver: davie m=1 {1e9 * t_dav / ps:.1f}, exact {1e9 * t_ex / ps:.1f} ns per path-step "
+          f"(exact/davie {t_ex / t_dav:.1f})")
 
 
 if __name__ == "__main__":

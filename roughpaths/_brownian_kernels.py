@@ -29,6 +29,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._random import _pcg64_normal
+
 
 @njit(cache=True, nogil=True)
 def _block_areas(dW, h, buf, m, davie, ito, out):
@@ -118,3 +120,84 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
                     out[p, r, i, j] = sym + v
                     out[p, r, j, i] = sym - v
                     q += 1
+
+
+# ----------------------------------------------------------------------------- exact d = 2 area
+@njit(cache=True, inline="always")
+def _exp1(sh, sl, ih, il):
+    """An Exp(1) variable from two standard normals, ``(Z1² + Z2²)/2`` (exact: χ²₂/2)."""
+    z1, sh, sl = _pcg64_normal(sh, sl, ih, il)
+    z2, sh, sl = _pcg64_normal(sh, sl, ih, il)
+    return 0.5 * (z1 * z1 + z2 * z2), sh, sl
+
+
+@njit(cache=True, nogil=True)
+def _exact_areas_d2(dW, h, states, n_terms, t1, t2, ito, out):
+    r"""Exact-in-law d = 2 Lévy areas given the increments, from the per-path area streams.
+
+    For a step of size ``h`` with increment ``w`` and ``μ = |w|²/h``, the Lévy area is
+    ``A = h (L + √V Z)`` with ``L`` logistic of scale ``1/(2π)`` (``L = log(E₁/E₂)/(2π)``),
+    ``Z ~ N(0, 1)`` and ``V = Σ_{k≥1} Γ_k/(2π²k²)``, ``Γ_k ~ Gamma(N_k)`` (0 if ``N_k = 0``),
+    ``N_k ~ Poisson(μ)`` (derivation in :mod:`roughpaths.brownian`). The first ``n_terms``
+    terms are drawn exactly (``N_k`` by exponential arrivals, ``Γ_k`` as ``½ χ²_{2N_k}``), the
+    tail ``Σ_{k>n_terms}`` by a Gamma variable with its exact mean ``μ t1`` and variance
+    ``2 μ t2`` (Marsaglia–Tsang). Draw order per step: ``Z``; ``E₁, E₂`` (2 normals each);
+    for each ``k``: the arrivals (2 normals each, the one past ``μ`` included) then the ``2 N_k``
+    normals of ``Γ_k``; the tail's normals. ``states`` ``(P, 4)`` advance in place; ``out``
+    ``(P, K, 2, 2)`` receives ``A J + ½ w⊗w (- ½ h I)``.
+    """
+    P, K, d = dW.shape
+    inv2pi = 1.0 / (2.0 * np.pi)
+    inv2pi2 = 1.0 / (2.0 * np.pi * np.pi)
+    for p in range(P):
+        sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+        for r in range(K):
+            hr = h[r]
+            w0 = dW[p, r, 0]
+            w1 = dW[p, r, 1]
+            mu = (w0 * w0 + w1 * w1) / hr
+            z, sh, sl = _pcg64_normal(sh, sl, ih, il)
+            e1, sh, sl = _exp1(sh, sl, ih, il)
+            e2, sh, sl = _exp1(sh, sl, ih, il)
+            V = 0.0
+            for k in range(1, n_terms + 1):
+                # N_k ~ Poisson(mu): number of unit-rate arrivals in [0, mu]
+                n = 0
+                tarr, sh, sl = _exp1(sh, sl, ih, il)
+                while tarr <= mu:
+                    n += 1
+                    e, sh, sl = _exp1(sh, sl, ih, il)
+                    tarr += e
+                g = 0.0
+                for _ in range(2 * n):
+                    x, sh, sl = _pcg64_normal(sh, sl, ih, il)
+                    g += x * x
+                V += 0.5 * g * inv2pi2 / (k * k)
+            if mu > 0.0:
+                alpha = mu * t1 * t1 / (2.0 * t2)
+                theta = 2.0 * t2 / t1
+                a = alpha + 1.0 if alpha < 1.0 else alpha
+                dd = a - 1.0 / 3.0
+                c = 1.0 / np.sqrt(9.0 * dd)
+                while True:
+                    x, sh, sl = _pcg64_normal(sh, sl, ih, il)
+                    v = 1.0 + c * x
+                    if v <= 0.0:
+                        continue
+                    v = v * v * v
+                    e, sh, sl = _exp1(sh, sl, ih, il)
+                    if -e < 0.5 * x * x + dd - dd * v + dd * np.log(v):
+                        break
+                gam = dd * v
+                if alpha < 1.0:
+                    e, sh, sl = _exp1(sh, sl, ih, il)
+                    gam *= np.exp(-e / alpha)
+                V += theta * gam
+            A = hr * (inv2pi * np.log(e1 / e2) + np.sqrt(V) * z)
+            sym = 0.5 * w0 * w1
+            out[p, r, 0, 0] = 0.5 * w0 * w0 - (0.5 * hr if ito else 0.0)
+            out[p, r, 1, 1] = 0.5 * w1 * w1 - (0.5 * hr if ito else 0.0)
+            out[p, r, 0, 1] = sym + A
+            out[p, r, 1, 0] = sym - A
+        states[p, 0] = sh
+        states[p, 1] = sl

@@ -45,10 +45,8 @@ try:  # the ziggurat tables numpy uses (numba ships a copy for its own Generator
     from numba.np.random._constants import wi_double as _ZIG_W
     from numba.np.random._constants import ziggurat_nor_inv_r as _ZIG_INV_R
     from numba.np.random._constants import ziggurat_nor_r as _ZIG_R
-    _ZIGGURAT = (_ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
 except ImportError:  # pragma: no cover - another numba layout: fall back to numpy's sampler
     _ZIG_K = None
-    _ZIGGURAT = None
 
 __all__ = ["standard_normal_into", "PathStreams"]
 
@@ -272,9 +270,15 @@ def _pcg64_seed(seeds, states):
         states[p, 3] = il
 
 
-@njit(cache=True, inline="always")
-def _pcg64_normal(sh, sl, ih, il, ki, wi, fi, r_tail, inv_r):
-    """One standard normal (numpy's ziggurat) from PCG64 state ``(sh, sl)``; returns ``(x, sh, sl)``."""
+@njit(cache=True)
+def _pcg64_normal(sh, sl, ih, il):
+    """One standard normal (numpy's ziggurat) from PCG64 state ``(sh, sl)``; returns ``(x, sh, sl)``.
+
+    The tables are module globals (numba freezes them as constants): passing them as arguments
+    costs a reference count per call, and an ``inline="always"`` version multiplied the
+    compile time of its callers.
+    """
+    ki, wi, fi, r_tail, inv_r = _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R
     m255 = np.uint64(255)
     m52 = np.uint64(0x000FFFFFFFFFFFFF)
     one = np.uint64(1)
@@ -310,13 +314,13 @@ def _pcg64_normal(sh, sl, ih, il, ki, wi, fi, r_tail, inv_r):
 
 
 @njit(cache=True)
-def _pcg64_normals(states, out, ki, wi, fi, r_tail, inv_r):
+def _pcg64_normals(states, out):
     """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
     P, n = out.shape
     for p in range(P):
         sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
         for i in range(n):
-            out[p, i], sh, sl = _pcg64_normal(sh, sl, ih, il, ki, wi, fi, r_tail, inv_r)
+            out[p, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
         states[p, 0] = sh
         states[p, 1] = sl
 
@@ -431,7 +435,7 @@ class PathStreams:
         if out.shape[0] != self.n_streams or out.ndim != 2 or out.dtype != np.float64:
             raise ValueError(f"out must be float64 of shape ({self.n_streams}, n), got {out.dtype} {out.shape}.")
         if self._fast:
-            _pcg64_normals(self.states, out, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+            _pcg64_normals(self.states, out)
         else:
             for p, g in enumerate(self._gens):
                 row = out[p]

@@ -49,6 +49,29 @@ conditional mean; the residual law error is in the fourth and higher cumulants a
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
 component (the added Gaussian is independent of the path).
 
+``levy_area="exact"`` (d = 2 only) samples the Lévy area from its conditional law given the
+increment ``w`` (Lévy 1951), whose characteristic function is
+:math:`\frac{\lambda h/2}{\sinh(\lambda h/2)}\exp\bigl(-\frac{|w|^2}{2h}(\frac{\lambda h}{2}\coth\frac{\lambda h}{2} - 1)\bigr)`.
+Derivation of the sampler: :math:`x/\sinh x = \prod_k (1 + x^2/(k\pi)^2)^{-1}` is the
+characteristic function of a logistic variable of scale :math:`h/(2\pi)` (``λ`` for ``x = λh/2``), and
+:math:`x\coth x - 1 = \sum_k 2x^2/(x^2 + k^2\pi^2)` makes the second factor a product over ``k``
+of compound Poisson laws with rate :math:`\mu = |w|^2/h` and Laplace jumps of scale
+:math:`h/(2\pi k)`. A sum of ``n`` standard Laplace variables is :math:`\sqrt{2\Gamma_n} Z`, so
+
+.. math:: A = h\bigl(L + \sqrt{V} Z\bigr),\quad L = \tfrac{1}{2\pi}\log\tfrac{E_1}{E_2},\quad
+          V = \sum_{k\ge1} \frac{\Gamma(N_k)}{2\pi^2 k^2},\quad N_k \sim \mathrm{Poisson}(\mu),
+
+(``E`` exponential, ``Z`` normal, all independent; check: :math:`E[V] = \mu/12`, so
+:math:`\mathrm{Var}(A\mid w) = h^2/12 + h|w|^2/12`). The first 8 terms are drawn exactly (Poisson
+by exponential arrivals, Gamma as a χ², all from the path's normals), the tail
+:math:`\sum_{k>8}` by a Gamma variable with its exact mean and variance. The law error this
+leaves, bounded through the characteristic functions by Gil-Pelaez
+(:math:`\sup|\Delta F| \le \pi^{-1}\int |\Delta\varphi(\lambda)|/\lambda\, d\lambda`), is below
+5·10⁻⁷ in CDF (sup norm; the resolution of that quadrature) for every ``|w|`` tried (``μ`` from
+0.5 to 50; replacing the tail by its mean alone would leave 1e-5): no Kolmogorov–Smirnov test
+with fewer than ~10¹² samples can see it. Cost: a variable number of normals, about
+``24 + 32 μ`` per step (``E[μ] = 2``: ~90), against 5 for Davie's ``m = 1`` (d = 2).
+
 Cost per step: ``d`` normals for the increment, plus ``m d`` (bridge, only if ``m > 1``),
 ``m d`` (space-time areas) and ``d(d-1)/2`` (Davie) normals and ``O(m d^2)`` flops for the area.
 The normals come from per-path streams (numpy's ziggurat over ``PCG64``, run by a numba kernel
@@ -73,7 +96,7 @@ import numbers
 import numpy as np
 
 from .validation import as_float_array, check_positive_int, check_rng
-from ._brownian_kernels import _block_areas
+from ._brownian_kernels import _block_areas, _exact_areas_d2
 from ._random import PathStreams
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from .level2 import outer
@@ -85,7 +108,9 @@ __all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_pa
 #: (Davie's own method: exact second moments at the lowest cost).
 DEFAULT_SUBSTEPS = 1
 
-_LEVY_METHODS = ("davie", "foster")
+_LEVY_METHODS = ("davie", "foster", "exact")
+#: Series terms drawn exactly by ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
+_EXACT_TERMS = 8
 _KINDS = ("stratonovich", "ito")
 
 
@@ -185,8 +210,9 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
         Dimension ``d >= 1`` of the Brownian motion.
     batch_shape : tuple of int, optional
         Leading batch axes (independent paths), default ``()``.
-    levy_area : {"davie", "foster"} or None
-        Lévy-area method (see the module docstring for its exact error): ``"davie"`` (default)
+    levy_area : {"davie", "foster", "exact"} or None
+        Lévy-area method (see the module docstring for its exact error; ``"exact"`` for ``d = 2``
+        only): ``"davie"`` (default)
         matches every second moment of ``(W, A)`` exactly, ``"foster"`` is the conditional mean
         given the substep information (best L² approximation, variance short by ``h²/(12 m)``).
         ``None`` (or ``"none"``) returns ``areas=None`` and draws only the increments.
@@ -426,6 +452,9 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
 
 # ---------------------------------------------------------------------------- the driver
 _BLOCK_BYTES = 2 << 20
+# tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
+_EXACT_T1 = (np.pi ** 2 / 6 - sum(1.0 / k ** 2 for k in range(1, _EXACT_TERMS + 1))) / (2 * np.pi ** 2)
+_EXACT_T2 = (np.pi ** 4 / 90 - sum(1.0 / k ** 4 for k in range(1, _EXACT_TERMS + 1))) / (4 * np.pi ** 4)
 
 
 class BrownianDriver(SeededDriver):
@@ -452,9 +481,9 @@ class BrownianDriver(SeededDriver):
         Start of the uniform grid (default 0).
     batch_shape : tuple of int
         Independent paths, default ``()``; path ``i`` is the ``i``-th in C order of the batch.
-    levy_area : {"davie", "foster"} or None
-        Area method (default ``"davie"``, exact second moments). ``None``: increments only
-        (``level == 1``).
+    levy_area : {"davie", "foster", "exact"} or None
+        Area method (default ``"davie"``, exact second moments); ``"exact"``: the exact law given
+        the increment, ``d = 2`` only (module docstring). ``None``: increments only (``level == 1``).
     substeps : int
         Substeps ``m`` per step of the area sampler, default :data:`DEFAULT_SUBSTEPS` ``= 1``
         (Davie's own method). Larger ``m`` lowers the L² error (``h/√(6m)`` for davie,
@@ -479,7 +508,8 @@ class BrownianDriver(SeededDriver):
     * areas: the same with ``spawn_key=S.spawn_key + (i, 1)``; step ``k`` takes the next
       ``(m d if m > 1) + m d + (d(d-1)/2 if davie)`` normals: the bridge normals, the
       space-time normals and Davie's normals, in this order (see
-      :mod:`roughpaths._brownian_kernels`).
+      :mod:`roughpaths._brownian_kernels`); for ``"exact"`` a variable number, in the order
+      documented in ``_brownian_kernels._exact_areas_d2``.
 
     So a path's numbers depend only on ``seed``, ``i``, and (for the areas) ``levy_area`` and
     ``substeps``: not on the block size, on which paths are generated together (:meth:`select`),
@@ -508,6 +538,13 @@ class BrownianDriver(SeededDriver):
         self._init_common(dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes)
         self.levy_area = _check_levy_method(levy_area)
         self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
+        if self.levy_area == "exact":
+            if self.dim != 2:
+                raise ValueError(f"levy_area='exact' is available for dim=2 only, got dim={self.dim}; use "
+                                 f"levy_area='davie' (exact second moments) for d > 2.")
+            if self.substeps != 1:
+                raise ValueError(f"substeps={self.substeps} has no effect with levy_area='exact' (the area is "
+                                 f"exact in law); leave substeps at its default.")
         self.kind = _check_kind(kind)
         self.level = 1 if self.levy_area is None else 2
         self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
@@ -518,7 +555,7 @@ class BrownianDriver(SeededDriver):
     # ------------------------------------------------------------------ layout
     @property
     def _n_area_normals(self) -> int:
-        if self.levy_area is None:
+        if self.levy_area in (None, "exact"):
             return 0
         d, m = self.dim, self.substeps
         return (m * d if m > 1 else 0) + m * d + (d * (d - 1) // 2 if self.levy_area == "davie" else 0)
@@ -563,7 +600,14 @@ class BrownianDriver(SeededDriver):
             inc_streams.fill(dW.reshape(P, k * d))
             dW *= np.sqrt(h)[:, None]
             areas = None
-            if self.level == 2:
+            if self.levy_area == "exact":
+                if area_streams.states is None:  # pragma: no cover - only if numpy's algorithms change
+                    raise RuntimeError("levy_area='exact' needs the numba PCG64 streams, whose self-check "
+                                       "against numpy failed in this process; use levy_area='davie'.")
+                areas = np.empty((P, k, d, d))
+                _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
+                                self.kind == "ito", areas)
+            elif self.level == 2:
                 z = zbuf[:P * k * na].reshape(P, k * na)
                 area_streams.fill(z)
                 areas = np.empty((P, k, d, d))
