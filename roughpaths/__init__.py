@@ -7,6 +7,7 @@ Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 
 from .brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path, refine
 from .coloured_noise import (
+    ColouredNoiseDriver,
     ColouredNoiseLimit,
     ColouredNoiseSample,
     ResolutionWarning,
@@ -72,6 +73,7 @@ __all__ = [
     "rough_integral",
     # coloured noise
     "coloured_noise_limit",
+    "ColouredNoiseDriver",
     "ColouredNoiseLimit",
     "ColouredNoiseSample",
     "sample_coloured_noise",

@@ -35,7 +35,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 try:  # the ziggurat tables numpy uses (numba ships a copy for its own Generator support)
     from numba.np.random._constants import fi_double as _ZIG_F
@@ -218,33 +220,30 @@ def _seed_states(entropy, out):
 
 
 # ----------------------------------------------------------------------------- PCG64
-_M32 = np.uint64(0xFFFFFFFF)
-_S32 = np.uint64(32)
-_MUL_HI = np.uint64(2549297995355413924)
-_MUL_LO = np.uint64(4865540595714422341)
+_PCG_MUL = (2549297995355413924 << 64) | 4865540595714422341       # numpy's PCG_DEFAULT_MULTIPLIER_128
 
 
-@njit(cache=True, inline="always")
-def _mulhi(a, b):
-    a0 = a & _M32
-    a1 = a >> _S32
-    b0 = b & _M32
-    b1 = b >> _S32
-    p00 = a0 * b0
-    p01 = a0 * b1
-    p10 = a1 * b0
-    mid = (p00 >> _S32) + (p01 & _M32) + (p10 & _M32)
-    return a1 * b1 + (p01 >> _S32) + (p10 >> _S32) + (mid >> _S32)
+@intrinsic
+def _lcg(typingctx, sh, sl, ih, il):
+    """One step of PCG64's 128-bit LCG, ``s <- s * MUL + inc (mod 2**128)``, on (hi, lo) uint64 halves.
 
+    Written as an LLVM ``i128`` multiply-add (twice as fast as emulating it with 64-bit halves).
+    """
+    sig = types.UniTuple(types.uint64, 2)(types.uint64, types.uint64, types.uint64, types.uint64)
 
-@njit(cache=True, inline="always")
-def _lcg(sh, sl, ih, il):
-    """One step of PCG64's 128-bit LCG: ``s <- s * MUL + inc`` (mod 2**128)."""
-    lo = sl * _MUL_LO
-    hi = _mulhi(sl, _MUL_LO) + sl * _MUL_HI + sh * _MUL_LO
-    lo2 = lo + il
-    hi2 = hi + ih + (np.uint64(1) if lo2 < lo else np.uint64(0))
-    return hi2, lo2
+    def codegen(context, builder, signature, args):
+        i128, i64 = ir.IntType(128), ir.IntType(64)
+        c64 = ir.Constant(i128, 64)
+
+        def join(hi, lo):
+            return builder.or_(builder.shl(builder.zext(hi, i128), c64), builder.zext(lo, i128))
+
+        r = builder.add(builder.mul(join(args[0], args[1]), ir.Constant(i128, _PCG_MUL)), join(args[2], args[3]))
+        lo = builder.trunc(r, i64)
+        hi = builder.trunc(builder.lshr(r, c64), i64)
+        return context.make_tuple(builder, signature.return_type, [hi, lo])
+
+    return sig, codegen
 
 
 @njit(cache=True, inline="always")
@@ -272,49 +271,56 @@ def _pcg64_seed(seeds, states):
 
 
 @njit(cache=True)
-def _pcg64_normals(states, out, ki, wi, fi, r_tail, inv_r):
-    """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
+def _pcg64_normal(sh, sl, ih, il):
+    """One standard normal (numpy's ziggurat) from PCG64 state ``(sh, sl)``; returns ``(x, sh, sl)``.
+
+    The tables are module globals (numba freezes them as constants): passing them as arguments
+    costs a reference count per call, and an ``inline="always"`` version multiplied the
+    compile time of its callers.
+    """
+    ki, wi, fi, r_tail, inv_r = _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R
     m255 = np.uint64(255)
     m52 = np.uint64(0x000FFFFFFFFFFFFF)
     one = np.uint64(1)
     s8 = np.uint64(8)
     s11 = np.uint64(11)
     scale = 1.0 / 9007199254740992.0
+    while True:
+        sh, sl = _lcg(sh, sl, ih, il)
+        r = _xsl_rr(sh, sl)
+        idx = np.intp(r & m255)
+        r = r >> s8
+        rabs = (r >> one) & m52
+        x = float(rabs) * wi[idx]
+        if r & one:
+            x = -x
+        if rabs < ki[idx]:
+            return x, sh, sl
+        if idx == 0:
+            while True:
+                sh, sl = _lcg(sh, sl, ih, il)
+                u1 = float(_xsl_rr(sh, sl) >> s11) * scale
+                sh, sl = _lcg(sh, sl, ih, il)
+                u2 = float(_xsl_rr(sh, sl) >> s11) * scale
+                xx = -inv_r * math.log1p(-u1)
+                yy = -math.log1p(-u2)
+                if yy + yy > xx * xx:
+                    return (-(r_tail + xx) if (rabs >> s8) & one else r_tail + xx), sh, sl
+        else:
+            sh, sl = _lcg(sh, sl, ih, il)
+            u = float(_xsl_rr(sh, sl) >> s11) * scale
+            if (fi[idx - 1] - fi[idx]) * u + fi[idx] < math.exp(-0.5 * x * x):
+                return x, sh, sl
+
+
+@njit(cache=True)
+def _pcg64_normals(states, out):
+    """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
     P, n = out.shape
     for p in range(P):
         sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
-        i = 0
-        while i < n:
-            sh, sl = _lcg(sh, sl, ih, il)
-            r = _xsl_rr(sh, sl)
-            idx = np.intp(r & m255)
-            r = r >> s8
-            rabs = (r >> one) & m52
-            x = float(rabs) * wi[idx]
-            if r & one:
-                x = -x
-            if rabs < ki[idx]:
-                out[p, i] = x
-                i += 1
-                continue
-            if idx == 0:
-                while True:
-                    sh, sl = _lcg(sh, sl, ih, il)
-                    u1 = float(_xsl_rr(sh, sl) >> s11) * scale
-                    sh, sl = _lcg(sh, sl, ih, il)
-                    u2 = float(_xsl_rr(sh, sl) >> s11) * scale
-                    xx = -inv_r * math.log1p(-u1)
-                    yy = -math.log1p(-u2)
-                    if yy + yy > xx * xx:
-                        out[p, i] = -(r_tail + xx) if (rabs >> s8) & one else r_tail + xx
-                        break
-                i += 1
-            else:
-                sh, sl = _lcg(sh, sl, ih, il)
-                u = float(_xsl_rr(sh, sl) >> s11) * scale
-                if (fi[idx - 1] - fi[idx]) * u + fi[idx] < math.exp(-0.5 * x * x):
-                    out[p, i] = x
-                    i += 1
+        for i in range(n):
+            out[p, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
         states[p, 0] = sh
         states[p, 1] = sl
 
@@ -386,8 +392,10 @@ class PathStreams:
         self.n_streams = int(keys.shape[0])
         fast = (seed_seq.pool_size == 4 and _fast_streams_ok()) if _force_numpy is None else not _force_numpy
         self._fast = fast
+        #: ``(P, 4)`` uint64 PCG64 states (hi, lo, inc hi, inc lo) on the fast path, else None
+        self.states = None
         if fast:
-            self._states = self._fast_states()
+            self.states = self._fast_states()
         else:
             self._gens = [np.random.Generator(np.random.PCG64(np.random.SeedSequence(
                 seed_seq.entropy, spawn_key=tuple(seed_seq.spawn_key) + tuple(int(v) for v in k),
@@ -427,7 +435,7 @@ class PathStreams:
         if out.shape[0] != self.n_streams or out.ndim != 2 or out.dtype != np.float64:
             raise ValueError(f"out must be float64 of shape ({self.n_streams}, n), got {out.dtype} {out.shape}.")
         if self._fast:
-            _pcg64_normals(self._states, out, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+            _pcg64_normals(self.states, out)
         else:
             for p, g in enumerate(self._gens):
                 row = out[p]

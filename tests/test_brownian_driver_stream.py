@@ -77,7 +77,8 @@ def test_stream_definition_against_numpy(method, m, kind):
     assert X.kind == (None if method is None else ("geometric" if kind == "stratonovich" else "ito"))
 
 
-@pytest.mark.parametrize("method, m", [("davie", 1), ("davie", 4), ("foster", 1), ("foster", 3), (None, 1)])
+@pytest.mark.parametrize("method, m", [("davie", 1), ("davie", 4), ("foster", 1), ("foster", 3), ("exact", 1),
+                                       (None, 1)])
 def test_bitwise_invariant_under_blocks_and_selection(method, m):
     drv = BrownianDriver(2, seed=np.random.SeedSequence(99), dt=0.01, n_steps=23, batch_shape=(3, 4),
                          levy_area=method, substeps=m)
@@ -165,7 +166,7 @@ def test_numba_streams_equal_numpy_fallback_and_raw_normals_equal_numpy():
     (dict(seed=1, dt=-0.1, n_steps=3), ValueError, "dt"),
     (dict(seed=1, dt=0.1, n_steps=0), ValueError, "n_steps"),
     (dict(seed=1, times=[0.0, 0.5, 0.5]), ValueError, "times"),
-    (dict(seed=1, dt=0.1, n_steps=3, levy_area="exact"), ValueError, "levy_area"),
+    (dict(seed=1, dt=0.1, n_steps=3, levy_area="wiktorsson"), ValueError, "levy_area"),
     (dict(seed=1, dt=0.1, n_steps=3, substeps=0), ValueError, "substeps"),
     (dict(seed=1, dt=0.1, n_steps=3, kind="strat"), ValueError, "kind"),
     (dict(seed=1, dt=0.1, n_steps=3, batch_shape=(-2,)), ValueError, "batch_shape"),
@@ -189,3 +190,30 @@ def test_sizes_are_checked_before_allocating():
         BrownianDriver(2, seed=0, dt=0.1, n_steps=2, batch_shape=(3,)).select([0.5])
     with pytest.raises(ValueError, match="max_steps"):
         next(BrownianDriver(2, seed=0, dt=0.1, n_steps=2).blocks(0))
+
+
+@pytest.mark.parametrize("method, m", [("davie", 2), (None, 1)])
+def test_numpy_fallback_driver_gives_the_same_bits(monkeypatch, method, m):
+    import roughpaths._random as rnd
+    kw = dict(seed=12, dt=0.1, n_steps=9, batch_shape=(3,), levy_area=method, substeps=m)
+    fast = BrownianDriver(2, **kw).rough_path()
+    monkeypatch.setattr(rnd, "_FAST_OK", [False])
+    slow_blocks = list(BrownianDriver(2, **kw).blocks(4))
+    np.testing.assert_array_equal(np.concatenate([b.increments for b in slow_blocks], axis=-2), fast.increments)
+    if method is not None:
+        np.testing.assert_array_equal(np.concatenate([b.areas for b in slow_blocks], axis=-3), fast.areas)
+
+
+def test_one_shot_wrappers_sample_the_driver_stream():
+    from roughpaths import brownian_increments_and_areas, brownian_rough_path
+    times = [0.0, 0.3, 0.5, 1.0]
+    X = brownian_rough_path(times, 2, 17, batch_shape=(3,), levy_area="foster", substeps=2)
+    Y = BrownianDriver(2, seed=17, times=times, batch_shape=(3,), levy_area="foster", substeps=2).rough_path()
+    np.testing.assert_array_equal(X.areas, Y.areas)
+    rng, twin = np.random.default_rng(5), np.random.default_rng(5)
+    dW, XX = brownian_increments_and_areas(rng, 4, 0.25, 3, batch_shape=(2,))
+    seed = np.random.SeedSequence([int(v) for v in twin.integers(0, 2**63, size=2, dtype=np.int64)])
+    Z = BrownianDriver(3, seed=seed, dt=0.25, n_steps=4, batch_shape=(2,)).rough_path()
+    np.testing.assert_array_equal(dW, Z.increments)
+    np.testing.assert_array_equal(XX, Z.areas)
+    assert rng.random() == twin.random()           # the wrapper advanced rng by exactly two draws
