@@ -263,9 +263,14 @@ class LieHeun(CoadjointSolver):
         alg = system.algebra
         w0 = system.drift_velocity(mu)
         sig0 = w0 * dt + eta
+        fin = np.all(np.isfinite(sig0), axis=-1, keepdims=True)     # a non-finite member fails alone
+        sig0 = np.where(fin, sig0, 0.0)
         a = alg.ad_star(sig0, mu)
         mu_p = mu + a + 0.5 * alg.ad_star(sig0, a)                  # predictor: 2nd-order Taylor of exp
-        return 0.5 * (w0 + system.drift_velocity(mu_p)) * dt + eta, None
+        fin = fin & np.all(np.isfinite(mu_p), axis=-1, keepdims=True)  # an overflowed predictor fails too
+        mu_p = np.where(fin, mu_p, 0.0)
+        sigma = 0.5 * (w0 + system.drift_velocity(mu_p)) * dt + eta
+        return np.where(fin, sigma, np.nan), None
 
 
 class ImplicitMidpoint(CoadjointSolver):
