@@ -118,7 +118,7 @@ class _Spec:
     mu0: np.ndarray
     driver: BrownianDriver
     method: object
-    block_steps: int
+    block_steps: int | None
     burn_in: int
     average_every: int
     record_every: int | None
@@ -170,7 +170,7 @@ def _run_chunk(spec: _Spec, first: int, last: int):
 
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
-                 chunk_size=256, block_steps=500, executor=None, keep_final=False) -> EnsembleResult:
+                 chunk_size=256, block_steps=None, executor=None, keep_final=False) -> EnsembleResult:
     r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
 
     Parameters
@@ -201,8 +201,9 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         Also keep across-path statistics at steps ``0, record_every, 2·record_every, …``.
     chunk_size : int
         Paths per task. Changes memory use and parallelism, never the numbers.
-    block_steps : int
-        Steps per time block. Changes memory use, never the numbers.
+    block_steps : int, optional
+        Steps per time block (default: the driver's cache-sized blocks). Changes memory use and
+        speed, never the numbers.
     executor : concurrent.futures.Executor, optional
         Runs the chunks (default: serially in this process); e.g. ``dask.distributed``'s
         ``client.get_executor()``. Never changes the numbers.
@@ -258,7 +259,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     if record_every is not None:
         record_every = check_positive_int(record_every, "record_every")
     chunk_size = check_positive_int(chunk_size, "chunk_size")
-    block_steps = check_positive_int(block_steps, "block_steps")
+    if block_steps is not None:
+        block_steps = check_positive_int(block_steps, "block_steps")
     if executor is not None and not hasattr(executor, "submit"):
         raise TypeError(f"executor must be a concurrent.futures.Executor (with .submit), got {executor!r}.")
     if method.levy_area != (levy_area is not None):                 # the driving level follows levy_area
