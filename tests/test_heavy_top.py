@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from mechanics.heavy_top import heavy_top
-from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate, simulate_brownian
-from roughpaths import RoughPath
+from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate_brownian
+from roughpaths import RoughPath, solve
 
 I3 = np.array([1.0, 2.0, 3.0])
 CHI = np.array([0.2, -0.1, 1.0])
@@ -52,7 +52,7 @@ def _energy_errors(top, method, ns, T=2.0):
     errs = []
     for n in ns:
         X = RoughPath.from_path(np.zeros((n + 1, 3)), times=np.linspace(0.0, T, n + 1))
-        _, mu = simulate(top, MU0, X, method)
+        mu = solve(top, X, MU0, method).states
         errs.append(np.max(np.abs(top.energy(mu) - top.energy(MU0))))
     return np.polyfit(np.log(T / np.array(ns)), np.log(errs), 1)[0], errs
 
@@ -90,7 +90,7 @@ def test_paper_gravity_sign_does_not_conserve_energy():
 def test_dissipation_decreases_modified_energy(rng):
     top = heavy_top(I3, CHI, sigma=0.0, s=S, theta=0.5)
     X = RoughPath.from_path(np.zeros((401, 3)), times=np.linspace(0.0, 4.0, 401))
-    _, mu = simulate(top, MU0, X, LieHeun())
+    mu = solve(top, X, MU0, LieHeun()).states
     e = top.modified_energy(mu)
     assert np.all(np.diff(e) <= 1e-12) and e[-1] < e[0] - 1e-3
 
@@ -108,9 +108,9 @@ def test_perturbed_driver_equals_conservative_torque_with_dissipation(method, rn
     plain = heavy_top(I3, CHI, sigma=0.3, theta=0.5)
     conservative = heavy_top(I3, CHI, sigma=0.3, s=S, theta=0.5, levy_in_dissipation=False)
     default = heavy_top(I3, CHI, sigma=0.3, s=S, theta=0.5)
-    _, a = simulate(plain, MU0, X.perturb(S), method)
-    _, b = simulate(conservative, MU0, X, method)
-    _, c = simulate(default, MU0, X, method)
+    a = solve(plain, X.perturb(S), MU0, method).states
+    b = solve(conservative, X, MU0, method).states
+    c = solve(default, X, MU0, method).states
     assert np.max(np.abs(a - b)) <= 1e-12
     assert np.max(np.abs(a - c)) > 1e-3
 
