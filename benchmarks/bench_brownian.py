@@ -1,21 +1,27 @@
-"""Benchmark: Brownian increments and Lévy areas (``roughpaths.brownian``).
+"""Benchmark: Brownian increments and Lévy areas, old samplers against ``roughpaths.BrownianDriver``.
 
-Times ``brownian_increments_and_areas`` for ``paths × steps`` (default 1000 × 1000), d = 2, 3,
-substeps m = 1, 8 (Davie areas), against the increments alone (``levy_area=None``), and prints
-medians of several repeats with same-run ratios. Two references explain the numbers:
+Two tables, same run, medians of ``--repeats`` calls (the machine is shared: read the ratios):
 
-* ``normals``: the time to draw, with the same ``numpy.random.Generator``, as many standard
-  normals as the sampler consumes (``d`` per step for the increments; ``2 m d + d(d-1)/2`` more
-  per step for the areas, ``m d + d(d-1)/2`` for ``m = 1``). The sampler must draw exactly these
-  numbers in this order (seed reproducibility), so ``normals`` is a floor for its time;
-* ``numpy``: the former pure-numpy implementation (batched matmuls, kept here only as a timing
-  reference; ``--no-numpy`` skips it, it is the slow part of this script).
+1. **normals** (ns per normal): numpy's ``Generator.standard_normal(out=...)``; the raw-word
+   ziggurat ``roughpaths._random.standard_normal_into`` (same numbers, one generator); the
+   per-path streams ``roughpaths._random.PathStreams`` (numba ``SeedSequence`` + ``PCG64`` +
+   ziggurat, one stream per path, the driver's generator), seeding included.
+2. **sampling** (ns per path-step, ``paths x steps``, d = 3), for increments only and with
+   areas (davie m = 1, foster m = 1, davie m = 8):
+
+   * ``mech-old``: the former fused sampler of ``mechanics.simulate_brownian`` (one generator,
+     unit normals step-major into a reused 512 KiB buffer ``(k, P, w)`` by the raw-word ziggurat,
+     ``w = 2d + d(d-1)/2`` for davie m = 1); it only drew the normals (the integrator turned them
+     into velocities), so it is a floor for any sampler of that stream;
+   * ``rp-old``: ``brownian_increments_and_areas`` (numpy generator, fused numba area kernel);
+   * ``driver``: ``BrownianDriver(...).blocks()`` iterated to the end (normals, increments and
+     areas arrays, the ``RoughPath`` blocks a solver consumes; seeding included).
+
+3. d = 2: the driver with Davie's areas against the exact sampler (``levy_area="exact"``).
 
 Usage::
 
-    python benchmarks/bench_brownian.py [--paths 1000] [--steps 1000] [--repeats 5] [--no-numpy]
-
-The machine is shared: compare ratios within one run, not absolute times across runs.
+    python benchmarks/bench_brownian.py [--paths 1000] [--steps 1000] [--repeats 5]
 """
 
 from __future__ import annotations
@@ -24,39 +30,33 @@ import argparse
 
 import numpy as np
 
-from roughpaths.brownian import _CHUNK_FLOATS, brownian_increments_and_areas
-
+from roughpaths import BrownianDriver
+from roughpaths._random import PathStreams, standard_normal_into
+from roughpaths.brownian import brownian_increments_and_areas
 
 from _timing import median_time as _median_time
 
+_MECH_BUFFER_BYTES = 1 << 19
 
-def _numpy_reference(rng, n_steps, h, d, paths, m):
-    """The former implementation (numpy batched products), Davie areas, Stratonovich."""
-    dW = rng.standard_normal((paths, n_steps, d)) * np.sqrt(h)
-    rows = dW.reshape(-1, d)
-    R = rows.shape[0]
-    iu = np.triu_indices(d, 1)
-    A = np.empty((R, d, d))
-    chunk = max(1, _CHUNK_FLOATS // (m * d * 4 + d * d))
-    for lo in range(0, R, chunk):
-        hi = min(R, lo + chunk)
-        W = rows[lo:hi]
-        sq = np.sqrt(h / m)
-        if m == 1:
-            w = W[:, None, :]
-        else:
-            z = rng.standard_normal((hi - lo, m, d)) * sq
-            w = z - z.mean(axis=1, keepdims=True) + W[:, None, :] / m
-        H = rng.standard_normal((hi - lo, m, d)) * (sq / np.sqrt(12.0))
-        s_excl = np.cumsum(w, axis=-2) - w
-        g = np.matmul(np.swapaxes(H + 0.5 * s_excl, -1, -2), w)
-        a = g - np.swapaxes(g, -1, -2)
-        lam = np.zeros((hi - lo, d, d))
-        zz = rng.standard_normal((hi - lo, iu[0].size))
-        lam[:, iu[0], iu[1]] = zz
-        lam[:, iu[1], iu[0]] = -zz
-        A[lo:hi] = a + lam * (h / np.sqrt(12.0 * m))
-    return dW, A.reshape(paths, n_steps, d, d) + 0.5 * dW[..., :, None] * dW[..., None, :]
+
+def _mech_old(P, N, d, with_area, m=1, method="davie"):
+    """The former mechanics fused sampler's random draws (its stream layout, only m = 1 davie existed)."""
+    npair = d * (d - 1) // 2
+    w = (2 * d + npair) if with_area else d
+    rng = np.random.default_rng(1)
+    k_max = max(1, min(N, _MECH_BUFFER_BYTES // (8 * P * w)))
+    buf = np.empty((k_max, P, w))
+    s = 0
+    while s < N:
+        k = min(k_max, N - s)
+        standard_normal_into(rng, buf[:k])
+        s += k
+
+
+def _drive(P, N, d, method, m):
+    for _ in BrownianDriver(d, seed=1, dt=1.0 / N, n_steps=N, batch_shape=(P,), levy_area=method,
+                            substeps=m).blocks():
+        pass
 
 
 def main(argv=None):
@@ -64,33 +64,52 @@ def main(argv=None):
     ap.add_argument("--paths", type=int, default=1000)
     ap.add_argument("--steps", type=int, default=1000)
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--no-numpy", action="store_true", help="skip the former numpy implementation")
     args = ap.parse_args(argv)
-    B, N, h, rep = args.paths, args.steps, 1.0 / args.steps, args.repeats
+    P, N, rep = args.paths, args.steps, args.repeats
+    d = 3
 
-    brownian_increments_and_areas(np.random.default_rng(0), 2, h, 2, batch_shape=(2,))   # JIT warm-up
-    print(f"Brownian increments + Davie Lévy areas, {B} paths x {N} steps, median of {rep} "
-          f"(numpy reference: median of {max(1, rep // 2)})")
-    print(f"{'d':>2} {'m':>2} | {'incr s':>7} {'areas s':>8} {'normals s':>9} {'numpy s':>8} | "
-          f"{'areas/incr':>10} {'areas/normals':>13} {'numpy/areas':>11}")
-    for d in (2, 3):
-        t_inc = _median_time(lambda: brownian_increments_and_areas(
-            np.random.default_rng(1), N, h, d, batch_shape=(B,), levy_area=None), rep)
-        for m in (1, 8):
-            t_area = _median_time(lambda: brownian_increments_and_areas(
-                np.random.default_rng(1), N, h, d, batch_shape=(B,), substeps=m), rep)
-            per_step = d + (m * d if m > 1 else 0) + m * d + d * (d - 1) // 2
-            buf = np.empty(B * N * per_step)
-            t_norm = _median_time(lambda: np.random.default_rng(1).standard_normal(out=buf), rep)
-            del buf
-            if args.no_numpy:
-                t_np, r_np = float("nan"), float("nan")
-            else:
-                t_np = _median_time(lambda: _numpy_reference(np.random.default_rng(1), N, h, d, B, m),
-                                    max(1, rep // 2))
-                r_np = t_np / t_area
-            print(f"{d:>2} {m:>2} | {t_inc:7.3f} {t_area:8.3f} {t_norm:9.3f} {t_np:8.3f} | "
-                  f"{t_area / t_inc:10.1f} {t_area / t_norm:13.2f} {r_np:11.1f}")
+    # warm-up (JIT, self-checks)
+    _drive(2, 3, d, "davie", 2)
+    _drive(2, 3, d, "foster", 1)
+    _drive(2, 3, 2, "exact", 1)
+    _mech_old(2, 3, d, True)
+    brownian_increments_and_areas(np.random.default_rng(0), 2, 0.1, d, batch_shape=(2,))
+
+    n = 1 << 22
+    buf = np.empty(n)
+    chunk = np.empty(_MECH_BUFFER_BYTES // 8)
+    t_np = _median_time(lambda: np.random.default_rng(1).standard_normal(out=buf), rep)
+
+    def raw():
+        g = np.random.default_rng(1)
+        for _ in range(n // chunk.size):
+            standard_normal_into(g, chunk)
+    t_raw = _median_time(raw, rep)
+    keys = np.stack([np.arange(P), np.zeros(P, dtype=np.int64)], axis=1)
+    pbuf = np.empty((P, n // P))
+    t_ps = _median_time(lambda: PathStreams(np.random.SeedSequence(1), keys).fill(pbuf), rep)
+    print(f"standard normals, {n} draws, median of {rep}: ns per normal")
+    print(f"  numpy standard_normal {1e9 * t_np / n:6.2f} | raw-word ziggurat {1e9 * t_raw / n:6.2f} "
+          f"| PathStreams ({P} streams, seeding incl.) {1e9 * t_ps / pbuf.size:6.2f}")
+    print(f"  ratios: numpy/raw {t_np / t_raw:.2f}, numpy/PathStreams {t_np * pbuf.size / (t_ps * n):.2f}")
+    del buf, pbuf
+
+    ps = P * N
+    print(f"\nsampling, {P} paths x {N} steps, d = {d}, median of {rep}: ns per path-step")
+    print(f"{'case':>14} | {'mech-old':>8} {'rp-old':>8} {'driver':>8} | {'driver/mech-old':>15} {'driver/rp-old':>13}")
+    for name, method, m in (("increments", None, 1), ("davie m=1", "davie", 1), ("foster m=1", "foster", 1),
+                            ("davie m=8", "davie", 8)):
+        t_mech = (_median_time(lambda: _mech_old(P, N, d, method is not None), rep)
+                  if m == 1 and method != "foster" else float("nan"))
+        t_rp = _median_time(lambda: brownian_increments_and_areas(
+            np.random.default_rng(1), N, 1.0 / N, d, batch_shape=(P,), levy_area=method, substeps=m), rep)
+        t_dr = _median_time(lambda: _drive(P, N, d, method, m), rep)
+        print(f"{name:>14} | {1e9 * t_mech / ps:8.1f} {1e9 * t_rp / ps:8.1f} {1e9 * t_dr / ps:8.1f} | "
+              f"{t_dr / t_mech:15.2f} {t_dr / t_rp:13.2f}")
+    t_dav = _median_time(lambda: _drive(P, N, 2, "davie", 1), rep)
+    t_ex = _median_time(lambda: _drive(P, N, 2, "exact", 1), rep)
+    print(f"\nd = 2, driver: davie m=1 {1e9 * t_dav / ps:.1f}, exact {1e9 * t_ex / ps:.1f} ns per path-step "
+          f"(exact/davie {t_ex / t_dav:.1f})")
 
 
 if __name__ == "__main__":

@@ -5,12 +5,11 @@ Problem (issue 4): I = diag(1, 2, 3), θ = 1, ξ_i = σ e_i with σ = 0.05, s = 
 
     dΠ = Π × Ω dt + θ Π × (Π × Ω) dt + σ Π × ∘dW,   Ω = I⁻¹Π.
 
-Ours: :func:`mechanics.integrators.simulate_brownian` with Lie–Heun (coadjoint update, |Π| exact),
-the Lévy area included (strong order 1) and, for reference, without it. Its so(3) fast path draws the
-unit normals of a block of steps in bulk (numpy's ziggurat over raw 64-bit words, bit-identical to
-``rng.standard_normal``; stream in C order ``(step, path, draw)``: dW (3), H (3), lambda (3)) into a
-reused buffer, then runs a structure-of-arrays numba kernel (SIMD over paths, trig-free Rodrigues);
-with the area 9 normals per path-step, so the normals are most of the cost. Peers (where installed, in the
+Ours: ``roughpaths.solve(rigid_body, BrownianDriver(3, seed, ...), mu0, LieHeun())`` (coadjoint
+update, |Π| exact), the Lévy area included (Davie, strong order 1) and, for reference, without it.
+The driver generates per-path seeded increments and areas block by block; the so(3) solver runs a
+structure-of-arrays numba kernel (SIMD over paths, trig-free Rodrigues). The driver alone is timed
+too: with the area it is most of the cost. Peers (where installed, in the
 same run): diffrax Heun on a batched (3, N) state (jit), torchsde Heun (noise_type="general",
 sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scaled per path-step).
 Reported: median wall time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
@@ -46,16 +45,29 @@ def _norm_err(final):
 
 
 def bench_ours(n_paths, n_steps, repeats, levy_area=True):
-    from mechanics.integrators import LieHeun, simulate_brownian
-    from mechanics.rigid_body import rigid_body
+    from mechanics import LieHeun, rigid_body
+    from roughpaths import BrownianDriver, solve
 
     rb = rigid_body(INERTIA, sigma=SIGMA, theta=THETA)
     mu0 = np.array([0.0, 0.0, 1.0])
-    simulate_brownian(rb, mu0, DT, 10, np.random.default_rng(0), n_paths=2, levy_area=levy_area)  # warm-up
+    method = "davie" if levy_area else None
+
+    def run(n, p, seed):
+        drv = BrownianDriver(3, seed=seed, dt=DT, n_steps=n, batch_shape=(p,), levy_area=method)
+        return solve(rb, drv, mu0, LieHeun(levy_area=levy_area), save_at="end").final
+
+    run(10, 2, 0)                                                   # warm-up (numba compile/cache load)
+    return _median_time(lambda: run(n_steps, n_paths, 1), repeats)
+
+
+def bench_driver_only(n_paths, n_steps, repeats):
+    """The Brownian driver alone (increments and Davie areas, block by block), for the cost split."""
+    from roughpaths import BrownianDriver
 
     def run():
-        return simulate_brownian(rb, mu0, DT, n_steps, np.random.default_rng(1), n_paths=n_paths,
-                                 method=LieHeun(), levy_area=levy_area, save_every=n_steps)[1][:, -1]
+        for block in BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,)).blocks():
+            last = block
+        return np.broadcast_to(np.array([0.0, 0.0, 1.0]), (n_paths, 3))
     return _median_time(run, repeats)
 
 
@@ -188,6 +200,7 @@ def main(argv=None):
 
     record("ours LieHeun + Levy area", n_paths, lambda: bench_ours(n_paths, n_steps, args.repeats, True))
     record("ours LieHeun, no area", n_paths, lambda: bench_ours(n_paths, n_steps, args.repeats, False))
+    record("  (BrownianDriver alone, Davie)", n_paths, lambda: bench_driver_only(n_paths, n_steps, args.repeats))
     if "diffrax" not in skip:
         record("diffrax Heun (batched 3xN)", n_paths, lambda: bench_diffrax(n_paths, n_steps, args.repeats))
     if "torchsde" not in skip:
@@ -196,7 +209,7 @@ def main(argv=None):
         record(f"sdeint stratHeun ({sde_paths} paths)", sde_paths,
                lambda: bench_sdeint(sde_paths, n_steps, max(1, args.repeats // 3)))
     ran = [r[0] for r in rows]
-    print("peers that ran:", ", ".join(ran[2:]) or "none")
+    print("peers that ran:", ", ".join(ran[3:]) or "none")
     ours = rows[0][2]
     print("ratios (ns per path-step, peer / ours with Levy area):")
     for name, _, ns, _ in rows[1:]:

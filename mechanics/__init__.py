@@ -4,19 +4,13 @@ Lie–Poisson / Euler–Poincaré equations with SALT noise, the Lévy-area corr
 dissipation, Casimir-preserving integrators, the stochastic rigid body and heavy top, Gibbs measures,
 and the coloured-noise Wong–Zakai anomaly, built on :mod:`roughpaths`.
 
-Conventions (``CONVENTIONS.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
+Conventions (``docs/conventions.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
 velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``h̃ = h + ⟨μ, ℓ⟩``; the
 paper's printed signs are available as ``convention="paper"``.
 """
 
-from .ensemble import (
-    EnsembleResult,
-    RunningMoments,
-    moment_observable,
-    path_generator,
-    run_ensemble,
-    split_moment_features,
-)
+from .ensemble import EnsembleResult, path_generator, run_ensemble
+from .statistics import RunningMoments, moment_observable, split_moment_features
 from .equilibria import (
     Equilibrium,
     LevelSets,
@@ -31,6 +25,7 @@ from .gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
 from .heavy_top import HeavyTop, heavy_top
 from .integrators import (
     ChordConvergenceError,
+    CoadjointSolver,
     ImplicitMidpoint,
     LieEuler,
     LieHeun,
@@ -39,8 +34,9 @@ from .integrators import (
     simulate,
     simulate_brownian,
 )
-from .lie_algebra import LieAlgebra, hat, se3, sl2r, so3, su2, vee
-from .lie_poisson import Hamiltonian, LiePoissonSystem, QuadraticHamiltonian, check_inertia, girsanov_shift
+from .lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra, hat, se3, sl2r, so3, su2, vee
+from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
+from .lie_poisson import LiePoissonSystem, girsanov_shift, levy_velocity
 from .rigid_body import RigidBody, isotropic_xi, rigid_body
 from .wong_zakai import (
     PlanarExample,
@@ -58,12 +54,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     # Lie algebras
-    "LieAlgebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
+    "LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
     # Lie–Poisson systems
-    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia",
+    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     # integrators
-    "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
+    "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
     "simulate", "simulate_brownian", "check_on_orbit",
     # equilibria, phase portraits, Gibbs measures
     "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",

@@ -1,8 +1,9 @@
-r"""Ensembles of stochastic Lie–Poisson paths: reproducible streams, running statistics, executors.
+r"""Ensembles of stochastic Lie–Poisson paths: one entry point, :func:`run_ensemble`, on top of :func:`roughpaths.solve`.
 
 :func:`run_ensemble` simulates ``n_paths`` independent paths of a
-:class:`~mechanics.lie_poisson.LiePoissonSystem` driven by Stratonovich Brownian motion and returns
-streaming statistics (memory independent of ``n_paths`` and ``n_steps``):
+:class:`~mechanics.lie_poisson.LiePoissonSystem` driven by a :class:`roughpaths.BrownianDriver`
+(Stratonovich Brownian motion, with a sampled Lévy area or level-1 driving) and returns streaming
+statistics (memory independent of ``n_steps``; ``O(chunk_size)`` in the paths):
 
 * ``final``: count, mean and covariance across paths of ``observable(μ_T)``;
 * ``time_average``: the same for each path's time average of ``observable(μ_t)`` over
@@ -10,150 +11,59 @@ streaming statistics (memory independent of ``n_paths`` and ``n_steps``):
   time averages is honest whatever the autocorrelation within a path);
 * ``snapshots``: optional statistics at every ``record_every``-th step.
 
-Reproducibility. Path ``i`` owns the random stream
-``Generator(PCG64(SeedSequence(seed, spawn_key=(i,))))`` (the ``i``-th child of
-``SeedSequence(seed).spawn``), consumed sequentially in time blocks of ``block_steps`` steps. A
-path's noise therefore depends only on ``(seed, i, block_steps, levy_area)``: the same seed gives
-the same paths whatever ``chunk_size`` (paths per task) or ``executor``, and the statistics agree
-to round-off (they are merged in chunk order with Chan's formula). With ``levy_area=None`` the
-stream is also independent of ``block_steps`` (``standard_normal`` draws concatenate).
+It is the same computation as ``roughpaths.solve(system, BrownianDriver(m, seed=seed, dt=dt,
+n_steps=n_steps, batch_shape=(n_paths,), levy_area=levy_area), mu0, method)``: paths are split into
+chunks of ``chunk_size`` (``driver.select``), each chunk is solved block by block in time
+(``block_steps``) and reduced to statistics on the fly.
 
-Vectorisation. The time stepping is vectorised over the paths of a chunk (one call of
-:func:`mechanics.integrators.simulate` per block, the numba so(3) kernel where it applies). The
-only per-path Python work is one RNG call per path per time block (``O(n_paths · n_steps /
-block_steps)`` calls, each drawing ``block_steps × m`` normals), negligible for
-``block_steps ≳ 100``.
+Reproducibility. A path's noise depends only on ``(seed, path index, levy_area)`` (the driver's
+stream); the coadjoint step of a member does not depend on the rest of the batch; time sums are
+accumulated step by step; the across-path statistics are reduced in fixed leaves of
+:data:`~mechanics.statistics.LEAF` paths merged in path order
+(:class:`~mechanics.statistics.LeafReducer`). So the results — final states and every statistic —
+are bitwise the same whatever ``chunk_size``, ``block_steps`` or ``executor``.
 
-Executors. ``executor=`` accepts any :class:`concurrent.futures.Executor` (thread or process pool,
-or a cluster client with the same ``submit`` interface). Tasks are ``(spec, first_path, last_path)``
-with a picklable spec: the system, observable and method must be picklable for process pools (a
-module-level function, not a lambda, as ``observable``).
+Executors. ``executor=`` accepts any :class:`concurrent.futures.Executor` (thread or process pool)
+or anything with the same ``submit`` interface, e.g. a ``dask.distributed`` cluster through
+``client.get_executor()`` (optional extra ``mechanics[dask]``). Tasks are ``(spec, first_path,
+last_path)`` with a picklable spec: the system and the observable must be picklable for process
+pools and clusters (a module-level function, not a lambda, as ``observable``).
 """
 
 from __future__ import annotations
 
-import math
+import copy
+import warnings
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
+from roughpaths import BrownianDriver, solve
 from roughpaths.validation import as_float_array, check_positive_int
+
+from .statistics import (
+    LeafReducer,
+    RunningMoments,
+    accumulate,
+    accumulate_moments,
+    moment_observable,
+    split_moment_features,
+)
 
 __all__ = ["RunningMoments", "EnsembleResult", "moment_observable", "split_moment_features",
            "path_generator", "run_ensemble"]
 
 
-# ------------------------------------------------------------------------------ running moments
-class RunningMoments:
-    r"""Streaming count, mean and covariance of vectors in ``R^p`` (Welford / Chan et al. merging).
-
-    ``update(x)`` adds a batch ``x`` of shape ``(k, p)`` (its mean and scatter are computed in two
-    passes, then merged); ``merge(other)`` combines two summaries exactly:
-    :math:`\bar x = \bar x_a + \delta\,n_b/n`,
-    :math:`M = M_a + M_b + \delta\delta^T n_a n_b/n` with :math:`\delta = \bar x_b - \bar x_a`.
-
-    Examples
-    --------
-    >>> x = np.arange(12.0).reshape(6, 2) ** 1.5
-    >>> a = RunningMoments(2).update(x[:2]).merge(RunningMoments(2).update(x[2:]))
-    >>> bool(np.allclose(a.mean, x.mean(0)) and np.allclose(a.covariance, np.cov(x.T)))
-    True
-    """
-
-    __slots__ = ("dim", "count", "mean", "scatter")
-
-    def __init__(self, dim: int):
-        self.dim = check_positive_int(dim, "dim")
-        self.count = 0
-        self.mean = np.zeros(self.dim)
-        self.scatter = np.zeros((self.dim, self.dim))
-
-    def update(self, x) -> "RunningMoments":
-        """Add the rows of ``x`` (shape ``(k, p)`` or ``(p,)``); returns ``self``."""
-        x = np.asarray(x, dtype=np.float64)
-        if x.ndim == 1:
-            x = x[None]
-        if x.ndim != 2 or x.shape[1] != self.dim:
-            raise ValueError(f"x must have shape (k, {self.dim}), got {x.shape}.")
-        k = x.shape[0]
-        if k == 0:
-            return self
-        other = RunningMoments(self.dim)
-        other.count = k
-        other.mean = x.mean(axis=0)
-        d = x - other.mean
-        other.scatter = d.T @ d
-        return self.merge(other)
-
-    def merge(self, other: "RunningMoments") -> "RunningMoments":
-        """Merge ``other`` into ``self`` (Chan et al.); returns ``self``."""
-        if not isinstance(other, RunningMoments) or other.dim != self.dim:
-            raise ValueError(f"can only merge a RunningMoments of dimension {self.dim}.")
-        if other.count == 0:
-            return self
-        if self.count == 0:
-            self.count, self.mean, self.scatter = other.count, other.mean.copy(), other.scatter.copy()
-            return self
-        n = self.count + other.count
-        delta = other.mean - self.mean
-        self.mean = self.mean + delta * (other.count / n)
-        self.scatter = self.scatter + other.scatter + np.outer(delta, delta) * (self.count * other.count / n)
-        self.count = n
-        return self
-
-    @property
-    def covariance(self) -> np.ndarray:
-        """Unbiased sample covariance ``(p, p)`` (NaN-free: zeros if ``count < 2``)."""
-        if self.count < 2:
-            return np.zeros((self.dim, self.dim))
-        return self.scatter / (self.count - 1)
-
-    @property
-    def standard_error(self) -> np.ndarray:
-        """Standard error of each component of the mean, ``sqrt(var / count)``, shape ``(p,)``."""
-        if self.count < 2:
-            return np.full(self.dim, np.inf)
-        return np.sqrt(np.diag(self.covariance) / self.count)
-
-    def copy(self) -> "RunningMoments":
-        out = RunningMoments(self.dim)
-        out.count, out.mean, out.scatter = self.count, self.mean.copy(), self.scatter.copy()
-        return out
-
-    def __repr__(self) -> str:
-        return f"RunningMoments(dim={self.dim}, count={self.count})"
-
-
-# ------------------------------------------------------------------------------ observables
-def moment_observable(x) -> np.ndarray:
-    """``(x, x_i x_j for i ≤ j)``: first and second moments; ``(..., n)`` → ``(..., n + n(n+1)/2)``."""
-    x = np.asarray(x, dtype=np.float64)
-    n = x.shape[-1]
-    i, j = np.triu_indices(n)
-    out = np.empty(x.shape[:-1] + (n + len(i),))
-    out[..., :n] = x
-    np.multiply(x[..., i], x[..., j], out=out[..., n:])
-    return out
-
-
-def split_moment_features(values, n: int):
-    """Unpack :func:`moment_observable` features: ``(..., n + n(n+1)/2)`` → mean ``(..., n)``, second
-    moment ``(..., n, n)`` (symmetric)."""
-    v = np.asarray(values, dtype=np.float64)
-    iu = np.triu_indices(n)
-    m2 = np.zeros(v.shape[:-1] + (n, n))
-    m2[..., iu[0], iu[1]] = v[..., n:]
-    m2[..., iu[1], iu[0]] = v[..., n:]
-    return v[..., :n], m2
-
-
 def path_generator(seed: int, index: int) -> np.random.Generator:
-    """The generator of path ``index``: ``PCG64(SeedSequence(seed, spawn_key=(index,)))``.
+    """Deprecated (no longer the ensemble's stream): ``PCG64(SeedSequence(seed, spawn_key=(index,)))``.
 
-    Identical to ``default_rng(SeedSequence(seed).spawn(n)[index])`` for any ``n > index``, but
-    O(1) to build.
+    The ensemble's paths come from ``roughpaths.BrownianDriver(..., seed=seed)``; path ``i`` of it
+    is ``driver.select([i])``.
     """
+    warnings.warn("path_generator is deprecated: run_ensemble draws its paths from roughpaths.BrownianDriver "
+                  "(path i is BrownianDriver(..., seed=seed, batch_shape=(n_paths,)).select([i])).",
+                  DeprecationWarning, stacklevel=2)
     return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(int(index),))))
 
 
@@ -206,12 +116,9 @@ class EnsembleResult:
 class _Spec:
     system: object
     mu0: np.ndarray
-    dt: float
-    n_steps: int
-    seed: int
+    driver: BrownianDriver
     method: object
-    levy_area: str | None
-    block_steps: int
+    block_steps: int | None
     burn_in: int
     average_every: int
     record_every: int | None
@@ -219,88 +126,51 @@ class _Spec:
     keep_final: bool
 
 
-def _draw_block(gens, k, dt, m, levy_area):
-    """Increments (c, k, m) and Stratonovich areas (c, k, m, m) (``None`` without Lévy area: level-1
-    driving), one generator call per path."""
-    c = len(gens)
-    dW = np.empty((c, k, m))
-    if levy_area is None:
-        sq = math.sqrt(dt)
-        for p, g in enumerate(gens):
-            dW[p] = g.standard_normal((k, m)) * sq
-        return dW, None
-    from roughpaths.brownian import brownian_increments_and_areas
-    areas = np.empty((c, k, m, m))
-    for p, g in enumerate(gens):
-        dW[p], areas[p] = brownian_increments_and_areas(g, k, dt, m, levy_area=levy_area)
-    return dW, areas
-
-
-def _observable_sum(observable, window):
-    """``Σ_t observable(window[:, t])`` per path, ``(c, T, n) → (c, p)``; BLAS fast path for the moments."""
-    if observable is moment_observable:
-        n = window.shape[-1]
-        i, j = np.triu_indices(n)
-        second = np.matmul(np.swapaxes(window, 1, 2), window)        # (c, n, n) = Σ_t x xᵀ
-        return np.concatenate([window.sum(axis=1), second[:, i, j]], axis=-1)
-    return np.asarray(observable(window)).sum(axis=1)
+def _observe(observable, x):
+    return np.asarray(observable(x), dtype=np.float64)
 
 
 def _run_chunk(spec: _Spec, first: int, last: int):
-    """Simulate paths ``first .. last-1``; return their statistics (picklable)."""
-    from roughpaths.rough_path import RoughPath
-
-    from .integrators import simulate
-
+    """Solve paths ``first .. last-1`` block by block; return their per-path values (picklable)."""
     system = spec.system
     c = last - first
-    n, m = system.dim, system.n_noise
-    gens = [path_generator(spec.seed, i) for i in range(first, last)]
+    n = system.dim
     mu0 = spec.mu0 if spec.mu0.ndim == 1 else spec.mu0[first:last]
     mu = np.array(np.broadcast_to(mu0, (c, n)), dtype=np.float64)
-    obs0 = np.asarray(spec.observable(mu[:1]))
-    p = obs0.shape[-1]
+    p = _observe(spec.observable, mu[:1]).shape[-1]
     acc = np.zeros((c, p))
     n_avg = 0
     snaps = []
-    snap_steps = []
     if spec.record_every is not None:
-        rm = RunningMoments(p).update(np.asarray(spec.observable(mu)))
-        snaps.append(rm)
-        snap_steps.append(0)
+        snaps.append(_observe(spec.observable, mu))
+    fast_moments = spec.observable is moment_observable
     step = 0
-    while step < spec.n_steps:
-        k = min(spec.block_steps, spec.n_steps - step)
-        dW, areas = _draw_block(gens, k, spec.dt, m, spec.levy_area)
-        times = (step + np.arange(k + 1)) * spec.dt
-        if areas is None:                                            # level 1: zero step Lévy area
-            X = RoughPath.from_increments(dW, None, times=times)
-            _, states = simulate(system, mu, X, spec.method, levy_area=False)   # (c, k+1, n)
-        else:
-            X = RoughPath(dW, areas, times=times, kind="geometric", check=False)
-            _, states = simulate(system, mu, X, spec.method)        # (c, k+1, n)
-        idx = step + np.arange(1, k + 1)                             # global step numbers of states[:, 1:]
-        # averaged steps: idx > burn_in and idx % average_every == 0, as a strided slice (no copy)
+    for block in spec.driver.select(range(first, last)).blocks(spec.block_steps):
+        k = block.n_steps
+        states = solve(system, block, mu, spec.method).states                 # (c, k + 1, n)
+        # averaged steps: idx > burn_in and idx % average_every == 0, a strided slice of states[:, 1:]
         first_ok = max(spec.burn_in + 1, step + 1)
         first_ok += (-first_ok) % spec.average_every
         if first_ok <= step + k:
-            window = states[:, 1 + first_ok - step - 1::spec.average_every]
-            acc += _observable_sum(spec.observable, window)
+            window = states[:, first_ok - step::spec.average_every]
+            if fast_moments:
+                accumulate_moments(acc, np.ascontiguousarray(window))
+            else:
+                accumulate(acc, np.ascontiguousarray(_observe(spec.observable, window)))
             n_avg += window.shape[1]
         if spec.record_every is not None:
-            for j in np.nonzero(idx % spec.record_every == 0)[0]:
-                snaps.append(RunningMoments(p).update(np.asarray(spec.observable(states[:, j + 1]))))
-                snap_steps.append(int(idx[j]))
+            for j in range(1, k + 1):
+                if (step + j) % spec.record_every == 0:
+                    snaps.append(_observe(spec.observable, states[:, j]))
         mu = np.ascontiguousarray(states[:, -1])
         step += k
-    final = RunningMoments(p).update(np.asarray(spec.observable(mu)))
-    tavg = RunningMoments(p).update(acc / n_avg) if n_avg else None
-    return final, tavg, snaps, snap_steps, (mu if spec.keep_final else None)
+    final = _observe(spec.observable, mu)
+    return final, (acc / n_avg if n_avg else None), snaps, (mu if spec.keep_final else None)
 
 
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
-                 chunk_size=256, block_steps=500, executor=None, keep_final=False) -> EnsembleResult:
+                 chunk_size=256, block_steps=None, executor=None, keep_final=False) -> EnsembleResult:
     r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
 
     Parameters
@@ -314,14 +184,15 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         Steps per path (horizon ``T = n_steps · dt``).
     n_paths : int
     seed : int
-        Master seed; path ``i`` uses :func:`path_generator` ``(seed, i)``.
-    method : integrator method, optional
-        ``mechanics.integrators.LieHeun()`` by default.
+        Seed of the ``roughpaths.BrownianDriver``; path ``i`` is the driver's path ``i``.
+    method : CoadjointSolver instance, optional
+        ``LieHeun()`` by default; its ``levy_area`` setting follows ``levy_area`` below.
     levy_area : {None, "davie", "foster"}
-        ``None`` (default): zero step Lévy area (weak order 1, enough for laws and invariant
-        measures). ``"davie"``/``"foster"``: sample it (strong order 1; slower).
+        ``None`` (default): level-1 driving, zero step Lévy area (weak order 1, enough for laws and
+        invariant measures). ``"davie"``/``"foster"``: the driver samples the area (strong order 1).
     observable : callable
-        ``(..., n) → (..., p)``; default :func:`moment_observable` (first and second moments).
+        ``(..., n) → (..., p)``, evaluated state by state; default :func:`moment_observable` (first
+        and second moments).
     burn_in : int
         Steps excluded from the time averages.
     average_every : int
@@ -329,11 +200,13 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     record_every : int, optional
         Also keep across-path statistics at steps ``0, record_every, 2·record_every, …``.
     chunk_size : int
-        Paths per task (memory ``O(chunk_size · block_steps · m²)``).
-    block_steps : int
-        Steps per random-number block (part of the stream definition when ``levy_area`` is set).
+        Paths per task. Changes memory use and parallelism, never the numbers.
+    block_steps : int, optional
+        Steps per time block (default: the driver's cache-sized blocks). Changes memory use and
+        speed, never the numbers.
     executor : concurrent.futures.Executor, optional
-        Runs the chunks (default: serially in this process).
+        Runs the chunks (default: serially in this process); e.g. ``dask.distributed``'s
+        ``client.get_executor()``. Never changes the numbers.
     keep_final : bool
         Also return every path's final state.
 
@@ -349,16 +222,22 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     >>> a = run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=50, n_paths=6, seed=1, chunk_size=4,
     ...                  keep_final=True)
     >>> b = run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=50, n_paths=6, seed=1, chunk_size=5,
-    ...                  keep_final=True)
-    >>> bool(np.array_equal(a.final_states, b.final_states))
+    ...                  block_steps=7, keep_final=True)
+    >>> bool(np.array_equal(a.final_states, b.final_states) and np.array_equal(a.final.mean, b.final.mean))
     True
     """
+    from .integrators import CoadjointSolver, LieHeun
+    from .lie_poisson import LiePoissonSystem
+
+    if not isinstance(system, LiePoissonSystem):
+        raise TypeError(f"system must be a LiePoissonSystem (e.g. mechanics.rigid_body(...)), got "
+                        f"{type(system).__name__}.")
     if method is None:
-        from .integrators import LieHeun
         method = LieHeun()
-    for attr in ("dim", "n_noise"):
-        if not hasattr(system, attr):
-            raise TypeError(f"system must be a LiePoissonSystem (needs .{attr}), got {type(system).__name__}.")
+    if not isinstance(method, CoadjointSolver):
+        raise TypeError(f"method must be a coadjoint solver instance (LieEuler(), LieHeun(), ImplicitMidpoint()), "
+                        f"got {method!r}" + (f"; did you mean {method.__name__}()?" if isinstance(method, type)
+                                             else "."))
     n = system.dim
     mu0 = as_float_array(mu0, "mu0", last_dims=(n,))
     if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating)) or not np.isfinite(dt) or dt <= 0:
@@ -380,12 +259,17 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     if record_every is not None:
         record_every = check_positive_int(record_every, "record_every")
     chunk_size = check_positive_int(chunk_size, "chunk_size")
-    block_steps = check_positive_int(block_steps, "block_steps")
+    if block_steps is not None:
+        block_steps = check_positive_int(block_steps, "block_steps")
     if executor is not None and not hasattr(executor, "submit"):
         raise TypeError(f"executor must be a concurrent.futures.Executor (with .submit), got {executor!r}.")
+    if method.levy_area != (levy_area is not None):                 # the driving level follows levy_area
+        method = copy.copy(method)
+        method.levy_area = levy_area is not None
 
-    spec = _Spec(system=system, mu0=mu0, dt=float(dt), n_steps=n_steps, seed=int(seed), method=method,
-                 levy_area=levy_area, block_steps=block_steps, burn_in=burn_in,
+    driver = BrownianDriver(system.n_noise, seed=int(seed), dt=float(dt), n_steps=n_steps, batch_shape=(n_paths,),
+                            levy_area=levy_area)
+    spec = _Spec(system=system, mu0=mu0, driver=driver, method=method, block_steps=block_steps, burn_in=burn_in,
                  average_every=average_every, record_every=record_every, observable=observable,
                  keep_final=bool(keep_final))
     bounds = [(a, min(a + chunk_size, n_paths)) for a in range(0, n_paths, chunk_size)]
@@ -397,20 +281,23 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
 
     final = tavg = None
     snaps: list = []
-    snap_steps: list = []
     finals = []
-    for fin, ta, sn, st, fs in parts:               # merged in chunk order: deterministic
-        final = fin if final is None else final.merge(fin)
-        if ta is not None:
-            tavg = ta if tavg is None else tavg.merge(ta)
-        if not snaps:
-            snaps, snap_steps = sn, st
-        else:
-            for a, b in zip(snaps, sn):
-                a.merge(b)
+    for fin, ta, sn, fs in parts:                  # in path order: fixed leaves, bitwise reproducible
+        if final is None:
+            p = fin.shape[-1]
+            final = LeafReducer(p)
+            tavg = LeafReducer(p) if ta is not None else None
+            snaps = [LeafReducer(p) for _ in sn]
+        final.add(fin)
+        if tavg is not None:
+            tavg.add(ta)
+        for red, values in zip(snaps, sn):
+            red.add(values)
         if fs is not None:
             finals.append(fs)
-    return EnsembleResult(final=final, time_average=tavg,
+    snap_steps = [] if record_every is None else list(range(0, n_steps + 1, record_every))
+    return EnsembleResult(final=final.result(), time_average=None if tavg is None else tavg.result(),
                           snapshot_times=np.asarray(snap_steps, dtype=np.float64) * float(dt),
-                          snapshots=snaps, final_states=np.concatenate(finals) if finals else None,
+                          snapshots=[r.result() for r in snaps],
+                          final_states=np.concatenate(finals) if finals else None,
                           n_paths=n_paths, n_steps=n_steps, dt=float(dt), seed=int(seed), state_dim=n)

@@ -1,6 +1,8 @@
-r"""Equilibria of the modified (Lévy-area-shifted) rigid body and their stability; phase portraits.
+r"""Equilibria of the modified (Lévy-area-shifted) rigid body and their stability.
 
-The deterministic part of the rough-path-correct (RP) rigid body of ``CONVENTIONS.md`` is
+Phase portraits (level sets of ``h̃`` on the sphere) are in :mod:`mechanics.phase_portrait`.
+
+The deterministic part of the rough-path-correct (RP) rigid body of ``docs/conventions.md`` is
 
 .. math::
 
@@ -33,12 +35,14 @@ saddle in both cases.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 
 from roughpaths.validation import as_float_array, check_antisymmetric
+
+from .lie_poisson import check_inertia, levy_velocity
 
 __all__ = [
     "Equilibrium",
@@ -59,25 +63,7 @@ def as_inverse_inertia(inertia, name: str = "inertia") -> np.ndarray:
 
     Raises ``ValueError`` for non-symmetric, non-positive-definite or wrongly shaped input.
     """
-    arr = as_float_array(inertia, name)
-    if arr.shape == (3,):
-        if np.any(arr <= 0):
-            raise ValueError(f"{name} must have positive principal moments, got {arr.tolist()}; "
-                             f"a rigid body needs 𝕀 = diag(I1, I2, I3) with every Ik > 0.")
-        return np.diag(1.0 / arr)
-    if arr.shape != (3, 3):
-        raise ValueError(f"{name} must be 3 principal moments (shape (3,)) or a 3x3 symmetric "
-                         f"positive-definite matrix, got shape {arr.shape}.")
-    scale = max(float(np.max(np.abs(arr))), 1e-300)
-    asym = float(np.max(np.abs(arr - arr.T)))
-    if asym > 1e-12 * scale:
-        raise ValueError(f"{name} must be symmetric, but |𝕀 - 𝕀ᵀ| = {asym:.3g}; "
-                         f"pass 0.5 * ({name} + {name}.T) if the asymmetry is round-off.")
-    sym = 0.5 * (arr + arr.T)
-    w = np.linalg.eigvalsh(sym)
-    if w[0] <= 0:
-        raise ValueError(f"{name} must be positive definite, its eigenvalues are {w.tolist()}.")
-    return np.linalg.inv(sym)
+    return np.linalg.inv(check_inertia(inertia, name, dim=3))
 
 
 def _as_c(c, name: str = "c") -> np.ndarray:
@@ -104,7 +90,7 @@ def _check_theta(theta) -> float:
 def isotropic_levy_shift(sigma, s, convention: str = "rp") -> np.ndarray:
     r"""The Lévy-area velocity ``c`` for isotropic noise ``ξ_i = σ e_i`` on so(3) ≅ R³.
 
-    ``convention="rp"`` (default, ``CONVENTIONS.md``): ``c = +½ Σ_ij s^{ij} ξ_i × ξ_j
+    ``convention="rp"`` (default, ``docs/conventions.md``): ``c = +½ Σ_ij s^{ij} ξ_i × ξ_j
     = σ² (s23, −s13, s12)``. ``convention="paper"``: the paper's printed ``−½`` (torque sign
     flipped), ``c = −σ² (s23, −s13, s12)``.
 
@@ -118,7 +104,7 @@ def isotropic_levy_shift(sigma, s, convention: str = "rp") -> np.ndarray:
     s = check_antisymmetric(s, "s", dim=3)
     if s.ndim != 2:
         raise ValueError(f"s must be a single 3x3 antisymmetric matrix, got shape {s.shape}.")
-    c = sig * sig * np.array([s[1, 2], -s[0, 2], s[0, 1]])
+    c = levy_velocity(s, sig * np.eye(3))
     if convention == "rp":
         return c
     if convention == "paper":
@@ -131,6 +117,11 @@ def modified_hamiltonian(Pi, inertia, c=None) -> np.ndarray:
     A = as_inverse_inertia(inertia)
     c = _as_c(c)
     P = as_float_array(Pi, "Pi", last_dims=(3,))
+    return _modified_hamiltonian(P, A, c)
+
+
+def _modified_hamiltonian(P, A, c):
+    """The one formula for ``h̃ = ½ Π·AΠ + c·Π`` on so(3)* (``A = 𝕀⁻¹``), used by the Gibbs measure too."""
     return 0.5 * np.einsum("...i,ij,...j->...", P, A, P) + P @ c
 
 
@@ -408,173 +399,12 @@ def rigid_body_equilibria(inertia, c=None, *, radius=1.0, theta=0.0):
 
 
 # ------------------------------------------------------------------------------ phase portraits
-@dataclass
-class LevelSets:
-    """Level curves of ``h̃`` on the sphere ``|Π| = r`` (for phase portraits).
-
-    Attributes
-    ----------
-    levels : ndarray (L,)
-        The energy values.
-    curves : list of list of ndarray
-        ``curves[k]`` holds the polylines (each of shape ``(m, 3)``, on the sphere to round-off,
-        projected onto the exact level set) of ``h̃ = levels[k]``; closed curves repeat their first
-        point at the end.
-    separatrix : ndarray of bool (L,)
-        True for the levels of saddle equilibria (the separatrices).
-    equilibria : list of Equilibrium
-        All equilibria, with type (see :func:`rigid_body_equilibria`).
-    radius : float
-    """
-
-    levels: np.ndarray
-    curves: list
-    separatrix: np.ndarray
-    equilibria: list
-    radius: float = 1.0
-    energy_range: tuple = field(default=(0.0, 0.0))
-
-
-def _join_polylines(lines, tol):
-    """Join polylines whose end points coincide (the φ seam of the chart), in 3-D."""
-    lines = [np.asarray(l) for l in lines if len(l) >= 2]
-    changed = True
-    while changed:
-        changed = False
-        for i in range(len(lines)):
-            for j in range(len(lines)):
-                if i == j:
-                    continue
-                a, b = lines[i], lines[j]
-                if np.linalg.norm(a[-1] - b[0]) <= tol:
-                    new = np.concatenate([a, b[1:]])
-                elif np.linalg.norm(a[-1] - b[-1]) <= tol:
-                    new = np.concatenate([a, b[::-1][1:]])
-                else:
-                    continue
-                lines = [l for k, l in enumerate(lines) if k not in (i, j)] + [new]
-                changed = True
-                break
-            if changed:
-                break
-    out = []
-    for l in lines:
-        if np.linalg.norm(l[0] - l[-1]) <= tol and len(l) > 2:
-            l = np.concatenate([l[:-1], l[:1]])
-        out.append(l)
-    return out
-
-
-def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_separatrices=True,
-                          n_theta=181, n_phi=361, theta=0.0, project=True):
-    r"""Level curves of ``h̃ = ½Π·𝕀⁻¹Π + c·Π`` on the sphere ``|Π| = r``, with the equilibria.
-
-    The rigid body's (modified) phase portrait: the conservative orbits are exactly these curves.
-    Contouring is done by ``contourpy`` (matplotlib's engine) on a (colatitude, longitude) grid,
-    seam pieces are joined in 3-D and every vertex is projected onto the exact level set (Newton
-    along the tangential gradient, then back to the sphere).
-
-    Parameters
-    ----------
-    inertia, c, radius, theta
-        As in :func:`rigid_body_equilibria` (RP sign of ``c``). The paper's Fig. surf2 caption
-        (``h̃ = ½Π·𝕀⁻¹Π + 0.0625 Π·e2`` for ``s13 = 25``, σ = 0.05) uses its printed sign: in the RP
-        convention that case is ``c = (0, −0.0625, 0)``; surf4/surf5 (``+0.0625, −0.0625, −0.125``
-        for ``s12 = −50, s13 = s23 = 25``) already agree with RP.
-    levels : int or array_like
-        Number of equally spaced interior levels between min and max of ``h̃`` on the sphere, or the
-        level values themselves.
-    include_separatrices : bool
-        Add the energies of the saddle equilibria (flagged in ``separatrix``).
-    n_theta, n_phi : int
-        Contouring grid.
-    project : bool
-        Project the vertices onto the exact level set (default True).
-
-    Returns
-    -------
-    LevelSets
-
-    Examples
-    --------
-    >>> ls = rigid_body_level_sets([1.0, 2.0, 3.0], levels=[0.2, 0.4])
-    >>> ls.levels.tolist(), ls.separatrix.tolist()    # the saddle level 1/4 is added
-    ([0.2, 0.25, 0.4], [False, True, False])
-    >>> [len(cs) for cs in ls.curves]   # ovals around ±e3, the two separatrix circles, ovals around ±e1
-    [2, 2, 2]
-    >>> bool(np.allclose(np.linalg.norm(ls.curves[0][0], axis=1), 1.0))
-    True
-    """
-    import contourpy
-
-    A = as_inverse_inertia(inertia)
-    c = _as_c(c)
-    r = _check_radius(radius)
-    eqs = rigid_body_equilibria(_inertia_from_inverse(A), c, radius=r, theta=theta)
-    emin, emax = eqs[0].energy, eqs[-1].energy
-    if np.ndim(levels) == 0:
-        n = int(levels)
-        if n < 1:
-            raise ValueError(f"levels must be a positive number of levels or an array of values, got {levels!r}.")
-        lv = list(np.linspace(emin, emax, n + 2)[1:-1])
-    else:
-        lv = list(as_float_array(levels, "levels", ndim=1))
-    sep = [False] * len(lv)
-    if include_separatrices:
-        for e in eqs:
-            if e.kind == "saddle" and not any(abs(e.energy - x) <= 1e-12 * (abs(emax) + abs(emin) + 1) for x in lv):
-                lv.append(e.energy)
-                sep.append(True)
-    order = np.argsort(lv)
-    lv = np.array(lv)[order]
-    sep = np.array(sep)[order]
-
-    th = np.linspace(0.0, np.pi, n_theta)
-    ph = np.linspace(-np.pi, np.pi, n_phi)
-    TH, PH = np.meshgrid(th, ph, indexing="ij")
-    P = r * np.stack([np.sin(TH) * np.cos(PH), np.sin(TH) * np.sin(PH), np.cos(TH)], axis=-1)
-    H = 0.5 * np.einsum("...i,ij,...j->...", P, A, P) + P @ c
-    gen = contourpy.contour_generator(ph, th, H, line_type="Separate")
-    curves = []
-    for level in lv:
-        pieces = []
-        for seg in gen.lines(float(level)):
-            phs, ths = seg[:, 0], seg[:, 1]
-            xyz = r * np.stack([np.sin(ths) * np.cos(phs), np.sin(ths) * np.sin(phs), np.cos(ths)], axis=-1)
-            if project:
-                xyz = _project_to_level(xyz, A, c, r, float(level))
-            pieces.append(xyz)
-        curves.append(_join_polylines(pieces, tol=1e-6 * r))
-    return LevelSets(levels=lv, curves=curves, separatrix=sep, equilibria=eqs, radius=r,
-                     energy_range=(emin, emax))
-
-
-def _inertia_from_inverse(A):
-    return np.linalg.inv(A)
-
-
-def _project_to_level(x, A, c, r, level, iters=4):
-    for _ in range(iters):
-        g = x @ A.T + c
-        n = x / np.linalg.norm(x, axis=-1, keepdims=True)
-        gt = g - np.sum(g * n, axis=-1, keepdims=True) * n
-        f = 0.5 * np.einsum("...i,ij,...j->...", x, A, x) + x @ c - level
-        g2 = np.sum(gt * gt, axis=-1)
-        ok = g2 > 1e-20 * (1.0 + float(np.max(g2, initial=0.0)))
-        step = np.where(ok, f / np.where(ok, g2, 1.0), 0.0)
-        step = np.clip(step, -0.05 * r / np.sqrt(np.maximum(g2, 1e-300)), 0.05 * r / np.sqrt(np.maximum(g2, 1e-300)))
-        x = x - step[..., None] * gt
-        x = r * x / np.linalg.norm(x, axis=-1, keepdims=True)
-    return x
-
-
-# ------------------------------------------------------------------------------------ heavy top
 def lagrange_top_sleeping_stability(I1, I3, omega3, mgl):
     r"""The sleeping Lagrange top: linear stability of ``Π = (0, 0, I3 ω3)``, ``Γ = e3``.
 
     Symmetric top ``𝕀 = diag(I1, I1, I3)``, ``h = ½Π·𝕀⁻¹Π + χ·Γ`` with ``χ = M g ℓ e3`` (centre of
     mass on the symmetry axis at distance ``ℓ``), Lie–Poisson equations on se(3)* in the
-    ``CONVENTIONS.md`` form ``Π̇ = Π × Ω + Γ × χ``, ``Γ̇ = Γ × Ω``. The upright spin is an equilibrium
+    ``docs/conventions.md`` form ``Π̇ = Π × Ω + Γ × χ``, ``Γ̇ = Γ × Ω``. The upright spin is an equilibrium
     for every ``ω3``; it is linearly (and, by energy–Casimir, nonlinearly) stable iff
     ``Π3² > 4 I1 M g ℓ`` (the fast-top criterion). The body-frame linearisation has the eigenvalues
     ``± √(4 I1 M g ℓ − Π3²) / (2 I1)`` (each twice) plus two zeros along the Casimir directions.
@@ -597,3 +427,6 @@ def lagrange_top_sleeping_stability(I1, I3, omega3, mgl):
     lam = np.sqrt(complex(-margin)) / (2.0 * I1)
     return {"stable": bool(margin > 0), "margin": margin,
             "eigenvalues": np.array([lam, lam, -lam, -lam, 0.0, 0.0], dtype=complex)}
+
+
+from .phase_portrait import LevelSets, rigid_body_level_sets  # noqa: E402  (re-exported: former home)

@@ -1,6 +1,6 @@
 r"""The Gibbs measure of the dissipative stochastic rigid body on the sphere ``|Π| = r``.
 
-Theorem 3.1 (with the ½ of ``CONVENTIONS.md``): for isotropic noise ``ξ_i = σ e_i`` the RP
+Theorem 3.1 (with the ½ of ``docs/conventions.md``): for isotropic noise ``ξ_i = σ e_i`` the RP
 equation
 
 .. math::
@@ -45,7 +45,7 @@ import numpy as np
 
 from roughpaths.validation import as_float_array, check_positive_int, check_rng
 
-from .equilibria import _as_c, _check_radius, _tangent_basis, as_inverse_inertia, rigid_body_equilibria
+from .equilibria import _modified_hamiltonian, _as_c, _check_radius, _tangent_basis, as_inverse_inertia, rigid_body_equilibria
 
 __all__ = ["GibbsMeasure", "gibbs_beta", "gibbs_moments"]
 
@@ -174,7 +174,7 @@ class GibbsMeasure:
         return self._energy(P)
 
     def _energy(self, P):
-        return 0.5 * np.einsum("...i,ij,...j->...", P, self._A, P) + P @ self._c
+        return _modified_hamiltonian(P, self._A, self._c)
 
     def log_density(self, Pi) -> np.ndarray:
         """``log p(Π) = −β h̃(Π) − log Z`` (w.r.t. the area measure); ``Π`` is taken as given (on the sphere)."""

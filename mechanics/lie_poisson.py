@@ -9,7 +9,7 @@ path :math:`\mathbf X = (X, \mathbb X)` in :math:`\mathbb R^m`, is
     w(\mu) = \nabla\tilde h(\mu) + \vartheta\,\big(\mathrm{ad}^*_{\nabla\tilde h(\mu)}\mu\big)^\sharp,
 
 with the modified Hamiltonian :math:`\tilde h(\mu) = h(\mu) + \langle\mu, \ell\rangle` and the Lévy-area
-velocity :math:`\ell = \tfrac12\sum_{i,j}\mathsf s^{ij}[\xi_i,\xi_j]` (``CONVENTIONS.md``; ``ad*`` as in
+velocity :math:`\ell = \tfrac12\sum_{i,j}\mathsf s^{ij}[\xi_i,\xi_j]` (``docs/conventions.md``; ``ad*`` as in
 :mod:`mechanics.lie_algebra`, i.e. :math:`\mathrm{ad}^*_\xi\Pi = \Pi\times\xi` on so(3)).
 
 Why :math:`+\ell`: the noise fields :math:`V_i(\mu) = \mathrm{ad}^*_{\xi_i}\mu` have Jacobi–Lie bracket
@@ -59,14 +59,15 @@ import numpy as np
 
 from roughpaths.validation import as_float_array, check_antisymmetric
 
+from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
 from .lie_algebra import LieAlgebra
 
 __all__ = [
     "Hamiltonian",
     "QuadraticHamiltonian",
     "LiePoissonSystem",
-    "LiePoissonVectorFields",
     "check_inertia",
+    "levy_velocity",
     "girsanov_shift",
     "CONVENTIONS",
 ]
@@ -74,146 +75,43 @@ __all__ = [
 CONVENTIONS = ("rp", "paper")
 
 
-def check_inertia(inertia, name: str = "inertia", *, dim: int | None = None) -> np.ndarray:
-    """Check a symmetric positive-definite ``(n, n)`` inertia tensor (a vector means ``diag``)."""
-    arr = as_float_array(inertia, name)
-    if arr.ndim == 1:
-        arr = np.diag(arr)
-    if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
-        raise ValueError(f"{name} must be a square (n, n) matrix or a vector of principal moments, "
-                         f"got shape {arr.shape}.")
-    if dim is not None and arr.shape[0] != dim:
-        raise ValueError(f"{name} must be {dim}x{dim} for this Lie algebra, got shape {arr.shape}.")
-    scale = max(1.0, float(np.max(np.abs(arr))))
-    asym = float(np.max(np.abs(arr - arr.T)))
-    if asym > 1e-12 * scale:
-        raise ValueError(f"{name} must be symmetric; {name} - {name}.T has entries up to {asym:.3g}. "
-                         f"Pass 0.5 * ({name} + {name}.T) if the asymmetry is round-off.")
-    eig = np.linalg.eigvalsh(0.5 * (arr + arr.T))
-    if eig[0] <= 0:
-        raise ValueError(f"{name} must be positive definite, but its smallest eigenvalue is "
-                         f"{eig[0]:.6g} (eigenvalues {np.array2string(eig, precision=4)}); principal "
-                         f"moments of inertia are strictly positive.")
-    return 0.5 * (arr + arr.T)
+def levy_velocity(s, xi, algebra=None) -> np.ndarray:
+    r"""The Lévy-area velocity :math:`\ell = \tfrac12\sum_{i,j}\mathsf s^{ij}[\xi_i,\xi_j]` (rough-path sign, with the ½).
 
-
-class Hamiltonian:
-    r"""A Hamiltonian :math:`h:\mathfrak g^*\to\mathbb R` with its gradient (and optionally Hessian).
+    The one formula for it: :attr:`LiePoissonSystem.levy_velocity`, the rigid body's torque
+    :math:`c = \tfrac12\mathsf s^{ij}\xi_i\times\xi_j` and the Wong–Zakai limits all use it.
 
     Parameters
     ----------
-    value : callable
-        ``mu (..., n) -> (...)``.
-    gradient : callable
-        ``mu (..., n) -> (..., n)``: :math:`\partial h/\partial\mu\in\mathfrak g`.
-    hessian : callable, optional
-        ``mu (..., n) -> (..., n, n)``. Default: central finite differences of ``gradient`` (only
-        used by the implicit midpoint's chord Jacobian and by :meth:`LiePoissonSystem.drift_jacobian`).
+    s : array_like ``(m, m)``
+        Antisymmetric area perturbation, in the coordinates of the driver of ``ξ``.
+    xi : array_like ``(m, n)``
+        Noise vectors (rows).
+    algebra : LieAlgebra, optional
+        Default so(3) (``[x, y] = x × y``, ``n = 3``).
+
+    Examples
+    --------
+    >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 1.0, -1.0
+    >>> levy_velocity(s, 2.0 * np.eye(3))      # σ² (s23, -s13, s12)
+    array([ 0., -4.,  0.])
     """
+    from .lie_algebra import so3
 
-    def __init__(self, value, gradient, hessian=None):
-        if not callable(value) or not callable(gradient):
-            raise TypeError("Hamiltonian needs callables value(mu) and gradient(mu); got "
-                            f"{type(value).__name__} and {type(gradient).__name__}.")
-        if hessian is not None and not callable(hessian):
-            raise TypeError(f"hessian must be callable or None, got {type(hessian).__name__}.")
-        self._value, self._gradient, self._hessian = value, gradient, hessian
-
-    def value(self, mu):
-        """:math:`h(\\mu)`, shape ``(...)``."""
-        return np.asarray(self._value(mu), dtype=np.float64)
-
-    def gradient(self, mu):
-        """:math:`\\partial h/\\partial\\mu`, shape ``(..., n)``."""
-        return np.asarray(self._gradient(mu), dtype=np.float64)
-
-    def hessian(self, mu):
-        """:math:`\\partial^2 h/\\partial\\mu^2`, shape ``(..., n, n)``."""
-        if self._hessian is not None:
-            return np.asarray(self._hessian(mu), dtype=np.float64)
-        mu = np.asarray(mu, dtype=np.float64)
-        n = mu.shape[-1]
-        eps = 1e-6 * np.maximum(1.0, np.abs(mu))
-        cols = []
-        for k in range(n):
-            e = np.zeros(n)
-            e[k] = 1.0
-            step = eps[..., k:k + 1] * e
-            cols.append((self.gradient(mu + step) - self.gradient(mu - step)) / (2.0 * eps[..., k:k + 1]))
-        return np.stack(cols, axis=-1)
-
-    @property
-    def is_quadratic(self) -> bool:
-        return False
+    alg = so3() if algebra is None else algebra
+    s = as_float_array(s, "s", ndim=2)
+    if s.shape[0] != s.shape[1]:
+        raise ValueError(f"s must be square, got shape {s.shape}.")
+    xi = as_float_array(xi, "xi", ndim=2, last_dims=(s.shape[0], alg.dim))
+    return _levy_velocity(s, _brackets(xi, alg.structure_constants))
 
 
-class QuadraticHamiltonian(Hamiltonian):
-    r""":math:`h(\mu) = \tfrac12\mu\cdot Q\mu + b\cdot\mu` with symmetric ``Q`` (``(n, n)``) and ``b`` (``(n,)``).
-
-    Use :meth:`from_inertia` for :math:`h = \tfrac12\mu\cdot\mathbb I^{-1}\mu` (symmetric positive
-    definite inertia checked).
-    """
-
-    def __init__(self, q, linear=None):
-        q = as_float_array(q, "q", ndim=2)
-        if q.shape[0] != q.shape[1]:
-            raise ValueError(f"q must be square, got shape {q.shape}.")
-        if float(np.max(np.abs(q - q.T))) > 1e-12 * max(1.0, float(np.max(np.abs(q)))):
-            raise ValueError("q must be symmetric; pass 0.5 * (q + q.T).")
-        n = q.shape[0]
-        b = np.zeros(n) if linear is None else as_float_array(linear, "linear", ndim=1)
-        if b.shape != (n,):
-            raise ValueError(f"linear must have shape ({n},), got {b.shape}.")
-        self.q, self.linear = q, b
-        super().__init__(self._val, self._grad, self._hess)
-
-    @classmethod
-    def from_inertia(cls, inertia, linear=None) -> "QuadraticHamiltonian":
-        """:math:`h = \\tfrac12\\mu\\cdot\\mathbb I^{-1}\\mu (+ b\\cdot\\mu)`; ``inertia`` symmetric positive definite."""
-        i = check_inertia(inertia)
-        return cls(np.linalg.inv(i), linear)
-
-    def _val(self, mu):
-        return 0.5 * np.einsum("...i,ij,...j->...", mu, self.q, mu) + mu @ self.linear
-
-    def _grad(self, mu):
-        return mu @ self.q + self.linear
-
-    def _hess(self, mu):
-        return np.broadcast_to(self.q, np.shape(mu)[:-1] + self.q.shape)
-
-    @property
-    def is_quadratic(self) -> bool:
-        return True
+def _brackets(xi, c):
+    return np.einsum("ia,jb,abk->ijk", xi, xi, c)                        # [ξ_i, ξ_j], (m, m, n)
 
 
-class LiePoissonVectorFields:
-    r"""The system's vector fields on :math:`\mathbb R^n` (plain callables, batch first).
-
-    ``drift(mu) (..., n)``, ``drift_jacobian(mu) (..., n, n)``, ``noise(mu) (..., n, m)`` (column ``i``
-    is :math:`V_i(\mu) = \mathrm{ad}^*_{\xi_i}\mu`), ``noise_jacobian(mu) (..., n, m, n)``
-    (``[..., a, i, b] = ∂V_i^a/∂μ_b``), and ``noise_matrices`` ``(m, n, n)`` (the linear fields
-    :math:`V_i(\mu) = B_i\mu`). The drift already contains the Lévy-area torque of ``s`` (set
-    ``s=0`` in the system to drive it with a perturbed rough path instead).
-    """
-
-    def __init__(self, system: "LiePoissonSystem"):
-        self.system = system
-        self.dim = system.dim
-        self.n_noise = system.n_noise
-        self.noise_matrices = system.noise_matrices
-
-    def drift(self, mu):
-        return self.system.drift(mu)
-
-    def drift_jacobian(self, mu):
-        return self.system.drift_jacobian(mu)
-
-    def noise(self, mu):
-        return self.system.noise(mu)
-
-    def noise_jacobian(self, mu):
-        return self.system.noise_jacobian(mu)
+def _levy_velocity(s, brackets):
+    return 0.5 * np.einsum("ij,ijk->k", s, brackets)
 
 
 class LiePoissonSystem:
@@ -304,8 +202,8 @@ class LiePoissonSystem:
             self._metric_inv = np.linalg.inv(mtr)
         self.xi, self.s, self.theta, self.convention = xi, s, theta, convention
         c = algebra.structure_constants
-        self._xi_brackets = np.einsum("ia,jb,abk->ijk", xi, xi, c)          # [ξ_i, ξ_j], (m, m, n)
-        self._levy_velocity = 0.5 * np.einsum("ij,ijk->k", s, self._xi_brackets)
+        self._xi_brackets = _brackets(xi, c)
+        self._levy_velocity = _levy_velocity(s, self._xi_brackets)
         self._shift = self._levy_velocity if convention == "rp" else -self._levy_velocity
         # velocity shift inside the double bracket: the same as _shift, or none (dissipation from h)
         self._shift_dissipation = self._shift if self.levy_in_dissipation else np.zeros(n)
@@ -334,6 +232,38 @@ class LiePoissonSystem:
     def n_noise(self) -> int:
         """Number ``m`` of noise vectors (dimension of the driving rough path)."""
         return self.xi.shape[0]
+
+    @property
+    def dim_state(self) -> int:
+        """Dimension ``n`` of the state (for :func:`roughpaths.solve`; equals :attr:`dim`)."""
+        return self.algebra.dim
+
+    @property
+    def dim_noise(self) -> int:
+        """Dimension ``m`` of the driver (for :func:`roughpaths.solve`; equals :attr:`n_noise`)."""
+        return self.xi.shape[0]
+
+    def quadratic_velocity_data(self):
+        r"""Constants of :math:`w(\mu)` for a quadratic Hamiltonian :math:`h = \tfrac12\mu\cdot Q\mu + b\cdot\mu`.
+
+        :math:`w(\mu) = g + \vartheta M^{-1}(\mathrm{ad}^*_{g + f}\mu)` with :math:`g = Q\mu + b + \ell'`
+        (:math:`\ell'` the torque velocity), :math:`f` the change of the gradient inside the double
+        bracket (``0``, or :math:`-\ell'` with ``levy_in_dissipation=False``). Used by compiled kernels.
+
+        Returns
+        -------
+        dict with ``q (n, n)``, ``linear (n,)`` (:math:`b + \ell'`), ``dissipation_change (n,)`` (:math:`f`),
+        ``metric_inv (n, n)`` (identity by default) and ``theta``; ``None`` if ``h`` is not quadratic.
+        """
+        h = self.hamiltonian
+        if not h.is_quadratic:
+            return None
+        n = self.dim
+        minv = np.eye(n) if self._metric_inv is None else self._metric_inv
+        return {"q": np.ascontiguousarray(h.q, dtype=np.float64),
+                "linear": np.asarray(h.linear + self._shift, dtype=np.float64),
+                "dissipation_change": np.asarray(self._shift_dissipation - self._shift, dtype=np.float64),
+                "metric_inv": np.ascontiguousarray(minv, dtype=np.float64), "theta": self.theta}
 
     @property
     def levy_velocity(self) -> np.ndarray:
@@ -396,7 +326,7 @@ class LiePoissonSystem:
         return self.hamiltonian.gradient(mu) + self._shift_dissipation
 
     def _sharp(self, v):
-        return v if self._metric_inv is None else v @ self._metric_inv
+        return v if self._metric_inv is None else (self._metric_inv.T @ v[..., None])[..., 0]
 
     def casimirs(self, mu) -> np.ndarray:
         """Casimirs of the algebra at ``mu``, shape ``(..., k)``."""
@@ -424,6 +354,10 @@ class LiePoissonSystem:
         :math:`\mathrm{ad}^*_{w(\mu)}\mu` (with ``levy_in_dissipation=False`` the second
         :math:`\nabla\tilde h` is :math:`\nabla h`). Shape ``(..., n)``."""
         return self._w(self._mu(mu))
+
+    def drift_velocity_jacobian(self, mu) -> np.ndarray:
+        r""":math:`Dw(\mu)`, shape ``(..., n, n)`` (``[..., a, b] = ∂w_a/∂μ_b``)."""
+        return self._w_jacobian(self._mu(mu))
 
     def _w(self, mu):
         g = self._grad_tilde(mu)
@@ -470,17 +404,14 @@ class LiePoissonSystem:
     def vector_fields(self):
         r"""The fields in the form :func:`roughpaths.solve.solve` accepts.
 
-        Returns a ``roughpaths.vector_fields.LinearVectorFields`` with the noise matrices
-        :math:`B_i` (:math:`V_i(\mu) = B_i\mu = \mathrm{ad}^*_{\xi_i}\mu`) and the (non-linear) drift
-        :meth:`drift` with its Jacobian; if that module is unavailable, a
-        :class:`LiePoissonVectorFields` with the same callables. The drift contains the Lévy torque
-        of ``s`` — drive it with ``X``; the uncorrected system (``with_s(0)``) driven by
-        ``X.perturb(s)`` is the same RDE (Proposition 2.1).
+        Returns a ``roughpaths.LinearVectorFields`` with the noise matrices :math:`B_i`
+        (:math:`V_i(\mu) = B_i\mu = \mathrm{ad}^*_{\xi_i}\mu`) and the (non-linear) drift
+        :meth:`drift` with its Jacobian. The drift contains the Lévy torque of ``s`` — drive it with
+        ``X``; the uncorrected system (``with_s(0)``) driven by ``X.perturb(s)`` is the same RDE
+        (Proposition 2.1).
         """
-        try:
-            from roughpaths.vector_fields import LinearVectorFields
-        except ImportError:  # pragma: no cover - roughpaths without the RDE layer
-            return LiePoissonVectorFields(self)
+        from roughpaths import LinearVectorFields
+
         return LinearVectorFields(self._noise_matrices, drift=self.drift, drift_jacobian=self.drift_jacobian)
 
     # ------------------------------------------------------------------ log-signature → algebra
@@ -504,10 +435,12 @@ class LiePoissonSystem:
         Replacing :math:`A` by :math:`A + \mathsf s\,\Delta t` adds exactly :math:`\ell\,\Delta t`.
         """
         inc = np.asarray(increments, dtype=np.float64)
-        out = inc @ self.xi
+        out = (self.xi.T @ inc[..., None])[..., 0]                # stacked mat-vec: no coupling across the batch
         if levy_areas is not None:
-            out = out + 0.5 * np.einsum("...ij,ijk->...k", np.asarray(levy_areas, dtype=np.float64),
-                                        self._xi_brackets)
+            a = np.asarray(levy_areas, dtype=np.float64)
+            m = self.n_noise
+            brk = self._xi_brackets.reshape(m * m, self.dim).T
+            out = out + 0.5 * (brk @ a.reshape(a.shape[:-2] + (m * m, 1)))[..., 0]
         return out
 
 

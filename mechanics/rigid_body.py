@@ -1,6 +1,6 @@
 r"""The stochastic rigid body on so(3)* ≅ R³ (body angular momentum :math:`\Pi`).
 
-Rough-path-correct equation (``CONVENTIONS.md``), with :math:`W = \mathbb I^{-1}\Pi + c`:
+Rough-path-correct equation (``docs/conventions.md``), with :math:`W = \mathbb I^{-1}\Pi + c`:
 
 .. math::
 
@@ -66,7 +66,11 @@ class RigidBody(LiePoissonSystem):
 
     @property
     def levy_torque_vector(self) -> np.ndarray:
-        r""":math:`c = \tfrac12\mathsf s^{ij}\xi_i\times\xi_j` (rough-path sign), shape ``(3,)``."""
+        r"""Deprecated alias of :attr:`levy_velocity` (:math:`c = \tfrac12\mathsf s^{ij}\xi_i\times\xi_j`)."""
+        import warnings
+
+        warnings.warn("RigidBody.levy_torque_vector is deprecated; use .levy_velocity.", DeprecationWarning,
+                      stacklevel=2)
         return self.levy_velocity
 
     def angular_velocity(self, Pi) -> np.ndarray:  # noqa: N803
@@ -101,7 +105,7 @@ def rigid_body(inertia, xi=None, sigma=None, s=None, theta=0.0, convention="rp",
     >>> import numpy as np
     >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 25.0, -25.0
     >>> rb = rigid_body([1.0, 2.0, 3.0], sigma=0.05, s=s, theta=1.0)
-    >>> rb.levy_torque_vector          # σ² (s23, -s13, s12)
+    >>> rb.levy_velocity               # c = σ² (s23, -s13, s12)
     array([ 0.    , -0.0625,  0.    ])
     >>> float(rb.modified_energy([0.0, 0.0, 1.0]))
     0.16666666666666666

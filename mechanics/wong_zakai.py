@@ -9,7 +9,7 @@ Rigid body (paper eq. (srbcoloured), **no added drift**): with :math:`\Omega = \
 
 driven by the (smooth) coloured noise ``B^ε = ∫ y/ε dt`` of :mod:`roughpaths.coloured_noise`.
 
-Limit (Friz–Oberhauser, ``CONVENTIONS.md``). ``B^ε`` converges as a rough path to
+Limit (Friz–Oberhauser, ``docs/conventions.md``). ``B^ε`` converges as a rough path to
 ``(MB, M BB^{Strat} Mᵀ + N(t−s))`` with ``M = A⁻¹D`` and ``N = Alt(ΣA⁻ᵀ)`` (**B^ε coordinates**).
 Driving the fields :math:`V_i(\Pi) = \Pi\times\xi_i` by ``MB`` is driving the fields
 :math:`\Pi\times\xi'_k` by ``B`` with ``ξ'_k = Σ_i M_{ik} ξ_i = σ M[:, k]`` (the columns of ``σA⁻¹D``);
@@ -57,9 +57,11 @@ from roughpaths.validation import as_float_array, check_positive_int, check_rng
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
 
-from .integrators import LieHeun, simulate
+from roughpaths import solve
+
+from .integrators import CoadjointSolver, LieHeun
 from .lie_algebra import so3
-from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
+from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia, levy_velocity
 from .rigid_body import rigid_body
 
 __all__ = [
@@ -76,26 +78,11 @@ __all__ = [
 
 
 def levy_torque(s, xi) -> np.ndarray:
-    r"""Lévy torque :math:`c = \tfrac12\sum_{i,j}s^{ij}\,\xi_i\times\xi_j` (rough-path sign), shape ``(3,)``.
+    r"""Deprecated alias of :func:`mechanics.lie_poisson.levy_velocity` (so(3)): :math:`c = \tfrac12\sum_{i,j}s^{ij}\,\xi_i\times\xi_j`."""
+    import warnings
 
-    Parameters
-    ----------
-    s : array_like ``(m, m)``, antisymmetric perturbation in the coordinates of the driver of ``ξ``.
-    xi : array_like ``(m, 3)``, noise vectors (rows).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 1.0, -1.0
-    >>> levy_torque(s, 2.0 * np.eye(3))      # σ² (s23, -s13, s12)
-    array([ 0., -4.,  0.])
-    """
-    s = as_float_array(s, "s", ndim=2)
-    xi = as_float_array(xi, "xi", ndim=2, last_dims=(s.shape[0], 3))
-    if s.shape[0] != s.shape[1]:
-        raise ValueError(f"s must be square, got shape {s.shape}.")
-    cr = np.cross(xi[:, None, :], xi[None, :, :])
-    return 0.5 * np.einsum("ij,ijk->k", s, cr)
+    warnings.warn("levy_torque is deprecated; use mechanics.levy_velocity(s, xi).", DeprecationWarning, stacklevel=2)
+    return levy_velocity(s, xi)
 
 
 @dataclass(frozen=True)
@@ -115,7 +102,7 @@ class RigidBodyWongZakai:
         ``c = ½ Σ N^{ij} ξ_i×ξ_j`` with ``ξ_i = σe_i``.
     perturbation_B : ndarray ``(m, m)`` or None
         ``M⁻¹ N M⁻ᵀ`` (``M`` square invertible): the same perturbation in ``B`` coordinates, i.e.
-        ``levy_torque(perturbation_B, limit_xi) == torque``.
+        ``levy_velocity(perturbation_B, limit_xi) == torque``.
     """
 
     limit: ColouredNoiseLimit
@@ -156,7 +143,7 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
         raise ValueError(f"sigma must be a finite number >= 0, got {sigma!r}.")
     cxi = sg * np.eye(3)
     lxi = (sg * lim.scaling).T.copy()
-    c = levy_torque(lim.levy_perturbation, cxi)
+    c = levy_velocity(lim.levy_perturbation, cxi)
     M = lim.scaling
     sB = None
     if M.shape[0] == M.shape[1] and np.linalg.cond(M) < 1e12:
@@ -216,7 +203,7 @@ def integrate_rigid_body(driver: RoughPath, Pi0, inertia, xi, theta=0.0, *, torq
 
     With ``torque = dissipation_shift = c`` this is the rough-path-correct (srblevy) model; with
     ``dissipation_shift = 0`` it is the limit of (srbcoloured). Runs the shared coadjoint integrators
-    (:func:`mechanics.integrators.simulate`, Lie–Heun by default, numba so(3) kernel) on the
+    (:func:`roughpaths.solve`, Lie–Heun by default, compiled so(3) kernel) on the
     system ``h = ½Π·I⁻¹Π + c_d·Π`` with the Lévy velocity ``c − c_d`` in the conservative term only
     (``levy_in_dissipation=False``); ``|Π|`` is conserved to round-off.
 
@@ -249,11 +236,28 @@ def integrate_rigid_body(driver: RoughPath, Pi0, inertia, xi, theta=0.0, *, torq
     >>> Pi[..., -1, :]                      # e3 is an equilibrium
     array([0., 0., 1.])
     """
+    import warnings
+
+    warnings.warn("integrate_rigid_body is deprecated; build the system with rigid_body(inertia, xi, s, theta, "
+                  "levy_in_dissipation=False) and call roughpaths.solve(system, X, Pi0, LieHeun()).",
+                  DeprecationWarning, stacklevel=2)
     if not isinstance(driver, RoughPath) or driver.level != 2:
         raise TypeError("driver must be a level-2 roughpaths.RoughPath (its step Lévy areas are used).")
     xi = as_float_array(xi, "xi", ndim=2, last_dims=(driver.dim, 3))
     system = _rigid_system(inertia, xi, theta, torque, dissipation_shift)
-    return simulate(system, Pi0, driver, LieHeun() if method is None else method, save_every)
+    sol = solve(system, driver, Pi0, _check_method(method), save_at=driver.times[::check_positive_int(
+        save_every, "save_every")])
+    return sol.times, sol.states
+
+
+def _check_method(method):
+    if method is None:
+        return LieHeun()
+    if not isinstance(method, CoadjointSolver):
+        raise TypeError(f"method must be a coadjoint solver instance (LieEuler(), LieHeun(), ImplicitMidpoint()), "
+                        f"got {method!r}" + (f"; did you mean {method.__name__}()?" if isinstance(method, type)
+                                             else "."))
+    return method
 
 
 def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0), theta=1.0, Pi0=(0.0, 0.0, 1.0),
@@ -263,7 +267,7 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
 
     Streams the exact coloured noise (:func:`roughpaths.coloured_noise.iter_coloured_noise`) in time
     chunks (constant memory) and integrates, on the same draws, with the shared coadjoint
-    integrators (:func:`mechanics.integrators.simulate` on each chunk's :class:`~roughpaths.RoughPath`):
+    integrators (:func:`roughpaths.solve` on each chunk's :class:`~roughpaths.RoughPath`):
 
     * ``"coloured"``: (srbcoloured), ``ξ_i = σe_i`` driven by the level-2 lift of ``B^ε``;
     * ``"limit"``: the white-noise limit, ``ξ'_k = σ(A⁻¹D)[:, k]`` driven by ``B`` with the Lévy torque
@@ -315,7 +319,7 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     h = T / n_steps
     save_every = check_positive_int(save_every, "save_every")
     n_paths = check_positive_int(n_paths, "n_paths")
-    method = LieHeun() if method is None else method
+    method = _check_method(method)
     inertia = _check_inertia3(inertia)
     P0 = as_float_array(Pi0, "Pi0", ndim=1, last_dims=(3,))
     K = n_steps // save_every + 1
@@ -353,7 +357,7 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
         keep = j % save_every == 0
         for k in systems:
             system, use_b = cfg[k]
-            _, st = simulate(system, state[k], XB if use_b else X, method)          # (P, S + 1, 3)
+            st = solve(system, XB if use_b else X, state[k], method).states          # (P, S + 1, 3)
             out[k][:, j[keep] // save_every] = st[:, 1:][:, keep]
             state[k] = st[:, -1].copy()
         done += S

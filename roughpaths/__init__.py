@@ -5,8 +5,9 @@ Conventions are fixed once, in ``CONVENTIONS.md`` of the project: the area ``XX[
 Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """
 
-from .brownian import DEFAULT_SUBSTEPS, brownian_increments_and_areas, brownian_rough_path, refine
+from .brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path, refine
 from .coloured_noise import (
+    ColouredNoiseDriver,
     ColouredNoiseLimit,
     ColouredNoiseSample,
     ResolutionWarning,
@@ -81,6 +82,7 @@ __all__ = [
     "rough_integral",
     # coloured noise
     "coloured_noise_limit",
+    "ColouredNoiseDriver",
     "ColouredNoiseLimit",
     "ColouredNoiseSample",
     "sample_coloured_noise",
@@ -105,6 +107,7 @@ __all__ = [
     "fgn_autocovariance",
     "piecewise_linear_lift",
     "brownian_rough_path",
+    "BrownianDriver",
     "brownian_increments_and_areas",
     "refine",
     "DEFAULT_SUBSTEPS",

@@ -1,7 +1,7 @@
 r"""Numba kernel for the Brownian step areas (private; called by :mod:`roughpaths.brownian`).
 
-One call turns pre-drawn standard normals into the level-2 step areas of a chunk of rows
-(steps), fusing what :mod:`roughpaths.brownian` used to do with batched numpy products:
+One call turns pre-drawn standard normals into the level-2 step areas of a block of
+path-steps:
 
 * substep increments ``w_k`` (a Brownian bridge pinned to the step increment ``W``:
   ``w_k = √δ (z_k - z̄) + W/m``, ``δ = h/m``; for ``m = 1`` simply ``w_1 = W``);
@@ -15,15 +15,13 @@ One call turns pre-drawn standard normals into the level-2 step areas of a chunk
 * the symmetric part ``½ W⊗W`` and, for Itô, ``-½ h I``.
 
 Conventions as in :mod:`roughpaths.brownian`: ``XX[i, j] = ∫ (W^i - W^i_s) ∘dW^j``, Lévy area
-with the ½. The random numbers are drawn by the caller from its ``numpy.random.Generator`` (so
-results reproduce from the seed, in the same order as the former numpy implementation); the
+with the ½. The random numbers are drawn by the caller (the driver's per-path streams); the
 kernel is deterministic. No temporary larger than ``O(d)``.
 
-Serial on purpose: the cost is dominated by the normals the caller draws (one thread, the
-Generator is sequential); the kernel is ~15 % of the total (d = 3, m = 8), and a ``prange``
-version measured slower end to end on the shared 2-core machine (idle OpenMP threads spin
-while the Generator draws the next chunk). ``nogil=True`` lets callers overlap it with other
-work. No ``fastmath``: round-off matches the numpy reference to ~1e-16 relative.
+Serial on purpose: the cost is dominated by drawing the normals (d = 3, m = 1: the kernel takes
+~15 ns of ~100 ns per path-step), and the machine is shared. ``nogil=True`` lets callers
+overlap it with other work. No ``fastmath``: round-off matches a naive per-step numpy
+reimplementation to ~1e-16 relative (``tests/test_brownian_driver_stream.py``).
 """
 
 from __future__ import annotations
@@ -31,77 +29,175 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._random import _pcg64_normal
+
 
 @njit(cache=True, nogil=True)
-def _step_areas(dW, h, z, zeta, lam, m, davie, ito, out):
-    """Level-2 step areas of ``R`` rows from pre-drawn standard normals, written into ``out``.
+def _block_areas(dW, h, buf, m, davie, ito, out):
+    """Level-2 step areas of a block ``(P, K)`` of path-steps from the per-step packed normals.
+
+    With the layout of :class:`roughpaths.BrownianDriver`'s
+    area stream: ``buf[p, k]`` holds, in this order, the bridge normals ``z`` (``m d``,
+    substep-major, only if ``m > 1``), the space-time normals ``ζ`` (``m d``) and, for Davie's
+    method, the ``d(d-1)/2`` normals ``λ`` (``numpy.triu_indices`` order).
+
+    Written as one loop nest with a branch for ``m = 1`` (Davie's own method:
+    ``A = H ∧ W + λ``, no substep loop): a per-step helper function taking the arrays measured
+    3-5x slower (array reference counting per call), the ``m = 1`` branch ~1.5x faster than
+    the general loop.
 
     Parameters
     ----------
-    dW : (R, d) float64
-        Step increments ``W``.
-    h : (R,) float64
+    dW : (P, K, d) float64
+        Step increments.
+    h : (K,) float64
         Step sizes.
-    z : (R, m, d) float64
-        Standard normals for the bridge (ignored, may be ``(0, 1, d)``, when ``m == 1``).
-    zeta : (R, m, d) float64
-        Standard normals for the space-time Lévy areas.
-    lam : (R, P) float64
-        Standard normals for Davie's term, ``P = d(d-1)/2`` (ignored unless ``davie``).
+    buf : (P, K, n_area) float64
+        Standard normals, ``n_area = (m d if m > 1 else 0) + m d + (d(d-1)/2 if davie else 0)``.
     m : int
         Substeps per step.
     davie, ito : bool
         Add Davie's independent Gaussian; subtract ``½ h I`` (Itô areas).
-    out : (R, d, d) float64
+    out : (P, K, d, d) float64
         Receives ``A + ½ W⊗W (- ½ h I)``.
     """
-    R, d = dW.shape
-    P = d * (d - 1) // 2
+    P, K, d = dW.shape
+    npair = d * (d - 1) // 2
     inv_m = 1.0 / m
-    inv_s12 = 1.0 / np.sqrt(12.0)
-    lam_scale = 1.0 / np.sqrt(12.0 * m)
-    shift = np.zeros(d)      # √δ z̄ - W/m, so that w_k = √δ z_k - shift
-    s = np.empty(d)          # S_k = Σ_{l<k} w_l
-    w = np.empty(d)
-    a = np.empty(d)          # H_k + ½ S_k
-    A = np.empty(P)          # Lévy area, pairs i < j in triu order
-    for r in range(R):
-        hr = h[r]
-        sq = np.sqrt(hr * inv_m)
-        sH = sq * inv_s12
-        if m > 1:
+    o_zeta = m * d if m > 1 else 0
+    o_lam = o_zeta + m * d
+    shift, s, w, a = np.zeros(d), np.empty(d), np.empty(d), np.empty(d)
+    A = np.empty(max(npair, 1))
+    sHs = np.sqrt(h * (inv_m / 12.0))            # √(δ/12), δ = h/m
+    cs = h / np.sqrt(12.0 * m)                   # Davie's scale h/√(12 m)
+    for p in range(P):
+        for r in range(K):
+            hr = h[r]
+            sH = sHs[r]
+            c = cs[r]
+            if m == 1:
+                q = 0
+                for i in range(d):
+                    Wi = dW[p, r, i]
+                    Hi = sH * buf[p, r, i]
+                    out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
+                    for j in range(i + 1, d):
+                        Wj = dW[p, r, j]
+                        v = Hi * Wj - sH * buf[p, r, j] * Wi
+                        if davie:
+                            v += buf[p, r, o_lam + q] * c
+                        sym = 0.5 * Wi * Wj
+                        out[p, r, i, j] = sym + v
+                        out[p, r, j, i] = sym - v
+                        q += 1
+                continue
+            sq = np.sqrt(hr * inv_m)
             for j in range(d):
                 acc = 0.0
                 for k in range(m):
-                    acc += z[r, k, j]
-                shift[j] = sq * acc * inv_m - dW[r, j] * inv_m
-        for j in range(d):
-            s[j] = 0.0
-        for p in range(P):
-            A[p] = 0.0
-        for k in range(m):
-            if m > 1:
+                    acc += buf[p, r, k * d + j]
+                shift[j] = sq * acc * inv_m - dW[p, r, j] * inv_m
+                s[j] = 0.0
+            for q in range(npair):
+                A[q] = 0.0
+            for k in range(m):
                 for j in range(d):
-                    w[j] = sq * z[r, k, j] - shift[j]
-            else:
-                for j in range(d):
-                    w[j] = dW[r, j]
-            for j in range(d):
-                a[j] = sH * zeta[r, k, j] + 0.5 * s[j]
-                s[j] += w[j]
-            p = 0
-            for i in range(d):         # (g - gᵀ)_{ij}, g = Σ_k a_k ⊗ w_k
+                    w[j] = sq * buf[p, r, k * d + j] - shift[j]
+                    a[j] = sH * buf[p, r, o_zeta + k * d + j] + 0.5 * s[j]
+                    s[j] += w[j]
+                q = 0
+                for i in range(d):         # (g - gᵀ)_{ij}, g = Σ_k a_k ⊗ w_k
+                    for j in range(i + 1, d):
+                        A[q] += a[i] * w[j] - a[j] * w[i]
+                        q += 1
+            q = 0
+            for i in range(d):
+                Wi = dW[p, r, i]
+                out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
                 for j in range(i + 1, d):
-                    A[p] += a[i] * w[j] - a[j] * w[i]
-                    p += 1
-        c = hr * lam_scale
-        p = 0
-        for i in range(d):
-            Wi = dW[r, i]
-            out[r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
-            for j in range(i + 1, d):
-                v = A[p] + (lam[r, p] * c if davie else 0.0)
-                sym = 0.5 * Wi * dW[r, j]
-                out[r, i, j] = sym + v
-                out[r, j, i] = sym - v
-                p += 1
+                    v = A[q] + (buf[p, r, o_lam + q] * c if davie else 0.0)
+                    sym = 0.5 * Wi * dW[p, r, j]
+                    out[p, r, i, j] = sym + v
+                    out[p, r, j, i] = sym - v
+                    q += 1
+
+
+# ----------------------------------------------------------------------------- exact d = 2 area
+@njit(cache=True, inline="always")
+def _exp1(sh, sl, ih, il):
+    """An Exp(1) variable from two standard normals, ``(Z1² + Z2²)/2`` (exact: χ²₂/2)."""
+    z1, sh, sl = _pcg64_normal(sh, sl, ih, il)
+    z2, sh, sl = _pcg64_normal(sh, sl, ih, il)
+    return 0.5 * (z1 * z1 + z2 * z2), sh, sl
+
+
+@njit(cache=True, nogil=True)
+def _exact_areas_d2(dW, h, states, n_terms, t1, t2, ito, out):
+    r"""Exact-in-law d = 2 Lévy areas given the increments, from the per-path area streams.
+
+    For a step of size ``h`` with increment ``w`` and ``μ = |w|²/h``, the Lévy area is
+    ``A = h (L + √V Z)`` with ``L`` logistic of scale ``1/(2π)`` (``L = log(E₁/E₂)/(2π)``),
+    ``Z ~ N(0, 1)`` and ``V = Σ_{k≥1} Γ_k/(2π²k²)``, ``Γ_k ~ Gamma(N_k)`` (0 if ``N_k = 0``),
+    ``N_k ~ Poisson(μ)`` (derivation in :mod:`roughpaths.brownian`). The first ``n_terms``
+    terms are drawn exactly (``N_k`` by exponential arrivals, ``Γ_k`` as ``½ χ²_{2N_k}``), the
+    tail ``Σ_{k>n_terms}`` by a Gamma variable with its exact mean ``μ t1`` and variance
+    ``2 μ t2`` (Marsaglia–Tsang). Draw order per step: ``Z``; ``E₁, E₂`` (2 normals each);
+    for each ``k``: the arrivals (2 normals each, the one past ``μ`` included) then the ``2 N_k``
+    normals of ``Γ_k``; the tail's normals. ``states`` ``(P, 4)`` advance in place; ``out``
+    ``(P, K, 2, 2)`` receives ``A J + ½ w⊗w (- ½ h I)``.
+    """
+    P, K, d = dW.shape
+    inv2pi = 1.0 / (2.0 * np.pi)
+    inv2pi2 = 1.0 / (2.0 * np.pi * np.pi)
+    for p in range(P):
+        sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+        for r in range(K):
+            hr = h[r]
+            w0 = dW[p, r, 0]
+            w1 = dW[p, r, 1]
+            mu = (w0 * w0 + w1 * w1) / hr
+            z, sh, sl = _pcg64_normal(sh, sl, ih, il)
+            e1, sh, sl = _exp1(sh, sl, ih, il)
+            e2, sh, sl = _exp1(sh, sl, ih, il)
+            V = 0.0
+            for k in range(1, n_terms + 1):
+                # N_k ~ Poisson(mu): number of unit-rate arrivals in [0, mu]
+                n = 0
+                tarr, sh, sl = _exp1(sh, sl, ih, il)
+                while tarr <= mu:
+                    n += 1
+                    e, sh, sl = _exp1(sh, sl, ih, il)
+                    tarr += e
+                g = 0.0
+                for _ in range(2 * n):
+                    x, sh, sl = _pcg64_normal(sh, sl, ih, il)
+                    g += x * x
+                V += 0.5 * g * inv2pi2 / (k * k)
+            if mu > 0.0:
+                alpha = mu * t1 * t1 / (2.0 * t2)
+                theta = 2.0 * t2 / t1
+                a = alpha + 1.0 if alpha < 1.0 else alpha
+                dd = a - 1.0 / 3.0
+                c = 1.0 / np.sqrt(9.0 * dd)
+                while True:
+                    x, sh, sl = _pcg64_normal(sh, sl, ih, il)
+                    v = 1.0 + c * x
+                    if v <= 0.0:
+                        continue
+                    v = v * v * v
+                    e, sh, sl = _exp1(sh, sl, ih, il)
+                    if -e < 0.5 * x * x + dd - dd * v + dd * np.log(v):
+                        break
+                gam = dd * v
+                if alpha < 1.0:
+                    e, sh, sl = _exp1(sh, sl, ih, il)
+                    gam *= np.exp(-e / alpha)
+                V += theta * gam
+            A = hr * (inv2pi * np.log(e1 / e2) + np.sqrt(V) * z)
+            sym = 0.5 * w0 * w1
+            out[p, r, 0, 0] = 0.5 * w0 * w0 - (0.5 * hr if ito else 0.0)
+            out[p, r, 1, 1] = 0.5 * w1 * w1 - (0.5 * hr if ito else 0.0)
+            out[p, r, 0, 1] = sym + A
+            out[p, r, 1, 0] = sym - A
+        states[p, 0] = sh
+        states[p, 1] = sl

@@ -1,6 +1,6 @@
 r"""Brownian motion lifted to a level-2 rough path (Stratonovich or Itô), sampled on a grid.
 
-Conventions (``CONVENTIONS.md``)
+Conventions (``docs/conventions.md``)
 --------------------------------
 * area ``XX[..., i, j]`` over a step ``[s, t]`` is :math:`\int_s^t (W^i_r - W^i_s)\,\circ dW^j_r`
   (``iisignature`` ordering);
@@ -41,20 +41,48 @@ counting each pair ``i < j`` once), and its variance is :math:`h^2/4 - h^2/(12 m
 moment of ``(W, A)`` is then exact, also conditionally on ``W``
 (:math:`\mathrm{Var}(A_{ij}\mid W) = h^2/12 + h(W_i^2 + W_j^2)/12`), and so is the
 conditional mean; the residual law error is in the fourth and higher cumulants and decays like
-``1/m`` (d = 2, measured with 2·10⁶ samples: excess kurtosis 1.36 for ``m = 1`` and 2.00 for the
-default ``m = 8``, exact value 2; a Kolmogorov–Smirnov test with 4·10⁵ samples cannot tell the
-``m = 8`` law from the exact one). Its
+``1/m`` (d = 2, measured with 2·10⁶ samples: excess kurtosis 1.36 for the default ``m = 1``
+(Davie's own method) and 2.00 for ``m = 8``, exact value 2; a Kolmogorov–Smirnov test with
+4·10⁵ samples cannot tell the ``m = 8`` law from the exact one). The default ``m``,
+:data:`DEFAULT_SUBSTEPS` ``= 1``, is the same for every entry point (this module's functions,
+:class:`BrownianDriver`); it gives exact second moments at the lowest cost. Its
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
 component (the added Gaussian is independent of the path).
 
+``levy_area="exact"`` (d = 2 only) samples the Lévy area from its conditional law given the
+increment ``w`` (Lévy 1951), whose characteristic function is
+:math:`\frac{\lambda h/2}{\sinh(\lambda h/2)}\exp\bigl(-\frac{|w|^2}{2h}(\frac{\lambda h}{2}\coth\frac{\lambda h}{2} - 1)\bigr)`.
+Derivation of the sampler: :math:`x/\sinh x = \prod_k (1 + x^2/(k\pi)^2)^{-1}` is the
+characteristic function of a logistic variable of scale :math:`h/(2\pi)` (``λ`` for ``x = λh/2``), and
+:math:`x\coth x - 1 = \sum_k 2x^2/(x^2 + k^2\pi^2)` makes the second factor a product over ``k``
+of compound Poisson laws with rate :math:`\mu = |w|^2/h` and Laplace jumps of scale
+:math:`h/(2\pi k)`. A sum of ``n`` standard Laplace variables is :math:`\sqrt{2\Gamma_n} Z`, so
+
+.. math:: A = h\bigl(L + \sqrt{V} Z\bigr),\quad L = \tfrac{1}{2\pi}\log\tfrac{E_1}{E_2},\quad
+          V = \sum_{k\ge1} \frac{\Gamma(N_k)}{2\pi^2 k^2},\quad N_k \sim \mathrm{Poisson}(\mu),
+
+(``E`` exponential, ``Z`` normal, all independent; check: :math:`E[V] = \mu/12`, so
+:math:`\mathrm{Var}(A\mid w) = h^2/12 + h|w|^2/12`). The first 8 terms are drawn exactly (Poisson
+by exponential arrivals, Gamma as a χ², all from the path's normals), the tail
+:math:`\sum_{k>8}` by a Gamma variable with its exact mean and variance. The law error this
+leaves, bounded through the characteristic functions by Gil-Pelaez
+(:math:`\sup|\Delta F| \le \pi^{-1}\int |\Delta\varphi(\lambda)|/\lambda\, d\lambda`), is below
+5·10⁻⁷ in CDF (sup norm; the resolution of that quadrature) for every ``|w|`` tried (``μ`` from
+0.5 to 50; replacing the tail by its mean alone would leave 1e-5): no Kolmogorov–Smirnov test
+with fewer than ~10¹² samples can see it. Cost: a variable number of normals, about
+``24 + 32 μ`` per step (``E[μ] = 2``: ~90), against 5 for Davie's ``m = 1`` (d = 2).
+
 Cost per step: ``d`` normals for the increment, plus ``m d`` (bridge, only if ``m > 1``),
 ``m d`` (space-time areas) and ``d(d-1)/2`` (Davie) normals and ``O(m d^2)`` flops for the area.
-The normals are drawn by ``rng`` (numpy, one thread) and the flops done by a fused numba kernel
-(:mod:`roughpaths._brownian_kernels`), so the time is essentially that of drawing the normals:
-areas cost about ``(d + 2 m d + d(d-1)/2) / d`` times the increments alone, i.e. ~3-4x for
-``m = 1`` and ~16-20x for the default ``m = 8`` (``benchmarks/bench_brownian.py``; 1000 paths x
-1000 steps, d = 3, m = 8: ~0.65 s against ~0.03 s for the increments). ``levy_area=None``
-returns the increments alone at the cost of ``d`` normals per step.
+The normals come from per-path streams (numpy's ziggurat over ``PCG64``, run by a numba kernel
+over all paths, :mod:`roughpaths._random`) and the flops from a numba kernel
+(:mod:`roughpaths._brownian_kernels`), so the time is essentially that of drawing the normals
+(``benchmarks/bench_brownian.py`` measures it against the former samplers).
+``levy_area=None`` returns the increments alone at the cost of ``d`` normals per step.
+
+Every entry point samples the same stream: :class:`BrownianDriver` (lazy, in time blocks) and
+the one-shot :func:`brownian_rough_path` / :func:`brownian_increments_and_areas`, which
+materialise a driver seeded from their ``rng``.
 
 References: J. Foster, T. Lyons, H. Oberhauser, *An optimal polynomial approximation of Brownian
 motion*, SIAM J. Numer. Anal. 58 (2020); A. Davie, *KMT theory applied to approximations of SDE*
@@ -67,38 +95,26 @@ import numbers
 
 import numpy as np
 
-from .validation import as_float_array, check_positive_int, check_rng, check_times
-from ._brownian_kernels import _step_areas
+from .validation import as_float_array, check_positive_int, check_rng
+from ._brownian_kernels import _block_areas, _exact_areas_d2
+from ._random import PathStreams
+from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from .level2 import outer
 from .rough_path import RoughPath
 
-__all__ = ["brownian_increments_and_areas", "brownian_rough_path", "refine", "DEFAULT_SUBSTEPS"]
+__all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "refine", "DEFAULT_SUBSTEPS"]
 
-#: Default number of substeps per grid step for the Lévy-area sampler.
-DEFAULT_SUBSTEPS = 8
+#: Default number of substeps per grid step for the Lévy-area sampler, the same for every entry point
+#: (Davie's own method: exact second moments at the lowest cost).
+DEFAULT_SUBSTEPS = 1
 
-_LEVY_METHODS = ("davie", "foster")
+_LEVY_METHODS = ("davie", "foster", "exact")
+#: Series terms drawn exactly by ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
+_EXACT_TERMS = 8
 _KINDS = ("stratonovich", "ito")
-# Rows (steps) per chunk of random draws: chunk = _CHUNK_FLOATS // (4 m d + d²) (buffers ~16 MB).
-# The chunking fixes which normals go to which step: changing it changes the samples of a seed.
-_CHUNK_FLOATS = 1 << 22
 
 
 # ---------------------------------------------------------------------------- validation
-def _check_batch_shape(batch_shape) -> tuple:
-    if isinstance(batch_shape, numbers.Integral) and not isinstance(batch_shape, bool):
-        batch_shape = (batch_shape,)
-    try:
-        shape = tuple(batch_shape)
-    except TypeError:
-        raise TypeError(f"batch_shape must be a tuple of integers, got {batch_shape!r}; "
-                        f"pass e.g. batch_shape=(1000,).") from None
-    for n in shape:
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
-            raise ValueError(f"batch_shape must hold non-negative integers, got {shape!r}.")
-    return tuple(int(n) for n in shape)
-
-
 def _check_kind(kind) -> str:
     if kind not in _KINDS:
         raise ValueError(f"kind must be 'stratonovich' or 'ito', got {kind!r}.")
@@ -126,6 +142,16 @@ def _check_dt(dt, n_steps: int) -> np.ndarray:
         raise ValueError(f"dt must be > 0, got dt[{k}]={arr[k]!r}; pass positive step sizes "
                          f"(use brownian_rough_path(times, ...) for a grid).")
     return arr
+
+
+def _seed_from_rng(rng) -> np.random.SeedSequence:
+    """The driver seed of the wrappers: drawn from a Generator (2 draws), or an int/SeedSequence as is."""
+    if isinstance(rng, np.random.Generator):
+        return np.random.SeedSequence([int(v) for v in rng.integers(0, 2**63, size=2, dtype=np.int64)])
+    if isinstance(rng, np.random.SeedSequence) or (isinstance(rng, numbers.Integral) and not isinstance(rng, bool)):
+        return _check_seed(rng)
+    raise TypeError(f"rng must be a numpy.random.Generator (or an int seed / SeedSequence), got "
+                    f"{type(rng).__name__}; pass rng=numpy.random.default_rng(seed).")
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -164,47 +190,6 @@ def _antisym_normal(rng: np.random.Generator, shape: tuple, d: int) -> np.ndarra
     return out
 
 
-def _sample_areas(rng, dW: np.ndarray, dt: np.ndarray, method: str, m: int, ito: bool,
-                  out: np.ndarray) -> None:
-    """Step areas for rows ``dW (R, d)`` with step sizes ``dt (R,)``, written into ``out (R, d, d)``.
-
-    Draws, chunk by chunk, the bridge normals ``(c, m, d)`` (only if ``m > 1``), the space-time
-    normals ``(c, m, d)`` and, for ``"davie"``, ``(c, d(d-1)/2)`` normals, in this order, then
-    calls the fused numba kernel (:func:`roughpaths._brownian_kernels._step_areas`). The chunk
-    size and the draw order are those of the original numpy implementation, so a seed gives the
-    same random numbers as before; the areas agree with it to round-off.
-    """
-    R, d = dW.shape
-    P = d * (d - 1) // 2
-    davie = method == "davie" and P > 0
-    chunk = max(1, _CHUNK_FLOATS // (m * d * 4 + d * d))
-    c0 = min(chunk, R)
-    zbuf = np.empty(c0 * m * d) if m > 1 else None
-    hbuf = np.empty(c0 * m * d)
-    lbuf = np.empty(c0 * P) if davie else None
-    no_z = np.empty((0, 1, d))
-    no_lam = np.empty((0, max(P, 1)))
-    for lo in range(0, R, chunk):
-        hi = min(R, lo + chunk)
-        n = hi - lo
-        if m > 1:
-            z = zbuf[:n * m * d]
-            rng.standard_normal(out=z)
-            z = z.reshape(n, m, d)
-        else:
-            z = no_z
-        zeta = hbuf[:n * m * d]
-        rng.standard_normal(out=zeta)
-        zeta = zeta.reshape(n, m, d)
-        if davie:
-            lam = lbuf[:n * P]
-            rng.standard_normal(out=lam)
-            lam = lam.reshape(n, P)
-        else:
-            lam = no_lam
-        _step_areas(dW[lo:hi], dt[lo:hi], z, zeta, lam, m, davie, ito, out[lo:hi])
-
-
 # ---------------------------------------------------------------------------- public API
 def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy_area="davie",
                                   substeps=DEFAULT_SUBSTEPS, kind="stratonovich"):
@@ -212,8 +197,11 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
 
     Parameters
     ----------
-    rng : numpy.random.Generator
-        Source of randomness (results are reproducible from its seed).
+    rng : numpy.random.Generator, int or numpy.random.SeedSequence
+        Source of randomness. The numbers are those of :class:`BrownianDriver` (see its *Stream*)
+        with ``seed = SeedSequence([a, b])``, ``a, b = rng.integers(0, 2**63, size=2)`` (one call
+        advances ``rng`` by these two draws only); an int or ``SeedSequence`` is used as the
+        driver's seed directly.
     n_steps : int
         Number of steps ``N >= 1``.
     dt : float or array_like, shape ``(N,)``
@@ -222,8 +210,9 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
         Dimension ``d >= 1`` of the Brownian motion.
     batch_shape : tuple of int, optional
         Leading batch axes (independent paths), default ``()``.
-    levy_area : {"davie", "foster"} or None
-        Lévy-area method (see the module docstring for its exact error): ``"davie"`` (default)
+    levy_area : {"davie", "foster", "exact"} or None
+        Lévy-area method (see the module docstring for its exact error; ``"exact"`` for ``d = 2``
+        only): ``"davie"`` (default)
         matches every second moment of ``(W, A)`` exactly, ``"foster"`` is the conditional mean
         given the substep information (best L² approximation, variance short by ``h²/(12 m)``).
         ``None`` (or ``"none"``) returns ``areas=None`` and draws only the increments.
@@ -243,9 +232,11 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
 
     Notes
     -----
-    The increments are drawn first from ``rng``, so for the same seed ``dW`` is identical
-    whatever ``levy_area``, ``substeps`` or ``kind``; chunking a long horizon into several calls
-    with one generator gives independent, exactly distributed chunks.
+    The increments and the areas come from separate per-path streams (:class:`BrownianDriver`),
+    so for the same seed ``dW`` is identical whatever ``levy_area``, ``substeps`` or ``kind``;
+    chunking a long horizon into several calls with one generator gives independent, exactly
+    distributed chunks (for a stream that does not depend on the chunking, iterate
+    ``BrownianDriver(...).blocks()``).
 
     Examples
     --------
@@ -261,24 +252,16 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     >>> bool(np.array_equal(dW, dW2)), none is None
     (True, True)
     """
-    rng = check_rng(rng, "rng")
+    seed = _seed_from_rng(rng)
     n_steps = check_positive_int(n_steps, "n_steps")
     dim = check_positive_int(dim, "dim")
     batch_shape = _check_batch_shape(batch_shape)
     h = _check_dt(dt, n_steps)
-    method = _check_levy_method(levy_area)
-    m = check_positive_int(substeps, "substeps")
-    kind = _check_kind(kind)
-
-    shape = batch_shape + (n_steps, dim)
-    dW = rng.standard_normal(shape) * np.sqrt(h)[:, None]
-    if method is None:
-        return dW, None
-    rows = dW.reshape(-1, dim)
-    hrows = np.ascontiguousarray(np.broadcast_to(h, batch_shape + (n_steps,)).reshape(-1))
-    areas = np.empty(shape + (dim,))
-    _sample_areas(rng, rows, hrows, method, m, kind == "ito", areas.reshape(-1, dim, dim))
-    return dW, areas
+    drv = BrownianDriver(dim, seed=seed, times=np.concatenate([[0.0], np.cumsum(h)]), batch_shape=batch_shape,
+                         levy_area=levy_area, substeps=substeps, kind=kind)
+    drv._h = h                               # the given step sizes exactly (not differences of their sums)
+    X = drv.rough_path()
+    return X.increments, X.areas
 
 
 def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich", levy_area="davie",
@@ -291,8 +274,9 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
         Strictly increasing grid (non-uniform allowed).
     dim : int
         Dimension ``d``.
-    rng : numpy.random.Generator
-        Source of randomness.
+    rng : numpy.random.Generator, int or numpy.random.SeedSequence
+        Source of randomness: the path is ``BrownianDriver(dim, seed=..., times=times, ...)
+        .rough_path()`` with the seed derived as in :func:`brownian_increments_and_areas`.
     batch_shape : tuple of int, optional
         Independent paths, default ``()``.
     kind : {"stratonovich", "ito"}
@@ -318,24 +302,9 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
     >>> float(X.geometric_defect().max()) < 1e-15
     True
     """
-    t = check_times(times, "times")
-    rng = check_rng(rng, "rng")
-    dim = check_positive_int(dim, "dim")
-    batch_shape = _check_batch_shape(batch_shape)
-    kind = _check_kind(kind)
-    dW, areas = brownian_increments_and_areas(rng, t.size - 1, np.diff(t), dim, batch_shape=batch_shape,
-                                              levy_area=levy_area, substeps=substeps, kind=kind)
-    if x0 is None:
-        z = np.zeros(batch_shape + (dim,))
-    else:
-        z = as_float_array(x0, "x0", last_dims=(dim,))
-        try:
-            z = np.array(np.broadcast_to(z, batch_shape + (dim,)))
-        except ValueError:
-            raise ValueError(f"x0 of shape {z.shape} does not broadcast to the batch shape "
-                             f"{batch_shape} + (d={dim},).") from None
-    rp_kind = None if areas is None else ("geometric" if kind == "stratonovich" else "ito")
-    return RoughPath(dW, areas, times=t, x0=z, kind=rp_kind, check=False)
+    seed = _seed_from_rng(rng)
+    return BrownianDriver(dim, seed=seed, times=times, batch_shape=batch_shape, kind=kind, levy_area=levy_area,
+                          substeps=substeps, x0=x0).rough_path()
 
 
 # ---------------------------------------------------------------------------- refinement
@@ -387,7 +356,8 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     factor : int
         Substeps per step, ``>= 1`` (``1`` returns ``X`` unchanged).
     rng : numpy.random.Generator
-        Source of randomness.
+        Source of randomness, drawn from directly (not the driver's per-path streams: the
+        refined path depends on the whole batch and on ``factor``'s sequence of splits).
 
     Returns
     -------
@@ -478,3 +448,173 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
         fine_h = np.diff(fine_t)
         areas[..., np.arange(d), np.arange(d)] -= 0.5 * fine_h[:, None]
     return RoughPath(dw, areas, times=fine_t, x0=X.x0, kind=X.kind, check=False)
+
+
+# ---------------------------------------------------------------------------- the driver
+_BLOCK_BYTES = 2 << 20
+# tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
+_EXACT_T1 = (np.pi ** 2 / 6 - sum(1.0 / k ** 2 for k in range(1, _EXACT_TERMS + 1))) / (2 * np.pi ** 2)
+_EXACT_T2 = (np.pi ** 4 / 90 - sum(1.0 / k ** 4 for k in range(1, _EXACT_TERMS + 1))) / (4 * np.pi ** 4)
+
+
+class BrownianDriver(SeededDriver):
+    r"""Brownian motion lifted to a level-2 rough path, generated lazily in time blocks, per-path seeded.
+
+    :func:`roughpaths.solve` consumes it exactly like the ``RoughPath`` that :meth:`rough_path`
+    returns, one block of ``~block_bytes`` at a time. The areas are sampled as documented in this
+    module (``levy_area`` and ``substeps``; ``None`` gives a level-1 driver).
+
+    Parameters
+    ----------
+    dim : int
+        Dimension ``d >= 1``.
+    seed : int or numpy.random.SeedSequence
+        Root of the random streams (see *Stream* below). A ``Generator`` is refused: its state
+        would make the paths depend on earlier draws.
+    times : array_like, shape ``(N + 1,)``, optional
+        Strictly increasing grid (non-uniform allowed). Or give ``dt`` and ``n_steps``.
+    dt : float, optional
+        Uniform step (grid ``t0 + dt * arange(n_steps + 1)``).
+    n_steps : int, optional
+        Number of uniform steps.
+    t0 : float
+        Start of the uniform grid (default 0).
+    batch_shape : tuple of int
+        Independent paths, default ``()``; path ``i`` is the ``i``-th in C order of the batch.
+    levy_area : {"davie", "foster", "exact"} or None
+        Area method (default ``"davie"``, exact second moments); ``"exact"``: the exact law given
+        the increment, ``d = 2`` only (module docstring). ``None``: increments only (``level == 1``).
+    substeps : int
+        Substeps ``m`` per step of the area sampler, default :data:`DEFAULT_SUBSTEPS` ``= 1``
+        (Davie's own method). Larger ``m`` lowers the L² error (``h/√(6m)`` for davie,
+        ``h/√(12m)`` for foster) at ``~2 m d`` more normals per step.
+    kind : {"stratonovich", "ito"}
+        Stratonovich (``RoughPath.kind == "geometric"``) or Itô areas.
+    x0 : array_like, shape ``(d,)`` or ``(*batch_shape, d)``, optional
+        Starting point (default 0).
+    block_bytes : int
+        Target memory of one block (increments, areas and random buffers), default 2 MiB (at
+        least one step per block); it sets the default of :meth:`blocks`, never the numbers.
+        Measured (1000 paths x 1000 steps, d = 3): 1-2 MiB blocks, which stay in cache while a
+        solver consumes them, sample 10-25 % faster than 32 MiB blocks.
+
+    Notes
+    -----
+    **Stream.** Let ``S = SeedSequence(seed)`` (or the given one) and ``i`` the flat index of a
+    path in ``batch_shape`` (C order). Path ``i`` uses two independent standard-normal streams,
+
+    * increments: ``Generator(PCG64(SeedSequence(S.entropy, spawn_key=S.spawn_key + (i, 0))))``;
+      step ``k`` takes the next ``d`` normals, times ``√h_k``;
+    * areas: the same with ``spawn_key=S.spawn_key + (i, 1)``; step ``k`` takes the next
+      ``(m d if m > 1) + m d + (d(d-1)/2 if davie)`` normals: the bridge normals, the
+      space-time normals and Davie's normals, in this order (see
+      :mod:`roughpaths._brownian_kernels`); for ``"exact"`` a variable number, in the order
+      documented in ``_brownian_kernels._exact_areas_d2``.
+
+    So a path's numbers depend only on ``seed``, ``i``, and (for the areas) ``levy_area`` and
+    ``substeps``: not on the block size, on which paths are generated together (:meth:`select`),
+    on the executor or process, nor on ``kind``; the increments do not depend on ``levy_area``
+    or ``substeps`` either. The normals are numpy's, bit for bit (numpy's ziggurat over
+    ``PCG64``), generated by a numba kernel over all paths (:mod:`roughpaths._random`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> drv = BrownianDriver(2, seed=7, dt=0.01, n_steps=100, batch_shape=(4,))
+    >>> drv.n_steps, drv.batch_shape, drv.level
+    (100, (4,), 2)
+    >>> X = drv.rough_path()
+    >>> blocks = list(drv.blocks(max_steps=30))
+    >>> [b.n_steps for b in blocks]
+    [30, 30, 30, 10]
+    >>> bool(np.array_equal(np.concatenate([b.areas for b in blocks], axis=1), X.areas))
+    True
+    >>> bool(np.array_equal(drv.select([1, 3]).rough_path().increments, X.increments[[1, 3]]))
+    True
+    """
+
+    def __init__(self, dim, *, seed, times=None, dt=None, n_steps=None, t0=0.0, batch_shape=(),
+                 levy_area="davie", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES):
+        self._init_common(dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes)
+        self.levy_area = _check_levy_method(levy_area)
+        self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
+        if self.levy_area == "exact":
+            if self.dim != 2:
+                raise ValueError(f"levy_area='exact' is available for dim=2 only, got dim={self.dim}; use "
+                                 f"levy_area='davie' (exact second moments) for d > 2.")
+            if self.substeps != 1:
+                raise ValueError(f"substeps={self.substeps} has no effect with levy_area='exact' (the area is "
+                                 f"exact in law); leave substeps at its default.")
+        self.kind = _check_kind(kind)
+        self.level = 1 if self.levy_area is None else 2
+        self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
+
+    def _starts(self) -> dict:
+        return {"_x0": self.dim}
+
+    # ------------------------------------------------------------------ layout
+    @property
+    def _n_area_normals(self) -> int:
+        if self.levy_area in (None, "exact"):
+            return 0
+        d, m = self.dim, self.substeps
+        return (m * d if m > 1 else 0) + m * d + (d * (d - 1) // 2 if self.levy_area == "davie" else 0)
+
+    def _bytes_per_path_step(self) -> int:
+        d = self.dim
+        return 8 * (2 * d + (d * d + self._n_area_normals if self.level == 2 else 0))
+
+    def __repr__(self) -> str:
+        return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
+                f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
+
+    # ------------------------------------------------------------------ generation
+    def blocks(self, max_steps=None):
+        """Yield consecutive ``RoughPath`` blocks of at most ``max_steps`` steps covering the grid.
+
+        The numbers do not depend on ``max_steps`` (see *Stream*); default
+        :meth:`default_block_steps`. Each call starts the streams afresh.
+        """
+        K = self._block_size(max_steps)
+        N, d, P = self.n_steps, self.dim, self.n_paths
+        ss = self.seed_sequence
+        keys = np.zeros((P, 2), dtype=np.int64)
+        keys[:, 0] = self.path_indices
+        inc_streams = PathStreams(ss, keys)
+        area_streams = None
+        na = self._n_area_normals
+        if self.level == 2:
+            keys = keys.copy()
+            keys[:, 1] = 1
+            area_streams = PathStreams(ss, keys)
+        rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
+        h_all = self._h
+        x = np.array(self._flat(self._x0, d))
+        zbuf = np.empty(P * min(K, N) * max(na, 1)) if self.level == 2 else None
+        davie = self.levy_area == "davie" and d > 1
+        for k0 in range(0, N, K):
+            k1 = min(N, k0 + K)
+            k = k1 - k0
+            h = np.ascontiguousarray(h_all[k0:k1])
+            dW = np.empty((P, k, d))
+            inc_streams.fill(dW.reshape(P, k * d))
+            dW *= np.sqrt(h)[:, None]
+            areas = None
+            if self.levy_area == "exact":
+                if area_streams.states is None:  # pragma: no cover - only if numpy's algorithms change
+                    raise RuntimeError("levy_area='exact' needs the numba PCG64 streams, whose self-check "
+                                       "against numpy failed in this process; use levy_area='davie'.")
+                areas = np.empty((P, k, d, d))
+                _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
+                                self.kind == "ito", areas)
+            elif self.level == 2:
+                z = zbuf[:P * k * na].reshape(P, k * na)
+                area_streams.fill(z)
+                areas = np.empty((P, k, d, d))
+                _block_areas(dW, h, z.reshape(P, k, na), self.substeps, davie, self.kind == "ito", areas)
+            x0 = x.reshape(self.batch_shape + (d,))
+            block = RoughPath(dW.reshape(self.batch_shape + (k, d)),
+                              None if areas is None else areas.reshape(self.batch_shape + (k, d, d)),
+                              times=self.times[k0:k1 + 1], x0=x0.copy(), kind=rp_kind, check=False)
+            x += dW.sum(axis=1)
+            yield block

@@ -150,19 +150,19 @@ def test_array_dt_matches_scalar_dt():
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
 
 
-def test_chunked_sampling_matches_law(monkeypatch):
-    import roughpaths.brownian as bm
-    monkeypatch.setattr(bm, "_CHUNK_FLOATS", 1000)     # many chunks
+def test_small_blocks_sample_the_same_law():
+    from roughpaths import BrownianDriver
     h, n = 0.3, 30000
-    dW, XX = bm.brownian_increments_and_areas(np.random.default_rng(6), 2, h, 2, batch_shape=(n // 2,))
-    a = _levy(XX)[..., 0, 1].ravel()
+    drv = BrownianDriver(2, seed=6, dt=h, n_steps=2, batch_shape=(n // 2,), block_bytes=1000)   # many blocks
+    a = np.concatenate([_levy(b.areas)[..., 0, 1] for b in drv.blocks()], axis=-1).ravel()
     assert _within(np.mean(a * a), h * h / 4, np.std(a * a) / np.sqrt(n))
 
 
 # ----------------------------------------------------------------------------- bad input
 @pytest.mark.parametrize("call, exc, word", [
     (lambda: brownian_increments_and_areas(np.random.RandomState(0), 2, 0.1, 2), TypeError, "rng"),
-    (lambda: brownian_increments_and_areas(0, 2, 0.1, 2), TypeError, "rng"),
+    (lambda: brownian_increments_and_areas(None, 2, 0.1, 2), TypeError, "rng"),
+    (lambda: brownian_increments_and_areas(0.5, 2, 0.1, 2), TypeError, "rng"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.0, 2), ValueError, "dt"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, -1.0, 2), ValueError, "dt"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, [0.1, 0.1, 0.1], 2), ValueError, "dt"),
@@ -171,7 +171,7 @@ def test_chunked_sampling_matches_law(monkeypatch):
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 0), ValueError, "dim"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2.0), TypeError, "dim"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, substeps=0), ValueError, "substeps"),
-    (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, levy_area="exact"), ValueError, "levy_area"),
+    (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, levy_area="nonsense"), ValueError, "levy_area"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, kind="strat"), ValueError, "kind"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, batch_shape=(-1,)), ValueError, "batch_shape"),
     (lambda: brownian_rough_path([0.0, 0.5, 0.5], 2, np.random.default_rng()), ValueError, "times"),

@@ -10,8 +10,8 @@ Claims tested:
   approximation has per-component L² error :math:`h\sqrt{(1/m - 1/M)/12}` (i.e. ``h/sqrt(12 m)``
   against the true area), fitted order ``-1/2`` in ``m``; dropping the cross term fails;
 * the public sampler's variances: ``foster`` gives :math:`h^2/4 - h^2/(12m)`, ``davie`` :math:`h^2/4`.
-* the fused numba sampler consumes the seed's normals in the documented order and equals a naive
-  per-step reimplementation to round-off.
+(The draw order and the kernel against a naive per-step reimplementation:
+``tests/test_brownian_driver_stream.py``.)
 """
 
 import iisignature
@@ -92,59 +92,3 @@ def test_public_sampler_variances(m):
     assert abs(v - (h * h / 4 - h * h / (12 * m))) < 5 * se
     v, se = out["davie"]
     assert abs(v - h * h / 4) < 5 * se
-
-
-def _naive_sampler(seed, n_steps, h, d, batch, m, method, kind, chunk_floats):
-    """Independent reimplementation of the documented draw order, one step at a time.
-
-    Increments ``(batch, N, d)`` first; then, per chunk of ``chunk_floats // (4md + d²)`` steps
-    (rows in C order), the bridge normals ``(c, m, d)`` (if ``m > 1``), the space-time normals
-    ``(c, m, d)`` and, for Davie, ``(c, d(d-1)/2)`` normals.
-    """
-    rng = np.random.default_rng(seed)
-    dW = rng.standard_normal((batch, n_steps, d)) * np.sqrt(h)
-    rows = dW.reshape(-1, d)
-    R, P = rows.shape[0], d * (d - 1) // 2
-    chunk = max(1, chunk_floats // (m * d * 4 + d * d))
-    out = np.empty((R, d, d))
-    for lo in range(0, R, chunk):
-        n = min(R, lo + chunk) - lo
-        z = rng.standard_normal((n, m, d)) if m > 1 else None
-        zeta = rng.standard_normal((n, m, d))
-        lam = rng.standard_normal((n, P)) if method == "davie" and P else None
-        for r in range(n):
-            W, delta = rows[lo + r], h / m
-            if m > 1:
-                w = np.sqrt(delta) * (z[r] - z[r].mean(axis=0)) + W / m
-            else:
-                w = W[None]
-            A = _naive(w, np.sqrt(delta / 12) * zeta[r])
-            if lam is not None:
-                iu = np.triu_indices(d, 1)
-                A[iu] += lam[r] * h / np.sqrt(12 * m)
-                A[iu[1], iu[0]] -= lam[r] * h / np.sqrt(12 * m)
-            out[lo + r] = A + 0.5 * np.outer(W, W) - (0.5 * h * np.eye(d) if kind == "ito" else 0)
-    return dW, out.reshape(batch, n_steps, d, d)
-
-
-@pytest.mark.parametrize("d, m, method, kind, chunk_floats", [
-    (1, 3, "davie", "stratonovich", 1 << 22),
-    (2, 1, "davie", "ito", 1 << 22),
-    (2, 8, "foster", "stratonovich", 1 << 22),
-    (3, 8, "davie", "stratonovich", 1000),       # several chunks
-    (4, 2, "davie", "ito", 300),
-])
-def test_fused_kernel_matches_naive_sampler_same_seed(monkeypatch, d, m, method, kind, chunk_floats):
-    """Same seed, same draws in the same order: equal increments, areas equal to round-off."""
-    import roughpaths.brownian as bm
-    monkeypatch.setattr(bm, "_CHUNK_FLOATS", chunk_floats)
-    h, N, batch = 0.05, 6, 9
-    dW, XX = bm.brownian_increments_and_areas(np.random.default_rng(42), N, h, d, batch_shape=(batch,),
-                                              levy_area=method, substeps=m, kind=kind)
-    dW0, XX0 = _naive_sampler(42, N, h, d, batch, m, method, kind, chunk_floats)
-    assert np.array_equal(dW, dW0)
-    np.testing.assert_allclose(XX, XX0, rtol=0, atol=1e-15)
-    # the check can fail: a transposed area or the other seed is far off
-    assert np.abs(np.swapaxes(XX, -1, -2) - XX0).max() > 1e-3 or d == 1
-    _, XX1 = _naive_sampler(43, N, h, d, batch, m, method, kind, chunk_floats)
-    assert np.abs(XX - XX1).max() > 1e-3

@@ -123,7 +123,7 @@ def test_bad_drivers_and_shapes(rng):
     ito = RoughPath(X.increments, X.areas - 0.05 * np.eye(3), times=X.times, kind="ito")
     with pytest.raises(ValueError, match="geometric"):
         simulate(rb, [0, 0, 1.0], ito)
-    with pytest.raises(ValueError, match="dimension 2"):
+    with pytest.raises(ValueError, match="dimension d=2"):
         simulate(rb, [0, 0, 1.0], RoughPath.from_path(vals[:, :2]))
     with pytest.raises(ValueError, match="mu0 must have trailing shape"):
         simulate(rb, [0, 1.0], X)
@@ -145,3 +145,37 @@ def test_bad_drivers_and_shapes(rng):
         simulate_brownian(rb, [0, np.nan, 1.0], 0.01, 10, rng)
     with pytest.raises(ValueError, match="broadcast"):
         simulate(rb, np.ones((4, 3)), RoughPath.from_path(np.stack([vals, vals, vals])))
+
+
+def test_solver_contract_of_the_coadjoint_schemes():
+    """The coadjoint schemes are roughpaths.Solver instances with declared levels and orders; classes
+    are refused everywhere; wrong fields or drivers are refused with the fix in the message."""
+    from roughpaths import BrownianDriver, Davie, LinearVectorFields, Solver, solve
+
+    from mechanics.ensemble import run_ensemble
+    from mechanics.integrators import LieEuler
+
+    for cls in (LieEuler, LieHeun, ImplicitMidpoint):
+        s = cls()
+        assert isinstance(s, Solver) and s.preserves == ("casimirs",) and s.calculus == "stratonovich"
+        assert (s.increment_level, s.order) == (2, 1.0)
+        assert (cls(levy_area=False).increment_level, cls(levy_area=False).order) == (1, 0.5)
+    assert (LieEuler.smooth_order, LieHeun.smooth_order, ImplicitMidpoint.smooth_order) == (1.0, 2.0, 2.0)
+    rb = rigid_body(I3, sigma=0.1)
+    X = BrownianDriver(3, seed=0, dt=0.01, n_steps=5)
+    with pytest.raises(TypeError, match=r"did you mean LieHeun\(\)"):
+        solve(rb, X, [0, 0, 1.0], LieHeun)
+    with pytest.raises(TypeError, match=r"did you mean LieHeun\(\)"):
+        run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=5, n_paths=2, seed=0, method=LieHeun)
+    with pytest.raises(TypeError, match=r"did you mean LieHeun\(\)"):
+        simulate(rb, [0, 0, 1.0], X.rough_path(), LieHeun)
+    with pytest.raises(TypeError, match="LiePoissonSystem"):
+        solve(LinearVectorFields(np.zeros((3, 3, 3))), X, np.ones(3), LieHeun())
+    with pytest.raises(TypeError, match="coadjoint solver"):
+        solve(rb, X, [0, 0, 1.0], Davie())
+    with pytest.raises(ValueError, match=r"levy_area=False"):
+        solve(rb, BrownianDriver(3, seed=0, dt=0.01, n_steps=5, levy_area=None), [0, 0, 1.0], LieHeun())
+    with pytest.raises(ValueError, match=r"to_level1"):
+        solve(rb, X, [0, 0, 1.0], LieHeun(levy_area=False))
+    with pytest.raises(TypeError, match="levy_area"):
+        LieHeun(levy_area="yes")

@@ -24,7 +24,7 @@ from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate
 from mechanics.lie_algebra import sl2r, so3
 from mechanics.lie_poisson import LiePoissonSystem
 from mechanics.rigid_body import rigid_body
-from roughpaths import RoughPath
+from roughpaths import RoughPath, solve
 
 S = np.array([[0.0, 1.5, -2.0], [-1.5, 0.0, 0.7], [2.0, -0.7, 0.0]])
 
@@ -45,10 +45,10 @@ def test_integrators_perturbed_path_equals_corrected_system(method, algebra, rng
     plain = LiePoissonSystem(algebra(), np.diag([1.0, 2.0, 3.0]), xi)
     corrected = plain.with_s(S)
     mu0 = scale * rng.standard_normal(3)
-    _, a = simulate(plain, mu0, X.perturb(S), method)
-    _, b = simulate(corrected, mu0, X, method)
+    a = solve(plain, X.perturb(S), mu0, method).states
+    b = solve(corrected, X, mu0, method).states
     np.testing.assert_allclose(a, b, atol=1e-12)
-    _, c = simulate(plain, mu0, X, method)          # without the correction: genuinely different
+    c = solve(plain, X, mu0, method).states          # without the correction: genuinely different
     assert np.max(np.abs(c - b)) > 1e-3 * scale
 
 
@@ -93,7 +93,7 @@ def test_coadjoint_scheme_agrees_with_generic_solver(rng):
     rb0 = rigid_body([1.0, 2.0, 3.0], sigma=0.7)
     mu0 = np.array([0.0, 0.6, 0.8])
     a = solve_mod.solve(rb0.vector_fields(), X.perturb(S), mu0, solvers.Davie()).final
-    _, b = simulate(rb0.with_s(S), mu0, X, LieHeun(), save_every=4000)
+    b = solve(rb0.with_s(S), X, mu0, LieHeun(), save_at=X.times[::4000]).states
     _, c = simulate(rigid_body([1.0, 2.0, 3.0], sigma=0.7, s=S, convention="paper"), mu0, X, LieHeun(),
                     save_every=4000)
     err, wrong = np.max(np.abs(a - b[:, -1])), np.max(np.abs(a - c[:, -1]))
@@ -105,8 +105,8 @@ def test_dissipative_models_differ(rng):
     """With θ > 0: driving the h-dissipated body by X̃ is not the h̃-dissipated body on X (Theorem 3.1's model)."""
     X = _driver(rng)
     rb0 = rigid_body([1.0, 2.0, 3.0], sigma=0.7, theta=1.0)
-    _, a = simulate(rb0, [0.0, 0.6, 0.8], X.perturb(S), LieHeun())
-    _, b = simulate(rb0.with_s(S), [0.0, 0.6, 0.8], X, LieHeun())
+    a = solve(rb0, X.perturb(S), [0.0, 0.6, 0.8], LieHeun()).states
+    b = solve(rb0.with_s(S), X, [0.0, 0.6, 0.8], LieHeun()).states
     assert np.max(np.abs(a - b)) > 1e-4
 
 
@@ -120,12 +120,12 @@ def test_dissipative_perturbed_path_equals_conservative_torque_system(method, al
     plain = LiePoissonSystem(algebra(), np.diag([1.0, 2.0, 3.0]), xi, theta=0.8)
     limit = LiePoissonSystem(algebra(), np.diag([1.0, 2.0, 3.0]), xi, s=S, theta=0.8, levy_in_dissipation=False)
     mu0 = scale * rng.standard_normal(3)
-    _, a = simulate(plain, mu0, X.perturb(S), method)
-    _, b = simulate(limit, mu0, X, method)
+    a = solve(plain, X.perturb(S), mu0, method).states
+    b = solve(limit, X, mu0, method).states
     np.testing.assert_allclose(a, b, atol=1e-12)
-    _, c = simulate(plain.with_s(S), mu0, X, method)                   # Theorem 3.1's model (h̃ dissipation)
+    c = solve(plain.with_s(S), X, mu0, method).states            # Theorem 3.1's model (h̃ dissipation)
     assert np.max(np.abs(c - b)) > 1e-3 * scale
-    _, d = simulate(limit.with_s(S), mu0, X, method)                   # with_s keeps the option
+    d = solve(limit.with_s(S), X, mu0, method).states                   # with_s keeps the option
     np.testing.assert_array_equal(d, b)
 
 

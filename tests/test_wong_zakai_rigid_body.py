@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_coloured_noise
-from mechanics.wong_zakai import (integrate_rigid_body, levy_torque, rigid_body_wong_zakai_limit,
+from mechanics.lie_poisson import levy_velocity
+from mechanics.wong_zakai import (integrate_rigid_body, rigid_body_wong_zakai_limit,
                                   simulate_wong_zakai_rigid_body)
 
 A, D = paper_coloured_noise_matrices(k=0.5)
@@ -30,16 +31,16 @@ def test_torque_mapping():
     N = wz.limit.N
     assert np.allclose(wz.torque, SIGMA ** 2 * np.array([N[1, 2], -N[0, 2], N[0, 1]]))
     assert np.allclose(wz.torque, [0.0, -SIGMA ** 2 / (2 * 0.5 * 1.25), 0.0])
-    assert np.allclose(levy_torque(wz.perturbation_B, wz.limit_xi), wz.torque)          # B coordinates
+    assert np.allclose(levy_velocity(wz.perturbation_B, wz.limit_xi), wz.torque)          # B coordinates
     assert np.allclose(wz.limit_xi, SIGMA * wz.limit.M.T)
     # the paper's 2N would double it
-    assert np.allclose(levy_torque(wz.limit.unnormalised_area_rate, wz.coloured_xi), 2 * wz.torque)
+    assert np.allclose(levy_velocity(wz.limit.unnormalised_area_rate, wz.coloured_xi), 2 * wz.torque)
     try:
         from mechanics.rigid_body import rigid_body
     except ImportError:  # pragma: no cover - the mechanics core is built in parallel
         return
     rb = rigid_body([1.0, 2.0, 3.0], xi=wz.limit_xi, s=wz.perturbation_B, theta=1.0)
-    assert np.allclose(rb.levy_torque_vector, wz.torque)
+    assert np.allclose(rb.levy_velocity, wz.torque)
 
 
 def test_limit_in_both_coordinates_agree(rng):

@@ -17,8 +17,9 @@ import numpy as np
 
 from mechanics.equilibria import rigid_body_equilibria
 from mechanics.gibbs import GibbsMeasure
-from mechanics.integrators import LieHeun, simulate, simulate_brownian
+from mechanics.integrators import LieHeun
 from mechanics.rigid_body import rigid_body
+from roughpaths import BrownianDriver, solve
 from roughpaths.brownian import brownian_rough_path
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")
@@ -32,8 +33,8 @@ s[0, 2], s[2, 0] = 25.0, -25.0                     # the paper's s13 = 25
 
 # %%
 body = rigid_body(inertia, sigma=sigma, s=s, theta=theta)
-print("Lévy torque c = ½ Σ s^{ij} ξ_i × ξ_j =", body.levy_torque_vector)
-assert np.allclose(body.levy_torque_vector, sigma**2 * np.array([s[1, 2], -s[0, 2], s[0, 1]]))
+print("Lévy torque c = ½ Σ s^{ij} ξ_i × ξ_j =", body.levy_velocity)
+assert np.allclose(body.levy_velocity, sigma**2 * np.array([s[1, 2], -s[0, 2], s[0, 1]]))
 print("h̃ at the north pole:", float(body.modified_energy([0.0, 0.0, 1.0])))
 
 # %% [markdown]
@@ -42,19 +43,22 @@ print("h̃ at the north pole:", float(body.modified_energy([0.0, 0.0, 1.0])))
 # `(𝕀⁻¹ − λ) Π = −c`, `|Π| = 1` (the paper's sentence "(0, 3σ²s13, …)" is not it).
 
 # %%
-eqs = rigid_body_equilibria(inertia, body.levy_torque_vector, theta=theta)
+eqs = rigid_body_equilibria(inertia, body.levy_velocity, theta=theta)
 for eq in eqs:
     print(eq)
 north = min((q for q in eqs if q.kind == "minimum" and q.point[2] > 0), key=lambda q: -q.point[2])
 
 # %% [markdown]
 # ## 3. Simulate: Casimir-preserving coadjoint scheme, Brownian motion with its Lévy areas
-# `simulate_brownian` streams Stratonovich Brownian increments and step Lévy areas; the coadjoint
-# update keeps `|Π| = 1` to round-off.
+# `roughpaths.solve` integrates the Lie–Poisson system with the coadjoint Lie–Heun solver on a
+# `BrownianDriver` (Stratonovich Brownian increments and Davie's step Lévy areas, generated block by
+# block, path `i` seeded by `(seed, i)`); the coadjoint update keeps `|Π| = 1` to round-off.
 
 # %%
 P, T, dt = (8, 60.0, 0.01) if SMALL else (64, 300.0, 0.005)
-times, Pi = simulate_brownian(body, [0.0, 0.0, 1.0], dt, int(T / dt), rng, n_paths=P, save_every=10)
+driver = BrownianDriver(3, seed=3, dt=dt, n_steps=int(T / dt), batch_shape=(P,))
+sol = solve(body, driver, [0.0, 0.0, 1.0], LieHeun(), save_at=driver.times[::10])
+times, Pi = sol.times, sol.states
 print("max ||Π| − 1| over all paths and times:", np.max(np.abs(np.linalg.norm(Pi, axis=-1) - 1)))
 assert np.max(np.abs(np.linalg.norm(Pi, axis=-1) - 1)) < 1e-12
 burn = times >= 30.0
@@ -67,7 +71,7 @@ mean, se = path_means.mean(axis=0), path_means.std(axis=0, ddof=1) / np.sqrt(P)
 # so we compare with the Gibbs mean conditioned on `Π3 > 0`.
 
 # %%
-g = GibbsMeasure(inertia, body.levy_torque_vector, sigma=sigma, theta=theta)
+g = GibbsMeasure(inertia, body.levy_velocity, sigma=sigma, theta=theta)
 f = lambda x: np.concatenate([x * (x[..., 2:3] > 0), (x[..., 2:3] > 0) * 1.0], axis=-1)
 e = g.expectation(f)
 gibbs_mean = e[:3] / e[3]
@@ -83,7 +87,7 @@ assert abs(mean[1]) > 0.3
 
 # %%
 X = brownian_rough_path(np.linspace(0.0, 5.0, 501), 3, rng, batch_shape=(4,))
-_, a = simulate(rigid_body(inertia, sigma=sigma, s=s), [0.0, 0.0, 1.0], X, LieHeun())
-_, b = simulate(rigid_body(inertia, sigma=sigma), [0.0, 0.0, 1.0], X.perturb(s), LieHeun())
+a = solve(rigid_body(inertia, sigma=sigma, s=s), X, [0.0, 0.0, 1.0], LieHeun()).states
+b = solve(rigid_body(inertia, sigma=sigma), X.perturb(s), [0.0, 0.0, 1.0], LieHeun()).states
 print("max |corrected(X) − plain(X.perturb(s))| =", np.max(np.abs(a - b)))
 assert np.max(np.abs(a - b)) < 1e-12

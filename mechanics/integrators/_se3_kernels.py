@@ -1,0 +1,188 @@
+r"""Compiled se(3) kernels of the explicit coadjoint solvers (quadratic Hamiltonian): an implementation detail.
+
+Selected by :meth:`~mechanics.integrators.base.CoadjointSolver.integrate` when the algebra is a
+:class:`~mechanics.lie_algebra.SE3Algebra` and the Hamiltonian is quadratic (the heavy top), for
+Lie–Euler and Lie–Heun. Same scheme as the numpy path; state ``μ = (Π, Γ)``, algebra element
+``σ = (ω, v)``, :math:`\mathrm{ad}^*_{(\omega,v)}(\Pi,\Gamma) = (\Pi\times\omega + \Gamma\times v,\ \Gamma\times\omega)`
+and the closed-form exponential of :func:`mechanics.lie_algebra.se3_ad_star_exp`
+(:math:`\Gamma' = T\Gamma`, :math:`\Pi' = T(\Pi - (Jv)\times\Gamma)`), with the one small-angle switch
+and Taylor coefficients of :mod:`mechanics.lie_algebra`. Members are independent (a loop over
+members, then over the block's steps); a member that becomes non-finite is marked by itself.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from ..lie_algebra import SMALL_ANGLE2, taylor_coefficients
+
+_taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
+
+
+@numba.njit(cache=True, inline="always")
+def _ad_star(x, mu, out):
+    """out = ad*_x mu on se(3)*: (Π×ω + Γ×v, Γ×ω), x = (ω, v), mu = (Π, Γ)."""
+    w0, w1, w2, v0, v1, v2 = x[0], x[1], x[2], x[3], x[4], x[5]
+    p0, p1, p2, g0, g1, g2 = mu[0], mu[1], mu[2], mu[3], mu[4], mu[5]
+    out[0] = p1 * w2 - p2 * w1 + g1 * v2 - g2 * v1
+    out[1] = p2 * w0 - p0 * w2 + g2 * v0 - g0 * v2
+    out[2] = p0 * w1 - p1 * w0 + g0 * v1 - g1 * v0
+    out[3] = g1 * w2 - g2 * w1
+    out[4] = g2 * w0 - g0 * w2
+    out[5] = g0 * w1 - g1 * w0
+
+
+@numba.njit(cache=True, inline="always")
+def _velocity(mu, q, lin, f, minv, theta, g, t1, t2, out):
+    """out = w(mu) = g + theta M⁻¹ ad*_{g+f} mu, g = Q mu + lin (buffers g, t1, t2 of length 6)."""
+    for i in range(6):
+        acc = lin[i]
+        for j in range(6):
+            acc += q[i, j] * mu[j]
+        g[i] = acc
+    if theta == 0.0:
+        for i in range(6):
+            out[i] = g[i]
+        return
+    for i in range(6):
+        t1[i] = g[i] + f[i]
+    _ad_star(t1, mu, t2)
+    for i in range(6):
+        acc = 0.0
+        for j in range(6):
+            acc += minv[i, j] * t2[j]
+        out[i] = g[i] + theta * acc
+
+
+@numba.njit(cache=True, inline="always")
+def _rot(w0, w1, w2, a, b, x0, x1, x2):
+    # x - a ω×x + b ω×(ω×x)
+    c0 = w1 * x2 - w2 * x1
+    c1 = w2 * x0 - w0 * x2
+    c2 = w0 * x1 - w1 * x0
+    d0 = w1 * c2 - w2 * c1
+    d1 = w2 * c0 - w0 * c2
+    d2 = w0 * c1 - w1 * c0
+    return x0 - a * c0 + b * d0, x1 - a * c1 + b * d1, x2 - a * c2 + b * d2
+
+
+@numba.njit(cache=True, inline="always")
+def _exp(s, mu, out):
+    """out = exp(ad*_s) mu on se(3)* (closed form, one small-angle switch)."""
+    w0, w1, w2, v0, v1, v2 = s[0], s[1], s[2], s[3], s[4], s[5]
+    t2 = w0 * w0 + w1 * w1 + w2 * w2
+    if t2 < SMALL_ANGLE2:
+        a, b, c = _taylor(t2)
+    else:
+        t = math.sqrt(t2)
+        sn = math.sin(t)
+        a = sn / t
+        h = math.sin(0.5 * t)
+        b = 2.0 * h * h / t2
+        c = (t - sn) / (t2 * t)
+    # J v = v + b ω×v + c ω×(ω×v)
+    c0 = w1 * v2 - w2 * v1
+    c1 = w2 * v0 - w0 * v2
+    c2 = w0 * v1 - w1 * v0
+    j0 = v0 + b * c0 + c * (w1 * c2 - w2 * c1)
+    j1 = v1 + b * c1 + c * (w2 * c0 - w0 * c2)
+    j2 = v2 + b * c2 + c * (w0 * c1 - w1 * c0)
+    g0, g1, g2 = mu[3], mu[4], mu[5]
+    p0 = mu[0] - (j1 * g2 - j2 * g1)
+    p1 = mu[1] - (j2 * g0 - j0 * g2)
+    p2 = mu[2] - (j0 * g1 - j1 * g0)
+    out[0], out[1], out[2] = _rot(w0, w1, w2, a, b, p0, p1, p2)
+    out[3], out[4], out[5] = _rot(w0, w1, w2, a, b, g0, g1, g2)
+
+
+@numba.njit(cache=True)
+def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, stop):
+    """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
+    (code 0) or Lie–Heun (code 1). Returns the number of members that failed."""
+    nb, nk, nm = dX.shape
+    area = dXX.shape[0] > 0
+    mu = np.empty(6)
+    e = np.empty(6)
+    w0 = np.empty(6)
+    w1 = np.empty(6)
+    s = np.empty(6)
+    a1 = np.empty(6)
+    a2 = np.empty(6)
+    pred = np.empty(6)
+    g = np.empty(6)
+    t1 = np.empty(6)
+    t2 = np.empty(6)
+    new = np.empty(6)
+    nfail = 0
+    for p in range(nb):
+        for i in range(6):
+            mu[i] = y[p, i]
+        slot = 0
+        for k in range(nk):
+            dt = dts[k]
+            for i in range(6):
+                acc = 0.0
+                for r in range(nm):
+                    acc += dX[p, k, r] * xi[r, i]
+                e[i] = acc
+            if area:
+                for r in range(pi.shape[0]):
+                    aij = 0.5 * (dXX[p, k, pi[r], pj[r]] - dXX[p, k, pj[r], pi[r]])
+                    for i in range(6):
+                        e[i] += aij * brk[r, i]
+            _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
+            for i in range(6):
+                s[i] = w0[i] * dt + e[i]
+            if code == 1:
+                _ad_star(s, mu, a1)
+                _ad_star(s, a1, a2)
+                for i in range(6):
+                    pred[i] = mu[i] + a1[i] + 0.5 * a2[i]
+                _velocity(pred, q, lin, f, minv, theta, g, t1, t2, w1)
+                for i in range(6):
+                    s[i] = 0.5 * (w0[i] + w1[i]) * dt + e[i]
+            _exp(s, mu, new)
+            finite = True
+            for i in range(6):
+                mu[i] = new[i]
+                if not math.isfinite(new[i]):
+                    finite = False
+            if not finite:
+                for i in range(6):
+                    mu[i] = np.nan
+                if first_bad[p] < 0:
+                    first_bad[p] = k
+                    nfail += 1
+            if save[k]:
+                for i in range(6):
+                    out[p, slot, i] = mu[i]
+                slot += 1
+            if stop and not finite:
+                break
+        for i in range(6):
+            y[p, i] = mu[i]
+    return nfail
+
+
+def integrate_se3(system, code, y, dX, dXX, dts, save, stop_on_failure):
+    """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
+
+    Returns ``(y, saved (B, S, 6), first_bad (B,))``.
+    """
+    data = system.quadratic_velocity_data()
+    nb = y.shape[0]
+    nm = dX.shape[-1]
+    pi, pj = np.triu_indices(nm, 1)
+    brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
+    y = np.array(y, dtype=np.float64, order="C")
+    out = np.full((nb, int(np.count_nonzero(save)), 6), np.nan)
+    first_bad = np.full(nb, -1, dtype=np.int64)
+    _se3_block(y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
+               pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64), int(code),
+               data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
+               data["metric_inv"], float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out, first_bad,
+               bool(stop_on_failure))
+    return y, out, first_bad

@@ -1,0 +1,344 @@
+r"""Compiled so(3) kernels of the coadjoint solvers (quadratic Hamiltonian): an implementation detail.
+
+:class:`~mechanics.integrators.base.CoadjointSolver.integrate` selects them when the system's algebra
+is a :class:`~mechanics.lie_algebra.SO3Algebra` and its Hamiltonian is quadratic; they compute the
+same scheme as the numpy path (:mod:`mechanics.integrators.base`), not bit for bit.
+
+Layout: the state lives in three contiguous rows ``m[0], m[1], m[2]`` (one entry per batch member)
+and every step is a loop over members whose body is pure arithmetic, so LLVM vectorises it (SIMD over
+members; no fast-math, so the vector and scalar loops round alike). All constants are unpacked into
+scalars before the loops. The Rodrigues factors use the Taylor branch (exact in float64 for
+``|sigma|² < 1e-2``, no trig); members whose ``|sigma|²`` exceeds it (or is not finite) keep their old
+state in the vector loop, are flagged, and are redone by the scalar exact step. Each member's result
+depends on its own data only, and a member that fails (non-finite, or a chord iteration that does
+not converge) is marked by itself; the others go on.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from ..lie_algebra import SMALL_ANGLE2, taylor_coefficients
+
+_taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
+
+# ---------------------------------------------------------------------- numba kernel (so(3), quadratic h)
+@numba.njit(cache=True, inline="always")
+def _rod(s0, s1, s2, m0, m1, m2):
+    # exp(ad*_s) m = m - a s×m + b s×(s×m), a = sin t / t, b = (1 - cos t)/t²
+    t2 = s0 * s0 + s1 * s1 + s2 * s2
+    if t2 < SMALL_ANGLE2:
+        a, b, _ = _taylor(t2)                # exact in float64 there; no transcendental calls
+    else:
+        t = math.sqrt(t2)
+        a = math.sin(t) / t
+        h = math.sin(0.5 * t)
+        b = 2.0 * h * h / t2
+    c0 = s1 * m2 - s2 * m1
+    c1 = s2 * m0 - s0 * m2
+    c2 = s0 * m1 - s1 * m0
+    d0 = s1 * c2 - s2 * c1
+    d1 = s2 * c0 - s0 * c2
+    d2 = s0 * c1 - s1 * c0
+    return m0 - a * c0 + b * d0, m1 - a * c1 + b * d1, m2 - a * c2 + b * d2
+
+
+@numba.njit(cache=True, inline="always")
+def _w3(q, lin, minv, theta, m0, m1, m2):
+    # lin (6,): lin[0:3] = b + shift (conservative gradient g = Q mu + lin[0:3]); lin[3:6] = the change of
+    # the gradient inside the double bracket, f = g + lin[3:6] (0, or -shift with levy_in_dissipation=False)
+    g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0]
+    g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1]
+    g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2]
+    if theta == 0.0:
+        return g0, g1, g2
+    f0, f1, f2 = g0 + lin[3], g1 + lin[4], g2 + lin[5]
+    # v = ad*_f mu = mu × f ; w = g + theta * Minv v
+    v0 = m1 * f2 - m2 * f1
+    v1 = m2 * f0 - m0 * f2
+    v2 = m0 * f1 - m1 * f0
+    return (g0 + theta * (minv[0, 0] * v0 + minv[0, 1] * v1 + minv[0, 2] * v2),
+            g1 + theta * (minv[1, 0] * v0 + minv[1, 1] * v1 + minv[1, 2] * v2),
+            g2 + theta * (minv[2, 0] * v0 + minv[2, 1] * v1 + minv[2, 2] * v2))
+
+
+@numba.njit(cache=True)
+def _so3_chord(m0, m1, m2, e0, e1, e2, s0, s1, s2, dt, q, lin, minv, theta, tol, max_iter):
+    """Chord iteration for the implicit midpoint sigma on so(3)*; returns sigma and a convergence flag."""
+    # chord Jacobian J = I - dt/2 Dw(mu) L(mu), L(mu) d = ad*_d mu = mu × d; g: the gradient inside
+    # the double bracket (see _w3 for the layout of lin)
+    g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0] + lin[3]
+    g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1] + lin[4]
+    g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2] + lin[5]
+    L = np.empty((3, 3))
+    L[0, 0], L[0, 1], L[0, 2] = 0.0, -m2, m1
+    L[1, 0], L[1, 1], L[1, 2] = m2, 0.0, -m0
+    L[2, 0], L[2, 1], L[2, 2] = -m1, m0, 0.0
+    Dw = q.copy()
+    if theta != 0.0:
+        # d(mu × g) = -hat(g) dmu + hat(mu) q dmu
+        A = np.empty((3, 3))
+        A[0, 0], A[0, 1], A[0, 2] = 0.0, g2, -g1
+        A[1, 0], A[1, 1], A[1, 2] = -g2, 0.0, g0
+        A[2, 0], A[2, 1], A[2, 2] = g1, -g0, 0.0
+        Dw = Dw + theta * (minv @ (A + L @ q))
+    Ji = np.linalg.inv(np.eye(3) - 0.5 * dt * (Dw @ L))
+    ok = False
+    for it in range(max_iter):
+        n0, n1, n2 = _rod(s0, s1, s2, m0, m1, m2)
+        u0, u1, u2 = _w3(q, lin, minv, theta, 0.5 * (m0 + n0), 0.5 * (m1 + n1), 0.5 * (m2 + n2))
+        r0 = s0 - u0 * dt - e0
+        r1 = s1 - u1 * dt - e1
+        r2 = s2 - u2 * dt - e2
+        d0 = Ji[0, 0] * r0 + Ji[0, 1] * r1 + Ji[0, 2] * r2
+        d1 = Ji[1, 0] * r0 + Ji[1, 1] * r1 + Ji[1, 2] * r2
+        d2 = Ji[2, 0] * r0 + Ji[2, 1] * r1 + Ji[2, 2] * r2
+        s0 -= d0
+        s1 -= d1
+        s2 -= d2
+        err = max(abs(d0), abs(d1), abs(d2))
+        if not (err == err):
+            break
+        if err <= tol * (1.0 + max(abs(s0), abs(s1), abs(s2))):
+            ok = True
+            break
+    return s0, s1, s2, ok
+
+
+@numba.njit(cache=True, inline="always")
+def _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_iter):
+    """One coadjoint step on so(3)*; returns the new state and a convergence flag."""
+    w0, w1, w2 = _w3(q, lin, minv, theta, m0, m1, m2)
+    s0, s1, s2 = w0 * dt + e0, w1 * dt + e1, w2 * dt + e2
+    if code == 1:
+        # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu (local error O(|s|³): enough for both orders)
+        c0 = m1 * s2 - m2 * s1
+        c1 = m2 * s0 - m0 * s2
+        c2 = m0 * s1 - m1 * s0
+        p0 = m0 + c0 + 0.5 * (c1 * s2 - c2 * s1)
+        p1 = m1 + c1 + 0.5 * (c2 * s0 - c0 * s2)
+        p2 = m2 + c2 + 0.5 * (c0 * s1 - c1 * s0)
+        v0, v1, v2 = _w3(q, lin, minv, theta, p0, p1, p2)
+        s0 = 0.5 * (w0 + v0) * dt + e0
+        s1 = 0.5 * (w1 + v1) * dt + e1
+        s2 = 0.5 * (w2 + v2) * dt + e2
+    elif code == 2:
+        s0, s1, s2, ok = _so3_chord(m0, m1, m2, e0, e1, e2, s0, s1, s2, dt, q, lin, minv, theta, tol, max_iter)
+        if not ok:
+            return m0, m1, m2, False
+    n0, n1, n2 = _rod(s0, s1, s2, m0, m1, m2)
+    return n0, n1, n2, True
+
+
+# Structure-of-arrays block kernels. The state lives in three contiguous rows m[0], m[1], m[2]
+# (one entry per path) and every step is a loop over paths whose body is pure arithmetic, so LLVM
+# vectorises it (SIMD over paths). All constants are unpacked into scalars before the loops (no
+# aliasing with the state rows, nothing recomputed per step). The Rodrigues factors use the Taylor
+# branch of `_rod` (exact in float64 for |sigma|² < 1e-2, no trig); paths whose |sigma|² exceeds it
+# keep their old state in the vector loop, are flagged, and are redone by the scalar exact step.
+_NCOEF = 30
+OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
+
+
+def coefficients(data):
+    """Flat float64 vector of the kernel constants from ``LiePoissonSystem.quadratic_velocity_data()``:
+    Q (9), b + shift (3), theta·M⁻¹ (9), dissipation change (3), spare."""
+    coef = np.zeros(_NCOEF)
+    coef[0:9] = data["q"].ravel()
+    coef[9:12] = data["linear"]
+    coef[12:21] = (data["theta"] * data["metric_inv"]).ravel()
+    coef[21:24] = data["dissipation_change"]
+    return coef
+
+
+@numba.njit(cache=True)
+def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k):
+    """Advance every member of ``m`` (3, B) by one coadjoint step with stochastic velocities ``e`` (3, B).
+
+    ``code`` 0 (Lie–Euler) and 1 (Lie–Heun) run the vectorised loop; 2 (implicit midpoint) the scalar
+    chord solve per member. A member that fails at this step (step index ``k``) is set to NaN and,
+    if it had not failed before, gets ``first_bad = k`` and ``reason`` (NON_FINITE or CHORD_FAILED).
+    Returns the number of members that failed for the first time at this step.
+    """
+    nb = m.shape[1]
+    ma, mb, mc = m[0], m[1], m[2]
+    ea, eb, ec = e[0], e[1], e[2]
+    nbad = 0
+    if code == 2:
+        for p in range(nb):
+            bad[p] = True
+        nbad = nb
+    else:
+        q00, q01, q02, q10, q11, q12, q20, q21, q22 = (coef[0], coef[1], coef[2], coef[3], coef[4], coef[5],
+                                                       coef[6], coef[7], coef[8])
+        l0, l1, l2 = coef[9], coef[10], coef[11]
+        f0, f1, f2 = coef[21], coef[22], coef[23]     # gradient change inside the double bracket
+        n00, n01, n02, n10, n11, n12, n20, n21, n22 = (coef[12], coef[13], coef[14], coef[15], coef[16],
+                                                       coef[17], coef[18], coef[19], coef[20])
+        hdt = 0.5 * dt
+        for p in range(nb):
+            m0 = ma[p]
+            m1 = mb[p]
+            m2 = mc[p]
+            e0 = ea[p]
+            e1 = eb[p]
+            e2 = ec[p]
+            # w(mu) = g + theta M⁻¹ (mu × (g + f)), g = Q mu + b + shift, f = shift_dissipation - shift
+            g0 = q00 * m0 + q01 * m1 + q02 * m2 + l0
+            g1 = q10 * m0 + q11 * m1 + q12 * m2 + l1
+            g2 = q20 * m0 + q21 * m1 + q22 * m2 + l2
+            v0 = m1 * (g2 + f2) - m2 * (g1 + f1)
+            v1 = m2 * (g0 + f0) - m0 * (g2 + f2)
+            v2 = m0 * (g1 + f1) - m1 * (g0 + f0)
+            w0 = g0 + n00 * v0 + n01 * v1 + n02 * v2
+            w1 = g1 + n10 * v0 + n11 * v1 + n12 * v2
+            w2 = g2 + n20 * v0 + n21 * v1 + n22 * v2
+            s0 = w0 * dt + e0
+            s1 = w1 * dt + e1
+            s2 = w2 * dt + e2
+            if code == 1:
+                # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
+                c0 = m1 * s2 - m2 * s1
+                c1 = m2 * s0 - m0 * s2
+                c2 = m0 * s1 - m1 * s0
+                y0 = m0 + c0 + 0.5 * (c1 * s2 - c2 * s1)
+                y1 = m1 + c1 + 0.5 * (c2 * s0 - c0 * s2)
+                y2 = m2 + c2 + 0.5 * (c0 * s1 - c1 * s0)
+                g0 = q00 * y0 + q01 * y1 + q02 * y2 + l0
+                g1 = q10 * y0 + q11 * y1 + q12 * y2 + l1
+                g2 = q20 * y0 + q21 * y1 + q22 * y2 + l2
+                v0 = y1 * (g2 + f2) - y2 * (g1 + f1)
+                v1 = y2 * (g0 + f0) - y0 * (g2 + f2)
+                v2 = y0 * (g1 + f1) - y1 * (g0 + f0)
+                s0 = (w0 + g0 + n00 * v0 + n01 * v1 + n02 * v2) * hdt + e0
+                s1 = (w1 + g1 + n10 * v0 + n11 * v1 + n12 * v2) * hdt + e1
+                s2 = (w2 + g2 + n20 * v0 + n21 * v1 + n22 * v2) * hdt + e2
+            # exp(ad*_s) m = m - a s×m + b s×(s×m), Taylor to t^8 (exact in float64 for t² < 1e-2)
+            t2 = s0 * s0 + s1 * s1 + s2 * s2
+            big = not (t2 < SMALL_ANGLE2)           # also NaN: redone (and diagnosed) by the scalar step
+            bad[p] = big
+            nbad += big
+            a, b, _ = _taylor(t2)
+            c0 = s1 * m2 - s2 * m1
+            c1 = s2 * m0 - s0 * m2
+            c2 = s0 * m1 - s1 * m0
+            d0 = s1 * c2 - s2 * c1
+            d1 = s2 * c0 - s0 * c2
+            d2 = s0 * c1 - s1 * c0
+            ma[p] = m0 if big else m0 - a * c0 + b * d0
+            mb[p] = m1 if big else m1 - a * c1 + b * d1
+            mc[p] = m2 if big else m2 - a * c2 + b * d2
+    nnew = 0
+    if nbad > 0:
+        for p in range(nb):
+            if bad[p]:
+                m0, m1, m2, e0, e1, e2 = ma[p], mb[p], mc[p], ea[p], eb[p], ec[p]
+                finite_in = math.isfinite(m0 + m1 + m2) and math.isfinite(e0 + e1 + e2)
+                ok = False
+                finite_out = False
+                if finite_in:
+                    m0, m1, m2, ok = _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_iter)
+                    finite_out = math.isfinite(m0 + m1 + m2)
+                if not (ok and finite_out):
+                    if first_bad[p] < 0:
+                        first_bad[p] = k
+                        reason[p] = NON_FINITE if (not finite_in or ok) else CHORD_FAILED
+                        nnew += 1
+                    m0 = m1 = m2 = np.nan
+                ma[p], mb[p], mc[p] = m0, m1, m2
+    return nnew
+
+
+@numba.njit(cache=True)
+def _so3_eta_block(m, eta, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
+                   first_bad, reason, stop):
+    """Advance m (3, B) over stochastic velocities eta (B, K, 3); after step k with ``save[k]`` the state
+    goes to the next slot of out (B, S, 3). With ``stop``, returns after the first step at which a
+    member failed. Returns the number of steps done."""
+    nb = m.shape[1]
+    slot = 0
+    for k in range(eta.shape[1]):
+        for p in range(nb):
+            e[0, p] = eta[p, k, 0]
+            e[1, p] = eta[p, k, 1]
+            e[2, p] = eta[p, k, 2]
+        nnew = _so3_block_step(m, e, dts[k], coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad,
+                               reason, k)
+        if save[k]:
+            for p in range(nb):
+                out[p, slot, 0] = m[0, p]
+                out[p, slot, 1] = m[1, p]
+                out[p, slot, 2] = m[2, p]
+            slot += 1
+        if stop and nnew > 0:
+            return k + 1
+    return eta.shape[1]
+
+
+def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure):
+    """Run the so(3) kernel on ``y`` (B, 3) with ``eta`` (B, K, 3); returns (y, saved, first_bad, reason)."""
+    nb = y.shape[0]
+    coef = coefficients(data)
+    lin = np.concatenate([data["linear"], data["dissipation_change"]])
+    m = np.ascontiguousarray(y.T)
+    out = np.full((nb, int(np.count_nonzero(save)), 3), np.nan)
+    first_bad = np.full(nb, -1, dtype=np.int64)
+    reason = np.zeros(nb, dtype=np.int8)
+    _so3_eta_block(m, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64),
+                   np.empty((3, nb)), np.empty(nb, dtype=np.bool_), coef, code, float(tol), int(max_iter),
+                   data["q"], lin, data["metric_inv"],
+                   float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason,
+                   bool(stop_on_failure))
+    return np.ascontiguousarray(m.T), out, first_bad, reason
+
+
+@numba.njit(cache=True)
+def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
+    """Stochastic velocities out (B, K, 3) = Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], A = ½(XX - XXᵀ).
+
+    ``dX`` (B, K, m); ``dXX`` (B, K, m, m) or an empty array (level-1 driving: no area term);
+    ``xi`` (m, 3); ``brk`` (npair, 3) the brackets of the pairs ``pi < pj``.
+    """
+    nb, nk, nm = dX.shape
+    area = dXX.shape[0] > 0
+    for p in range(nb):
+        for k in range(nk):
+            e0 = 0.0
+            e1 = 0.0
+            e2 = 0.0
+            for i in range(nm):
+                x = dX[p, k, i]
+                e0 += x * xi[i, 0]
+                e1 += x * xi[i, 1]
+                e2 += x * xi[i, 2]
+            if area:
+                for r in range(pi.shape[0]):
+                    i, j = pi[r], pj[r]
+                    a = 0.5 * (dXX[p, k, i, j] - dXX[p, k, j, i])
+                    e0 += a * brk[r, 0]
+                    e1 += a * brk[r, 1]
+                    e2 += a * brk[r, 2]
+            out[p, k, 0] = e0
+            out[p, k, 1] = e1
+            out[p, k, 2] = e2
+
+
+def stochastic_velocities(system, dX, dXX, batch):
+    """``system.stochastic_velocity`` of a block for the so(3) kernels, shape ``(prod(batch), K, 3)``."""
+    nk, nm = dX.shape[-2:]
+    nb = int(np.prod(batch, dtype=np.int64))
+    dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, nm)).reshape(nb, nk, nm), dtype=np.float64)
+    if dXX is None:
+        dXX = np.empty((0, 0, 0, 0))
+    else:
+        dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, nm, nm)).reshape(nb, nk, nm, nm),
+                                   dtype=np.float64)
+    pi, pj = np.triu_indices(nm, 1)
+    brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
+    out = np.empty((nb, nk, 3))
+    _eta_from_increments(dX, dXX, np.ascontiguousarray(system.xi), brk, pi.astype(np.int64), pj.astype(np.int64),
+                         out)
+    return out

@@ -1,0 +1,336 @@
+r"""Casimir-preserving coadjoint solvers: :class:`LieEuler`, :class:`LieHeun`, :class:`ImplicitMidpoint`.
+
+They follow the solver contract of :class:`roughpaths.Solver`, so a Lie–Poisson system is solved
+like any RDE: ``roughpaths.solve(system, X, mu0, LieHeun())`` returns a :class:`roughpaths.Solution`.
+Every scheme updates
+
+.. math::  \mu_{n+1} = \exp(\mathrm{ad}^*_{\sigma_n})\,\mu_n,
+
+so :math:`\mu_{n+1}` stays on the coadjoint orbit of :math:`\mu_n` and every Casimir is conserved to
+round-off. The Lie-algebra increment is :math:`\sigma_n = \bar w\,\Delta t_n + \eta_n` with the
+*stochastic velocity* (:meth:`~mechanics.lie_poisson.LiePoissonSystem.stochastic_velocity`)
+
+.. math::  \eta_n = \sum_i \xi_i X^i_{n} + \tfrac12\sum_{i,j} A^{ij}_n[\xi_i,\xi_j],
+
+built from the step's increment :math:`X_n` and Lévy area :math:`A_n = \tfrac12(\mathbb X_n - \mathbb X_n^T)`
+(the level-2 log-signature), and a drift velocity :math:`\bar w` (:math:`w(\mu) = \nabla\tilde h +
+\vartheta(\mathrm{ad}^*_{\nabla\tilde h}\mu)^\sharp`, :mod:`mechanics.lie_poisson`):
+
+* :class:`LieEuler`: :math:`\bar w = w(\mu_n)`;
+* :class:`LieHeun`: :math:`\bar w = \tfrac12(w(\mu_n) + w(\mu^*))`,
+  :math:`\mu^* = (1 + \mathrm{ad}^*_{\sigma^*} + \tfrac12(\mathrm{ad}^*_{\sigma^*})^2)\mu_n`,
+  :math:`\sigma^* = w(\mu_n)\Delta t + \eta_n` (the predictor only feeds the drift velocity; its
+  :math:`O(|\sigma|^3)` error keeps both orders);
+* :class:`ImplicitMidpoint` (the paper's appendix scheme): :math:`\bar w = w(\tfrac12(\mu_n+\mu_{n+1}))`,
+  solved per batch member by the chord method (:mod:`mechanics.integrators._chord`).
+
+Why the area term, and why :math:`+\tfrac12`: the noise fields are linear, :math:`V_i\mu = B_i\mu` with
+:math:`B_i = \mathrm{ad}^*_{\xi_i}`; Davie's step contains :math:`B_jB_i\mathbb X^{ij} = \tfrac12(B_iX^i)^2 +
+\tfrac12A^{ij}(B_jB_i - B_iB_j)`, and :math:`B_jB_i - B_iB_j = \mathrm{ad}^*_{[\xi_i,\xi_j]}`. The second-order
+term of :math:`\exp(\mathrm{ad}^*_\sigma)` reproduces both exactly when :math:`\sigma\ni\tfrac12A^{ij}[\xi_i,\xi_j]`.
+With the area the schemes have strong order 1 on Brownian rough paths (order 2 in ``dt`` without
+noise for Lie–Heun and the midpoint rule); without it (``levy_area=False``: level-1 driving, zero
+step area) only order ½ for non-commuting ``ξ``. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
+adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` to :math:`\sigma_n`: the
+discrete Proposition 2.1.
+
+Implementation: for a :class:`~mechanics.lie_algebra.SO3Algebra` with a quadratic Hamiltonian,
+:meth:`CoadjointSolver.integrate` runs compiled block kernels (:mod:`mechanics.integrators._so3_kernels`),
+for an :class:`~mechanics.lie_algebra.SE3Algebra` (the heavy top) with the explicit schemes those of
+:mod:`mechanics.integrators._se3_kernels`; otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
+:func:`roughpaths.expm_batched` per member otherwise). Either way a batch member's result depends
+on its own data only; a member that fails is reported through ``first_bad`` (contract item 8).
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from roughpaths import Solver
+from roughpaths.validation import as_float_array, check_positive_int
+
+from ..lie_algebra import SE3Algebra, SO3Algebra
+from ..lie_poisson import LiePoissonSystem
+from . import _se3_kernels, _so3_kernels
+from ._chord import chord_solve
+
+__all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
+           "check_on_orbit"]
+
+
+class ChordConvergenceError(RuntimeError):
+    """The implicit midpoint's chord iteration did not converge (the message names the step and members)."""
+
+
+class CoadjointSolver(Solver):
+    r"""Base class of the coadjoint solvers (contract of :class:`roughpaths.Solver`).
+
+    Parameters
+    ----------
+    levy_area : bool
+        ``True`` (default): level-2 driving, the step Lévy areas enter :math:`\sigma_n`
+        (``increment_level = 2``; a level-2 geometric driver is required). ``False``: level-1 driving,
+        :math:`\sigma_n` from the increments alone, i.e. zero step Lévy area (``increment_level = 1``);
+        a level-1 driver is then required, so areas are never dropped silently (pass
+        ``X.to_level1()`` to discard the areas of a level-2 path deliberately).
+    """
+
+    calculus = "stratonovich"
+    preserves = ("casimirs",)
+    smooth_order = 2.0
+    _code = -1
+
+    def __init__(self, levy_area: bool = True):
+        if not isinstance(levy_area, (bool, np.bool_)):
+            raise TypeError(f"levy_area must be True (use the driver's Lévy areas) or False (level-1 driving, "
+                            f"zero area), got {levy_area!r}.")
+        self.levy_area = bool(levy_area)
+
+    # -------------------------------------------------------------- declarations (contract 1-4)
+    @property
+    def increment_level(self) -> int:
+        """2 with ``levy_area=True`` (increments and areas), 1 without (increments only)."""
+        return 2 if self.levy_area else 1
+
+    @property
+    def order(self) -> float:
+        """Strong order on Brownian rough paths: 1 with the Lévy area, ½ without (non-commuting ξ)."""
+        return 1.0 if self.levy_area else 0.5
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()" if self.levy_area else f"{type(self).__name__}(levy_area=False)"
+
+    # -------------------------------------------------------------- checks (contract 5-6)
+    def check_fields(self, fields):
+        """Accept a :class:`~mechanics.lie_poisson.LiePoissonSystem` (contract item 5)."""
+        if not isinstance(fields, LiePoissonSystem):
+            raise TypeError(f"{self!r} integrates a mechanics.LiePoissonSystem (e.g. mechanics.rigid_body(...)), "
+                            f"got {type(fields).__name__}; for roughpaths.VectorFields use Davie(), LogODE(), "
+                            f"Heun() or Euler().")
+        return fields
+
+    def check_driver(self, driver) -> None:
+        """Require a geometric driver of level 2 (``levy_area=True``) or exactly 1 (contract item 6)."""
+        level = driver.level
+        if self.levy_area and level < 2:
+            raise ValueError(f"the driver is a level-1 path (no area) but {self!r} needs the step Lévy areas. "
+                             f"Pass {type(self).__name__}(levy_area=False) to drive with the increments alone "
+                             f"(zero Lévy area per step), or a level-2 path (e.g. RoughPath.from_path(values) "
+                             f"for the piecewise-linear lift, or the increments with their areas).")
+        if not self.levy_area and level != 1:
+            raise ValueError(f"{self!r} drives with the increments alone but the driver is a level-2 path: its "
+                             f"areas would be discarded. Pass driver.to_level1() to drop them deliberately, or "
+                             f"{type(self).__name__}() to use them.")
+        kind = getattr(driver, "kind", "geometric")
+        if self.levy_area and kind not in ("geometric", "stratonovich"):
+            raise ValueError(f"the driver is a {kind!r} rough path; the coadjoint schemes solve the geometric "
+                             f"(Stratonovich-type) RDE. Convert an Itô lift with XX + ½(t-s)I first.")
+
+    # -------------------------------------------------------------- the scheme
+    def _sigma(self, system, mu, dt, eta):
+        """Lie-algebra increment ``sigma (..., n)`` and a convergence mask (``None``: always converged)."""
+        raise NotImplementedError
+
+    def _advance(self, system, mu, dt, eta):
+        """One step: ``(new mu, ok)``; failed members (non-finite or not converged) are NaN, ``ok`` False."""
+        mu, eta = np.broadcast_arrays(np.asarray(mu, dtype=np.float64), np.asarray(eta, dtype=np.float64))
+        live = np.all(np.isfinite(mu), axis=-1) & np.all(np.isfinite(eta), axis=-1)
+        new = np.full(mu.shape, np.nan)
+        conv = None
+        if np.all(live):                        # members are computed alone or as a subset: same bits
+            mu_l, eta_l = mu, eta
+        else:
+            mu_l, eta_l = mu[live], eta[live]
+        with np.errstate(all="ignore"):
+            sigma, conv_l = self._sigma(system, mu_l, dt, eta_l)
+            sig_ok = np.all(np.isfinite(sigma), axis=-1)
+            if not np.all(sig_ok):
+                sigma = np.where(sig_ok[..., None], sigma, 0.0)
+            new_l = system.algebra.Ad_star_exp(sigma, mu_l)
+        ok_l = np.all(np.isfinite(new_l), axis=-1) & sig_ok
+        if conv_l is not None:
+            ok_l = ok_l & conv_l
+            conv = np.ones(mu.shape[:-1], dtype=bool)
+            conv[live] = conv_l
+        new[live] = np.where(ok_l[..., None], new_l, np.nan)
+        ok = np.zeros(mu.shape[:-1], dtype=bool)
+        ok[live] = ok_l
+        return new, ok, conv
+
+    @staticmethod
+    def _eta(system, dX, dXX):
+        areas = None if dXX is None else 0.5 * (dXX - np.swapaxes(dXX, -1, -2))
+        return system.stochastic_velocity(dX, areas)
+
+    def step(self, fields, y, t, dt, dX, dXX):
+        """One step (contract item 7); a failed member comes back NaN."""
+        return self._advance(fields, y, float(dt), self._eta(fields, dX, dXX))[0]
+
+    def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
+        """Advance a block of steps (contract item 8); compiled so(3) kernels where they apply.
+
+        Raises :class:`ChordConvergenceError` (with ``stop_on_failure``) when a member's chord
+        iteration fails; other failures are reported through ``first_bad``.
+        """
+        system = fields
+        n = system.dim
+        batch = y.shape[:-1]
+        dts = np.diff(np.asarray(times, dtype=np.float64))
+        nk = dts.size
+        nsave = int(np.count_nonzero(save))
+        dXX = dXX if self.levy_area else None
+        if isinstance(system.algebra, SO3Algebra) and system.hamiltonian.is_quadratic:
+            nb = int(np.prod(batch, dtype=np.int64))
+            eta_b = _so3_kernels.stochastic_velocities(system, dX, dXX, batch)
+            y2, saved, first_bad, reason = _so3_kernels.integrate_so3(
+                system.quadratic_velocity_data(), self._code, getattr(self, "tol", 1e-13),
+                getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
+            y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
+            first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
+        elif isinstance(system.algebra, SE3Algebra) and system.hamiltonian.is_quadratic and self._code in (0, 1):
+            nb = int(np.prod(batch, dtype=np.int64))
+            d = dX.shape[-1]
+            dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
+            if dXX is not None:
+                dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
+                                           dtype=np.float64)
+            y2, saved, first_bad = _se3_kernels.integrate_se3(system, self._code, y.reshape(nb, n), dX, dXX, dts,
+                                                              save, stop_on_failure)
+            y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
+            chord = np.zeros(batch, dtype=bool)
+        else:
+            saved = np.full(batch + (nsave, n), np.nan)
+            first_bad = np.full(batch, -1, dtype=np.int64)
+            chord = np.zeros(batch, dtype=bool)
+            slot = 0
+            y2 = y
+            eta = self._eta(system, dX, dXX)                                    # (B_X..., K, n)
+            for k in range(nk):
+                y2, ok, conv = self._advance(system, y2, float(dts[k]), eta[..., k, :])
+                new = ~ok & (first_bad < 0)
+                if new.any():
+                    first_bad[new] = k
+                    if conv is not None:
+                        chord |= new & ~np.broadcast_to(conv, batch)
+                if save[k]:
+                    saved[..., slot, :] = y2
+                    slot += 1
+                if stop_on_failure and new.any():
+                    break
+        if stop_on_failure and chord.any():
+            raise self._chord_error(np.argwhere(chord), first_bad, times, dts)
+        return y2, saved, first_bad
+
+    def _chord_error(self, members, first_bad, times, dts):
+        k = int(min(first_bad[tuple(m)] for m in members))
+        who = ", ".join(str(tuple(int(i) for i in m)) for m in members[:8])
+        return ChordConvergenceError(
+            f"implicit midpoint: the chord iteration did not converge at step {k} of the block from "
+            f"t = {float(times[0]):.6g} (step from t = {float(times[k]):.6g}, dt = {float(dts[k]):.3g}) for batch "
+            f"member(s) {who}: tolerance {self.tol:g} not reached after max_iter = {self.max_iter} iterations. "
+            f"Reduce dt (or use LieHeun), or raise max_iter / tol; roughpaths.solve(..., on_failure='mask') "
+            f"keeps the other members.")
+
+
+class LieEuler(CoadjointSolver):
+    r"""Explicit Lie–Euler: :math:`\sigma_n = w(\mu_n)\Delta t + \eta_n`.
+
+    Declared orders: strong order 1 on Brownian rough paths with the Lévy area (½ without), order 1
+    in ``dt`` on smooth drivers. Preserves the Casimirs.
+    """
+
+    smooth_order = 1.0
+    _code = 0
+
+    def _sigma(self, system, mu, dt, eta):
+        return system.drift_velocity(mu) * dt + eta, None
+
+
+class LieHeun(CoadjointSolver):
+    r"""Explicit Lie–Heun (predictor–corrector on the drift velocity; the noise part is additive in
+    :math:`\mathfrak g`, so it enters predictor and corrector alike).
+
+    Declared orders: strong order 1 on Brownian rough paths with the Lévy area (½ without), order 2
+    in ``dt`` on smooth drivers. Preserves the Casimirs.
+    """
+
+    smooth_order = 2.0
+    _code = 1
+
+    def _sigma(self, system, mu, dt, eta):
+        alg = system.algebra
+        w0 = system.drift_velocity(mu)
+        sig0 = w0 * dt + eta
+        fin = np.all(np.isfinite(sig0), axis=-1, keepdims=True)     # a non-finite member fails alone
+        sig0 = np.where(fin, sig0, 0.0)
+        a = alg.ad_star(sig0, mu)
+        mu_p = mu + a + 0.5 * alg.ad_star(sig0, a)                  # predictor: 2nd-order Taylor of exp
+        fin = fin & np.all(np.isfinite(mu_p), axis=-1, keepdims=True)  # an overflowed predictor fails too
+        mu_p = np.where(fin, mu_p, 0.0)
+        sigma = 0.5 * (w0 + system.drift_velocity(mu_p)) * dt + eta
+        return np.where(fin, sigma, np.nan), None
+
+
+class ImplicitMidpoint(CoadjointSolver):
+    r"""The paper's implicit midpoint Munthe-Kaas step, :math:`\bar w = w(\tfrac12(\mu_n+\mu_{n+1}))`.
+
+    Solved for :math:`\sigma_n` per batch member by the chord method:
+    :math:`\sigma\leftarrow\sigma - J^{-1}F(\sigma)`,
+    :math:`F(\sigma) = \sigma - w(\tfrac12(\mu_n + e^{\mathrm{ad}^*_\sigma}\mu_n))\Delta t - \eta_n`,
+    :math:`J = I - \tfrac{\Delta t}2 Dw(\mu_n) L(\mu_n)` with :math:`L(\mu)\delta = \mathrm{ad}^*_\delta\mu`
+    (frozen for the step). A member stops when :math:`\max|\Delta\sigma| \le` ``tol``
+    :math:`(1 + |\sigma|_\infty)`; one that has not after ``max_iter`` iterations fails
+    (:class:`ChordConvergenceError`, or marked with ``on_failure="mask"``).
+
+    Declared orders: strong order 1 with the Lévy area (½ without), order 2 in ``dt`` on smooth
+    drivers. Preserves the Casimirs.
+    """
+
+    smooth_order = 2.0
+    _code = 2
+
+    def __init__(self, tol: float = 1e-13, max_iter: int = 50, *, levy_area: bool = True):
+        super().__init__(levy_area)
+        if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not np.isfinite(tol) or tol <= 0:
+            raise ValueError(f"tol must be a positive finite number, got {tol!r}.")
+        self.tol = float(tol)
+        self.max_iter = check_positive_int(max_iter, "max_iter")
+
+    def __repr__(self) -> str:
+        extra = "" if self.levy_area else ", levy_area=False"
+        return f"ImplicitMidpoint(tol={self.tol:g}, max_iter={self.max_iter}{extra})"
+
+    def _sigma(self, system, mu, dt, eta):
+        return chord_solve(system, mu, dt, eta, self.tol, self.max_iter)
+
+
+# ---------------------------------------------------------------------- orbit checks
+def check_on_orbit(system: LiePoissonSystem, mu, orbit, *, rtol: float = 1e-10, name: str = "mu0"):
+    """Require ``system.casimirs(mu) == orbit`` (relative tolerance ``rtol``) for every batch entry.
+
+    ``orbit`` has shape ``(k,)`` or broadcasts against ``(..., k)``. Raises ``ValueError`` naming the
+    Casimir, the worst batch index, the value and the expected value.
+    """
+    cas = system.casimirs(mu)
+    target = as_float_array(orbit, "orbit")
+    if target.ndim == 0:
+        target = target[None]
+    try:
+        target = np.broadcast_to(target, cas.shape)
+    except ValueError:
+        raise ValueError(f"orbit must give the {cas.shape[-1]} Casimir value(s) "
+                         f"{system.algebra.casimir_names}, got shape {np.shape(orbit)}.") from None
+    err = np.abs(cas - target) / np.maximum(1.0, np.abs(target))
+    if np.any(err > rtol):
+        flat = int(np.argmax(err))
+        idx = np.unravel_index(flat, err.shape)
+        k = idx[-1]
+        names = system.algebra.casimir_names
+        label = names[k] if k < len(names) else f"Casimir {k}"
+        raise ValueError(f"{name} is off the coadjoint orbit: {label} = {float(cas[idx])!r} at batch index "
+                         f"{tuple(int(i) for i in idx[:-1])}, expected {float(target[idx])!r} (relative error "
+                         f"{err[idx]:.3g} > {rtol:g}). A Casimir-preserving method keeps the orbit of the "
+                         f"initial state; project {name} onto the orbit (e.g. normalise |Pi|) or pass the "
+                         f"orbit it lies on.")

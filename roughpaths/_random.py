@@ -1,0 +1,445 @@
+r"""Fast, bit-exact standard normals (private; used by the Brownian driver and samplers).
+
+Two services, both reproducing numpy **bit for bit** (so that the stream of a seed is defined by
+plain numpy calls and can be checked against them):
+
+* :func:`standard_normal_into` ``(rng, out)``: ``rng.standard_normal(out=out)`` for a
+  ``numpy.random.Generator``, same values and same end state of the generator. numpy's ziggurat
+  (256 layers, ``random_standard_normal`` in numpy's ``distributions.c``) is re-implemented in
+  numba over a buffer of raw 64-bit words (``bit_generator.random_raw``), which removes numpy's
+  per-draw function-pointer calls (about 3x faster per normal). Used for the bit generators whose
+  ``next_double`` is ``(raw >> 11) * 2**-53``, after a one-off self-check against
+  ``standard_normal`` per process; any other generator (e.g. ``MT19937``) uses numpy directly.
+* :class:`PathStreams`: one independent stream per path for many paths at once, the stream of
+  key ``k`` (a tuple of ints) being::
+
+      numpy.random.Generator(numpy.random.PCG64(
+          numpy.random.SeedSequence(entropy, spawn_key=base_key + k))).standard_normal(...)
+
+  ``fill(out)`` with ``out`` of shape ``(P, n)`` writes the next ``n`` normals of stream ``p``
+  into ``out[p]``; successive calls continue the streams, so the numbers do not depend on how a
+  stream is cut into calls. Fast path: the ``SeedSequence`` hashing, the ``PCG64`` seeding and
+  stepping (128-bit LCG, XSL-RR output) and the ziggurat run in one numba kernel over all paths
+  (no Python per path; seeding costs ~0.2 µs per stream instead of ~35 µs through numpy).
+  It is self-checked once per process against numpy on a few keys (``SeedSequence``,
+  ``PCG64`` state, normals including the ziggurat tail); if the check fails (a future numpy
+  changing an algorithm) the streams fall back to one numpy ``Generator`` per path, same
+  numbers, slower.
+
+The ziggurat tables are numpy's; numba ships a copy for its own ``Generator`` support, which
+we import (falling back to numpy everywhere if its layout changes).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
+
+try:  # the ziggurat tables numpy uses (numba ships a copy for its own Generator support)
+    from numba.np.random._constants import fi_double as _ZIG_F
+    from numba.np.random._constants import ki_double as _ZIG_K
+    from numba.np.random._constants import wi_double as _ZIG_W
+    from numba.np.random._constants import ziggurat_nor_inv_r as _ZIG_INV_R
+    from numba.np.random._constants import ziggurat_nor_r as _ZIG_R
+except ImportError:  # pragma: no cover - another numba layout: fall back to numpy's sampler
+    _ZIG_K = None
+
+__all__ = ["standard_normal_into", "PathStreams"]
+
+_RAW_BIT_GENERATORS = ("PCG64", "PCG64DXSM", "SFC64", "Philox")
+_RAW_OK: dict = {}
+
+
+# ----------------------------------------------------------------------------- raw-word ziggurat
+@njit(cache=True)
+def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
+    """Fill ``out[start:]`` from ``raw`` (uint64) with numpy's ziggurat; returns (raw consumed, next index).
+
+    Stops at the first attempt that would need more raw words than remain (that attempt is then
+    redone from its first word on the next call, so no word is skipped or reused).
+    """
+    n = out.size
+    nr = raw.size
+    pos = 0
+    i = start
+    m255 = np.uint64(255)
+    m52 = np.uint64(0x000FFFFFFFFFFFFF)
+    one = np.uint64(1)
+    s8 = np.uint64(8)
+    s11 = np.uint64(11)
+    scale = 1.0 / 9007199254740992.0
+    while i < n:
+        if pos >= nr:
+            break
+        first = pos
+        r = raw[pos]
+        pos += 1
+        idx = np.intp(r & m255)
+        r = r >> s8
+        rabs = (r >> one) & m52
+        x = float(rabs) * wi[idx]
+        if r & one:
+            x = -x
+        if rabs < ki[idx]:
+            out[i] = x
+            i += 1
+            continue
+        if idx == 0:
+            done = False
+            while True:
+                if pos + 2 > nr:
+                    break
+                xx = -inv_r * math.log1p(-(float(raw[pos] >> s11) * scale))
+                yy = -math.log1p(-(float(raw[pos + 1] >> s11) * scale))
+                pos += 2
+                if yy + yy > xx * xx:
+                    out[i] = -(r_tail + xx) if (rabs >> s8) & one else r_tail + xx
+                    done = True
+                    break
+            if not done:
+                pos = first
+                break
+            i += 1
+        else:
+            if pos + 1 > nr:
+                pos = first
+                break
+            u = float(raw[pos] >> s11) * scale
+            pos += 1
+            if (fi[idx - 1] - fi[idx]) * u + fi[idx] < math.exp(-0.5 * x * x):
+                out[i] = x
+                i += 1
+    return pos, i
+
+
+def _fill_normals_raw(bit_generator, out) -> bool:
+    """Fill ``out`` (C-contiguous float64) from ``bit_generator.random_raw``, requesting exactly the words used."""
+    flat = out.reshape(-1)
+    n = flat.size
+    i = 0
+    left = np.empty(0, dtype=np.uint64)
+    while i < n:
+        # every remaining normal needs >= 1 word and the pending attempt needs > len(left) words, so
+        # asking for n - i new words never over-draws: the generator ends where numpy's would
+        new = bit_generator.random_raw(n - i)
+        raw = new if left.size == 0 else np.concatenate([left, new])
+        used, i = _ziggurat_fill(raw, flat, i, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+        left = raw[used:]
+    return left.size == 0
+
+
+def _raw_normals_ok(rng) -> bool:
+    name = type(rng.bit_generator).__name__
+    if _ZIG_K is None or name not in _RAW_BIT_GENERATORS:
+        return False
+    if name not in _RAW_OK:                  # one-off self-check against numpy on a private generator
+        bg = type(rng.bit_generator)(12345)
+        ref = np.random.Generator(type(rng.bit_generator)(12345)).standard_normal(20_000)
+        got = np.empty(20_000)
+        _RAW_OK[name] = _fill_normals_raw(bg, got) and np.array_equal(got, ref)
+    return _RAW_OK[name]
+
+
+def standard_normal_into(rng: np.random.Generator, out: np.ndarray) -> None:
+    """``rng.standard_normal(out=out)``: same values and end state, faster for 64-bit bit generators.
+
+    ``out`` must be a C-contiguous float64 array.
+    """
+    if out.dtype != np.float64 or not out.flags.c_contiguous:
+        raise ValueError("out must be a C-contiguous float64 array.")
+    if _raw_normals_ok(rng):
+        if _fill_normals_raw(rng.bit_generator, out):
+            return
+        raise RuntimeError("internal error: the raw-word normal sampler over-drew the bit generator.")
+    rng.standard_normal(out=out)
+
+
+# ----------------------------------------------------------------------------- SeedSequence
+# numpy's SeedSequence (numpy/random/bit_generator.pyx), 32-bit arithmetic, pool size 4.
+_INIT_A = np.uint32(0x43B0D7E5)
+_MULT_A = np.uint32(0x931E8875)
+_INIT_B = np.uint32(0x8B51F9DD)
+_MULT_B = np.uint32(0x58F38DED)
+_MIX_MULT_L = np.uint32(0xCA01F9DD)
+_MIX_MULT_R = np.uint32(0x4973F715)
+_XSHIFT = np.uint32(16)
+
+
+@njit(cache=True, inline="always")
+def _hashmix(value, hc):
+    value = np.uint32(value ^ hc)
+    hc = np.uint32(hc * _MULT_A)
+    value = np.uint32(value * hc)
+    value = np.uint32(value ^ (value >> _XSHIFT))
+    return value, hc
+
+
+@njit(cache=True, inline="always")
+def _mix(x, y):
+    r = np.uint32(np.uint32(_MIX_MULT_L * x) - np.uint32(_MIX_MULT_R * y))
+    return np.uint32(r ^ (r >> _XSHIFT))
+
+
+@njit(cache=True)
+def _seed_states(entropy, out):
+    """``SeedSequence`` pools and ``generate_state(4, uint64)`` for each row of ``entropy``.
+
+    ``entropy`` (P, L) uint32: the assembled entropy words of each stream (``L >= 4``: the run
+    entropy padded to the pool size, then the spawn key). ``out`` (P, 4) uint64 receives
+    ``generate_state(4, np.uint64)``.
+    """
+    P, L = entropy.shape
+    mixer = np.empty(4, dtype=np.uint32)
+    st32 = np.empty(8, dtype=np.uint32)
+    for p in range(P):
+        hc = _INIT_A
+        for i in range(4):
+            mixer[i], hc = _hashmix(entropy[p, i], hc)
+        for i_src in range(4):
+            for i_dst in range(4):
+                if i_src != i_dst:
+                    v, hc = _hashmix(mixer[i_src], hc)
+                    mixer[i_dst] = _mix(mixer[i_dst], v)
+        for i_src in range(4, L):
+            for i_dst in range(4):
+                v, hc = _hashmix(entropy[p, i_src], hc)
+                mixer[i_dst] = _mix(mixer[i_dst], v)
+        hb = _INIT_B
+        for i in range(8):
+            v = np.uint32(mixer[i % 4] ^ hb)
+            hb = np.uint32(hb * _MULT_B)
+            v = np.uint32(v * hb)
+            v = np.uint32(v ^ (v >> _XSHIFT))
+            st32[i] = v
+        for i in range(4):
+            out[p, i] = np.uint64(st32[2 * i]) | (np.uint64(st32[2 * i + 1]) << np.uint64(32))
+
+
+# ----------------------------------------------------------------------------- PCG64
+_PCG_MUL = (2549297995355413924 << 64) | 4865540595714422341       # numpy's PCG_DEFAULT_MULTIPLIER_128
+
+
+@intrinsic
+def _lcg(typingctx, sh, sl, ih, il):
+    """One step of PCG64's 128-bit LCG, ``s <- s * MUL + inc (mod 2**128)``, on (hi, lo) uint64 halves.
+
+    Written as an LLVM ``i128`` multiply-add (twice as fast as emulating it with 64-bit halves).
+    """
+    sig = types.UniTuple(types.uint64, 2)(types.uint64, types.uint64, types.uint64, types.uint64)
+
+    def codegen(context, builder, signature, args):
+        i128, i64 = ir.IntType(128), ir.IntType(64)
+        c64 = ir.Constant(i128, 64)
+
+        def join(hi, lo):
+            return builder.or_(builder.shl(builder.zext(hi, i128), c64), builder.zext(lo, i128))
+
+        r = builder.add(builder.mul(join(args[0], args[1]), ir.Constant(i128, _PCG_MUL)), join(args[2], args[3]))
+        lo = builder.trunc(r, i64)
+        hi = builder.trunc(builder.lshr(r, c64), i64)
+        return context.make_tuple(builder, signature.return_type, [hi, lo])
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always")
+def _xsl_rr(sh, sl):
+    x = sh ^ sl
+    rot = sh >> np.uint64(58)
+    return (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
+
+
+@njit(cache=True)
+def _pcg64_seed(seeds, states):
+    """PCG64 states ``(P, 4)`` = (state_hi, state_lo, inc_hi, inc_lo) from ``generate_state(4, uint64)``."""
+    one = np.uint64(1)
+    for p in range(seeds.shape[0]):
+        ih = (seeds[p, 2] << one) | (seeds[p, 3] >> np.uint64(63))
+        il = (seeds[p, 3] << one) | one
+        sh, sl = _lcg(np.uint64(0), np.uint64(0), ih, il)
+        lo = sl + seeds[p, 1]
+        sh = sh + seeds[p, 0] + (one if lo < sl else np.uint64(0))
+        sh, sl = _lcg(sh, lo, ih, il)
+        states[p, 0] = sh
+        states[p, 1] = sl
+        states[p, 2] = ih
+        states[p, 3] = il
+
+
+@njit(cache=True)
+def _pcg64_normal(sh, sl, ih, il):
+    """One standard normal (numpy's ziggurat) from PCG64 state ``(sh, sl)``; returns ``(x, sh, sl)``.
+
+    The tables are module globals (numba freezes them as constants): passing them as arguments
+    costs a reference count per call, and an ``inline="always"`` version multiplied the
+    compile time of its callers.
+    """
+    ki, wi, fi, r_tail, inv_r = _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R
+    m255 = np.uint64(255)
+    m52 = np.uint64(0x000FFFFFFFFFFFFF)
+    one = np.uint64(1)
+    s8 = np.uint64(8)
+    s11 = np.uint64(11)
+    scale = 1.0 / 9007199254740992.0
+    while True:
+        sh, sl = _lcg(sh, sl, ih, il)
+        r = _xsl_rr(sh, sl)
+        idx = np.intp(r & m255)
+        r = r >> s8
+        rabs = (r >> one) & m52
+        x = float(rabs) * wi[idx]
+        if r & one:
+            x = -x
+        if rabs < ki[idx]:
+            return x, sh, sl
+        if idx == 0:
+            while True:
+                sh, sl = _lcg(sh, sl, ih, il)
+                u1 = float(_xsl_rr(sh, sl) >> s11) * scale
+                sh, sl = _lcg(sh, sl, ih, il)
+                u2 = float(_xsl_rr(sh, sl) >> s11) * scale
+                xx = -inv_r * math.log1p(-u1)
+                yy = -math.log1p(-u2)
+                if yy + yy > xx * xx:
+                    return (-(r_tail + xx) if (rabs >> s8) & one else r_tail + xx), sh, sl
+        else:
+            sh, sl = _lcg(sh, sl, ih, il)
+            u = float(_xsl_rr(sh, sl) >> s11) * scale
+            if (fi[idx - 1] - fi[idx]) * u + fi[idx] < math.exp(-0.5 * x * x):
+                return x, sh, sl
+
+
+@njit(cache=True)
+def _pcg64_normals(states, out):
+    """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
+    P, n = out.shape
+    for p in range(P):
+        sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+        for i in range(n):
+            out[p, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
+        states[p, 0] = sh
+        states[p, 1] = sl
+
+
+def _uint32_words(value: int) -> list:
+    """numpy's ``_coerce_to_uint32_array`` for one non-negative int (little-endian 32-bit words)."""
+    if value == 0:
+        return [0]
+    words = []
+    while value:
+        words.append(value & 0xFFFFFFFF)
+        value >>= 32
+    return words
+
+
+def _entropy_words(seed_seq: np.random.SeedSequence) -> list:
+    ent = seed_seq.entropy
+    if isinstance(ent, (int, np.integer)):
+        words = _uint32_words(int(ent))
+    else:
+        words = [w for v in ent for w in _uint32_words(int(v))]
+    return words
+
+
+_FAST_OK: list = []
+
+
+def _fast_streams_ok() -> bool:
+    """One-off self-check of the numba SeedSequence/PCG64/ziggurat against numpy (cached per process)."""
+    if not _FAST_OK:
+        ok = _ZIG_K is not None
+        if ok:
+            try:
+                for ent, base in ((12345, ()), (2**70 + 3, (7,)), ([1, 2**40], ())):
+                    ss = np.random.SeedSequence(ent, spawn_key=base)
+                    keys = [(0, 0), (1, 1), (2**33 + 5, 0)]
+                    s = PathStreams(ss, keys, _force_numpy=False)
+                    got = np.empty((len(keys), 3000))
+                    s.fill(got[:, :1000])
+                    s.fill(got[:, 1000:])
+                    for j, k in enumerate(keys):
+                        g = np.random.Generator(np.random.PCG64(
+                            np.random.SeedSequence(ent, spawn_key=base + k)))
+                        ok = ok and np.array_equal(got[j], g.standard_normal(3000))
+            except Exception:  # pragma: no cover - defensive: any failure means "use numpy"
+                ok = False
+        _FAST_OK.append(bool(ok))
+    return _FAST_OK[0]
+
+
+class PathStreams:
+    """Independent standard-normal streams, one per key, continued across :meth:`fill` calls.
+
+    Stream ``j`` is that of ``numpy.random.Generator(numpy.random.PCG64(SeedSequence(
+    seed_seq.entropy, spawn_key=seed_seq.spawn_key + keys[j], pool_size=seed_seq.pool_size)))``.
+
+    Parameters
+    ----------
+    seed_seq : numpy.random.SeedSequence
+        Root of the streams (its ``pool_size`` must be 4, numpy's default, for the fast path).
+    keys : sequence of tuples of non-negative ints, or ndarray ``(P, k)`` of int
+        The spawn-key suffix of each stream.
+    """
+
+    def __init__(self, seed_seq, keys, *, _force_numpy=None):
+        keys = np.asarray(keys, dtype=object) if not isinstance(keys, np.ndarray) else keys
+        self._seed_seq = seed_seq
+        self._keys = keys
+        self.n_streams = int(keys.shape[0])
+        fast = (seed_seq.pool_size == 4 and _fast_streams_ok()) if _force_numpy is None else not _force_numpy
+        self._fast = fast
+        #: ``(P, 4)`` uint64 PCG64 states (hi, lo, inc hi, inc lo) on the fast path, else None
+        self.states = None
+        if fast:
+            self.states = self._fast_states()
+        else:
+            self._gens = [np.random.Generator(np.random.PCG64(np.random.SeedSequence(
+                seed_seq.entropy, spawn_key=tuple(seed_seq.spawn_key) + tuple(int(v) for v in k),
+                pool_size=seed_seq.pool_size))) for k in keys]
+
+    def _fast_states(self) -> np.ndarray:
+        ss = self._seed_seq
+        run = _entropy_words(ss)
+        base = [w for v in ss.spawn_key for w in _uint32_words(int(v))]
+        keys = self._keys
+        P = self.n_streams
+        if P == 0:
+            return np.empty((0, 4), dtype=np.uint64)
+        kint = np.asarray(keys, dtype=np.int64) if keys.dtype != object else None
+        if kint is not None and kint.ndim == 2 and kint.min(initial=0) >= 0 and kint.max(initial=0) < 2**32:
+            # the common case: every key element is one 32-bit word, the entropy rows have one length
+            if len(run) < 4:
+                run = run + [0] * (4 - len(run))
+            prefix = np.array(run + base, dtype=np.uint32)
+            ent = np.empty((P, prefix.size + kint.shape[1]), dtype=np.uint32)
+            ent[:, :prefix.size] = prefix
+            ent[:, prefix.size:] = kint.astype(np.uint32)
+            seeds = np.empty((P, 4), dtype=np.uint64)
+            _seed_states(ent, seeds)
+        else:
+            seeds = np.empty((P, 4), dtype=np.uint64)
+            for j, k in enumerate(keys):
+                spawn = base + [w for v in k for w in _uint32_words(int(v))]
+                r = run + [0] * max(0, 4 - len(run))    # zero padding == numpy's hashmix(0) fill
+                _seed_states(np.array([r + spawn], dtype=np.uint32), seeds[j:j + 1])
+        states = np.empty((P, 4), dtype=np.uint64)
+        _pcg64_seed(seeds, states)
+        return states
+
+    def fill(self, out: np.ndarray) -> None:
+        """Write the next ``out.shape[1]`` normals of stream ``p`` into ``out[p]`` (``out`` float64 ``(P, n)``)."""
+        if out.shape[0] != self.n_streams or out.ndim != 2 or out.dtype != np.float64:
+            raise ValueError(f"out must be float64 of shape ({self.n_streams}, n), got {out.dtype} {out.shape}.")
+        if self._fast:
+            _pcg64_normals(self.states, out)
+        else:
+            for p, g in enumerate(self._gens):
+                row = out[p]
+                if row.flags.c_contiguous:
+                    standard_normal_into(g, row)
+                else:
+                    out[p] = g.standard_normal(out.shape[1])

@@ -1,0 +1,170 @@
+"""Shared machinery of the per-path seeded drivers (private): seed, grid, paths, selection, sizes.
+
+A seeded driver keys the random stream of each path by the path's flat index ``i`` in the
+original ``batch_shape`` (C order), so that a subset of paths (:meth:`SeededDriver.select`),
+a block size or a process does not change any path's numbers. Subclasses define the streams and
+``blocks``; :class:`roughpaths.BrownianDriver` and :class:`roughpaths.ColouredNoiseDriver`.
+"""
+
+from __future__ import annotations
+
+import numbers
+import os
+
+import numpy as np
+
+from .driver import Driver
+from .validation import as_float_array, check_positive_int, check_times
+
+
+def check_seed(seed) -> np.random.SeedSequence:
+    """An int ``>= 0`` or a ``SeedSequence`` (as is); a ``Generator`` is refused with the reason."""
+    if isinstance(seed, np.random.SeedSequence):
+        return seed
+    if isinstance(seed, numbers.Integral) and not isinstance(seed, bool):
+        if seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {seed}.")
+        return np.random.SeedSequence(int(seed))
+    if isinstance(seed, np.random.Generator):
+        raise TypeError("seed must be an int or a numpy.random.SeedSequence, got a Generator: a Generator's "
+                        "state would make the paths depend on what was drawn before. Pass seed=<int>.")
+    raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
+
+
+def check_batch_shape(batch_shape) -> tuple:
+    if isinstance(batch_shape, numbers.Integral) and not isinstance(batch_shape, bool):
+        batch_shape = (batch_shape,)
+    try:
+        shape = tuple(batch_shape)
+    except TypeError:
+        raise TypeError(f"batch_shape must be a tuple of integers, got {batch_shape!r}; "
+                        f"pass e.g. batch_shape=(1000,).") from None
+    for n in shape:
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
+            raise ValueError(f"batch_shape must hold non-negative integers, got {shape!r}.")
+    return tuple(int(n) for n in shape)
+
+
+def grid(times, dt, n_steps, t0):
+    """``(times, h)``: the grid and its step sizes (exactly ``dt`` on a uniform grid)."""
+    if times is not None:
+        if dt is not None or n_steps is not None:
+            raise ValueError("pass either times=... or dt=... with n_steps=..., not both.")
+        t = check_times(times, "times")
+        return t, np.diff(t)
+    if dt is None or n_steps is None:
+        raise ValueError("the grid is missing: pass times=<increasing array> or dt=<step> and n_steps=<int>.")
+    n = check_positive_int(n_steps, "n_steps")
+    if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
+        raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
+                         f"non-uniform grid.")
+    return float(t0) + float(dt) * np.arange(n + 1, dtype=np.float64), np.full(n, float(dt))
+
+
+def phys_bytes() -> float:
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return float("inf")
+
+
+class SeededDriver(Driver):
+    """Base of the per-path seeded drivers: grid, batch, path indices, ``x0``-like start, ``select``."""
+
+    def _init_common(self, dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes):
+        self.dim = check_positive_int(dim, "dim")
+        self.seed_sequence = check_seed(seed)
+        self.times, self._h = grid(times, dt, n_steps, t0)
+        self.times.setflags(write=False)
+        self.batch_shape = check_batch_shape(batch_shape)
+        self.block_bytes = check_positive_int(block_bytes, "block_bytes")
+        self._paths = None                   # None: all paths 0..n-1 (nothing allocated before blocks())
+
+    def _check_start(self, x0, name: str, dim: int):
+        """A start value broadcastable to ``batch_shape + (dim,)`` (kept unbroadcast until needed)."""
+        z = as_float_array(x0, name, last_dims=(dim,))
+        try:
+            np.broadcast_shapes(z.shape, self.batch_shape + (dim,))
+        except ValueError:
+            raise ValueError(f"{name} of shape {z.shape} does not broadcast to the batch shape "
+                             f"{self.batch_shape} + ({dim},).") from None
+        return z.copy()
+
+    @property
+    def n_paths(self) -> int:
+        """Number of paths (``prod(batch_shape)``)."""
+        return int(np.prod(self.batch_shape, dtype=np.int64))
+
+    @property
+    def path_indices(self) -> np.ndarray:
+        """Flat indices (in the original batch) of this driver's paths; they key the streams."""
+        return np.arange(self.n_paths, dtype=np.int64) if self._paths is None else self._paths.copy()
+
+    def _flat(self, start, dim: int) -> np.ndarray:
+        """A start value (``(dim,)`` or batch-shaped) as ``(n_paths, dim)``."""
+        return np.broadcast_to(start, self.batch_shape + (dim,)).reshape(-1, dim)
+
+    def _starts(self) -> dict:                # pragma: no cover - overridden
+        """The per-path start arrays, by attribute name, and their last dimension."""
+        return {}
+
+    def default_block_steps(self) -> int:
+        """Steps per block used by :meth:`blocks` when ``max_steps`` is None (from ``block_bytes``)."""
+        per_step = max(1, self.n_paths) * self._bytes_per_path_step()
+        return max(1, min(self.n_steps, self.block_bytes // per_step))
+
+    def _block_size(self, max_steps) -> int:
+        K = self.default_block_steps() if max_steps is None else check_positive_int(max_steps, "max_steps")
+        need = float(self.n_paths) * min(K, self.n_steps) * self._bytes_per_path_step()
+        if need > 0.5 * phys_bytes():
+            raise ValueError(f"one block of {min(K, self.n_steps)} step(s) for {self.n_paths} paths needs "
+                             f"{need / 2**30:.1f} GiB, more than half the machine's memory; pass a smaller "
+                             f"max_steps or select(...) fewer paths.")
+        return K
+
+    def select(self, paths):
+        """A driver for a subset of this driver's paths, bitwise equal to those paths of this one.
+
+        Parameters
+        ----------
+        paths : slice, range or array_like of int
+            Flat indices into this driver's batch (C order). The result has ``batch_shape ==
+            (len(paths),)``; its start values are taken from this driver's.
+
+        Returns
+        -------
+        Driver
+            Of the same class.
+        """
+        n = self.n_paths
+        if isinstance(paths, slice):
+            idx = np.arange(n)[paths]
+        else:
+            if isinstance(paths, range):
+                paths = np.arange(paths.start, paths.stop, paths.step)
+            idx = np.asarray(paths)
+            if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
+                raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, "
+                                f"got {paths!r}.")
+            if idx.size and (idx.min() < -n or idx.max() >= n):
+                raise ValueError(f"paths holds indices outside [0, {n}) (this driver has {n} paths), "
+                                 f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
+            idx = np.where(idx < 0, idx + n, idx).astype(np.int64)
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new._paths = self.path_indices[idx]
+        for name, dim in self._starts().items():
+            start = getattr(self, name)
+            if start is not None:
+                setattr(new, name, self._flat(start, dim)[idx])
+        new.batch_shape = (int(idx.size),)
+        return new
+
+    def rough_path(self):
+        """The whole driver as one ``RoughPath`` (refused, naming the size, if it would not fit in memory)."""
+        need = float(self.n_paths) * self.n_steps * 8 * (self.dim + (self.dim ** 2 if self.level == 2 else 0))
+        if need > 0.5 * phys_bytes():
+            raise ValueError(f"the whole path needs {need / 2**30:.1f} GiB, more than half the machine's "
+                             f"memory; pass the driver to solve(...) (it is consumed block by block) or "
+                             f"iterate driver.blocks(), or select(...) fewer paths.")
+        return super().rough_path()
