@@ -96,7 +96,7 @@ import numbers
 import numpy as np
 
 from .validation import as_float_array, check_positive_int, check_rng
-from ._brownian_kernels import _block_areas, _exact_areas_d2
+from ._brownian_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from .level2 import outer
@@ -452,6 +452,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
 
 # ---------------------------------------------------------------------------- the driver
 _BLOCK_BYTES = 2 << 20
+_NO_STATES = np.empty((0, 4), dtype=np.uint64)
 # tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
 _EXACT_T1 = (np.pi ** 2 / 6 - sum(1.0 / k ** 2 for k in range(1, _EXACT_TERMS + 1))) / (2 * np.pi ** 2)
 _EXACT_T2 = (np.pi ** 4 / 90 - sum(1.0 / k ** 4 for k in range(1, _EXACT_TERMS + 1))) / (4 * np.pi ** 4)
@@ -590,7 +591,8 @@ class BrownianDriver(SeededDriver):
         rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
         h_all = self._h
         x = np.array(self._flat(self._x0, d))
-        zbuf = np.empty(P * min(K, N) * max(na, 1)) if self.level == 2 else None
+        rows = 1 if area_streams is None or area_streams.states is not None else P * min(K, N)
+        zbuf = np.empty(rows * max(na, 1))      # one step's normals, or the block's (numpy fallback)
         davie = self.levy_area == "davie" and d > 1
         for k0 in range(0, N, K):
             k1 = min(N, k0 + K)
@@ -598,7 +600,8 @@ class BrownianDriver(SeededDriver):
             h = np.ascontiguousarray(h_all[k0:k1])
             dW = np.empty((P, k, d))
             inc_streams.fill(dW.reshape(P, k * d))
-            dW *= np.sqrt(h)[:, None]
+            x_start = x.copy()
+            _scale_accumulate(dW, np.sqrt(h), x)    # x: the position at the end of the block
             areas = None
             if self.levy_area == "exact":
                 if area_streams.states is None:  # pragma: no cover - only if numpy's algorithms change
@@ -608,13 +611,17 @@ class BrownianDriver(SeededDriver):
                 _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
                                 self.kind == "ito", areas)
             elif self.level == 2:
-                z = zbuf[:P * k * na].reshape(P, k * na)
-                area_streams.fill(z)
                 areas = np.empty((P, k, d, d))
-                _block_areas(dW, h, z.reshape(P, k, na), self.substeps, davie, self.kind == "ito", areas)
-            x0 = x.reshape(self.batch_shape + (d,))
+                if area_streams.states is not None:      # draw each step's normals inside the kernel
+                    _block_areas(dW, h, zbuf[:na].reshape(1, 1, na), area_streams.states, self.substeps, davie,
+                                 self.kind == "ito", areas)
+                else:
+                    z = zbuf[:P * k * na].reshape(P, k * na)
+                    area_streams.fill(z)
+                    _block_areas(dW, h, z.reshape(P, k, na), _NO_STATES, self.substeps, davie,
+                                 self.kind == "ito", areas)
             block = RoughPath(dW.reshape(self.batch_shape + (k, d)),
                               None if areas is None else areas.reshape(self.batch_shape + (k, d, d)),
-                              times=self.times[k0:k1 + 1], x0=x0.copy(), kind=rp_kind, check=False)
-            x += dW.sum(axis=1)
+                              times=self.times[k0:k1 + 1], x0=x_start.reshape(self.batch_shape + (d,)),
+                              kind=rp_kind, check=False)
             yield block
