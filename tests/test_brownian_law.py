@@ -171,7 +171,7 @@ def test_small_blocks_sample_the_same_law():
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 0), ValueError, "dim"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2.0), TypeError, "dim"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, substeps=0), ValueError, "substeps"),
-    (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, levy_area="exact"), ValueError, "levy_area"),
+    (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, levy_area="wiktorsson"), ValueError, "levy_area"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, kind="strat"), ValueError, "kind"),
     (lambda: brownian_increments_and_areas(np.random.default_rng(), 2, 0.1, 2, batch_shape=(-1,)), ValueError, "batch_shape"),
     (lambda: brownian_rough_path([0.0, 0.5, 0.5], 2, np.random.default_rng()), ValueError, "times"),
