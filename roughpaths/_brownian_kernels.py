@@ -19,7 +19,7 @@ with the ½. The random numbers are drawn by the caller (the driver's per-path s
 kernel is deterministic. No temporary larger than ``O(d)``.
 
 Serial on purpose: the cost is dominated by drawing the normals (d = 3, m = 1: the kernel takes
-~15 ns of ~100 ns per path-step), and the machine is shared. ``nogil=True`` lets callers
+about 20 of 120 ns per path-step), and the machine is shared. ``nogil=True`` lets callers
 overlap it with other work. No ``fastmath``: round-off matches a naive per-step numpy
 reimplementation to ~1e-16 relative (``tests/test_brownian_driver_stream.py``).
 """
