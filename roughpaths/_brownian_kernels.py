@@ -19,7 +19,7 @@ with the ½. The random numbers are drawn by the caller (the driver's per-path s
 kernel is deterministic. No temporary larger than ``O(d)``.
 
 Serial on purpose: the cost is dominated by drawing the normals (d = 3, m = 1: the kernel takes
-~15 ns of ~100 ns per path-step), and the machine is shared. ``nogil=True`` lets callers
+about 20 of 120 ns per path-step), and the machine is shared. ``nogil=True`` lets callers
 overlap it with other work. No ``fastmath``: round-off matches a naive per-step numpy
 reimplementation to ~1e-16 relative (``tests/test_brownian_driver_stream.py``).
 """
@@ -33,7 +33,65 @@ from ._random import _pcg64_normal
 
 
 @njit(cache=True, nogil=True)
-def _block_areas(dW, h, buf, m, davie, ito, out):
+def _scale_accumulate(dW, sqh, x):
+    """``dW[p, k] *= sqh[k]`` and ``x[p] += Σ_k dW[p, k]`` in one pass (numpy's middle-axis sum
+    measured ~4x the cost of the scaling)."""
+    P, K, d = dW.shape
+    for p in range(P):
+        for k in range(K):
+            for j in range(d):
+                v = dW[p, k, j] * sqh[k]
+                dW[p, k, j] = v
+                x[p, j] += v
+
+
+@njit(cache=True, nogil=True)
+def _areas_m1(dW, h, buf, states, davie, ito, out):
+    """:func:`_block_areas` for ``m = 1`` (Davie's own method, ``A = H ∧ W + λ``, no substeps).
+
+    A separate loop nest: inside the general one it measured ~1.5x slower.
+    """
+    P, K, d = dW.shape
+    sHs = np.sqrt(h / 12.0)
+    cs = h / np.sqrt(12.0)
+    draw = states.shape[0] > 0
+    na = buf.shape[2]
+    zero = np.uint64(0)
+    sh, sl, ih, il = zero, zero, zero, zero
+    for p in range(P):
+        if draw:
+            sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+        for r in range(K):
+            hr = h[r]
+            sH = sHs[r]
+            c = cs[r]
+            if draw:
+                for i in range(na):
+                    buf[0, 0, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
+                bp, br = 0, 0
+            else:
+                bp, br = p, r
+            q = 0
+            for i in range(d):
+                Wi = dW[p, r, i]
+                Hi = sH * buf[bp, br, i]
+                out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
+                for j in range(i + 1, d):
+                    Wj = dW[p, r, j]
+                    v = Hi * Wj - sH * buf[bp, br, j] * Wi
+                    if davie:
+                        v += buf[bp, br, d + q] * c
+                    sym = 0.5 * Wi * Wj
+                    out[p, r, i, j] = sym + v
+                    out[p, r, j, i] = sym - v
+                    q += 1
+        if draw:
+            states[p, 0] = sh
+            states[p, 1] = sl
+
+
+@njit(cache=True, nogil=True)
+def _block_areas(dW, h, buf, states, m, davie, ito, out):
     """Level-2 step areas of a block ``(P, K)`` of path-steps from the per-step packed normals.
 
     With the layout of :class:`roughpaths.BrownianDriver`'s
@@ -41,10 +99,8 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
     substep-major, only if ``m > 1``), the space-time normals ``ζ`` (``m d``) and, for Davie's
     method, the ``d(d-1)/2`` normals ``λ`` (``numpy.triu_indices`` order).
 
-    Written as one loop nest with a branch for ``m = 1`` (Davie's own method:
-    ``A = H ∧ W + λ``, no substep loop): a per-step helper function taking the arrays measured
-    3-5x slower (array reference counting per call), the ``m = 1`` branch ~1.5x faster than
-    the general loop.
+    Written as loop nests (a per-step helper function taking the arrays measured 3-5x slower:
+    array reference counting per call); ``m = 1`` has its own, :func:`_areas_m1`.
 
     Parameters
     ----------
@@ -52,8 +108,14 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
         Step increments.
     h : (K,) float64
         Step sizes.
-    buf : (P, K, n_area) float64
-        Standard normals, ``n_area = (m d if m > 1 else 0) + m d + (d(d-1)/2 if davie else 0)``.
+    buf : (P, K, n_area) or (1, 1, n_area) float64
+        Standard normals, ``n_area = (m d if m > 1 else 0) + m d + (d(d-1)/2 if davie else 0)``;
+        with ``states``, a scratch row that receives each step's normals as they are drawn.
+    states : (P, 4) uint64 or (0, 4)
+        If not empty, the PCG64 states of the paths' area streams (:mod:`roughpaths._random`):
+        each step's ``n_area`` normals are drawn here, in order, instead of read from ``buf``
+        (same numbers as drawing the block first; saves the buffer's memory traffic). The
+        states advance in place.
     m : int
         Substeps per step.
     davie, ito : bool
@@ -61,6 +123,9 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
     out : (P, K, d, d) float64
         Receives ``A + ½ W⊗W (- ½ h I)``.
     """
+    if m == 1:
+        _areas_m1(dW, h, buf, states, davie, ito, out)
+        return
     P, K, d = dW.shape
     npair = d * (d - 1) // 2
     inv_m = 1.0 / m
@@ -70,40 +135,36 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
     A = np.empty(max(npair, 1))
     sHs = np.sqrt(h * (inv_m / 12.0))            # √(δ/12), δ = h/m
     cs = h / np.sqrt(12.0 * m)                   # Davie's scale h/√(12 m)
+    draw = states.shape[0] > 0
+    na = buf.shape[2]
+    zero = np.uint64(0)
+    sh, sl, ih, il = zero, zero, zero, zero
     for p in range(P):
+        if draw:
+            sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
         for r in range(K):
             hr = h[r]
             sH = sHs[r]
             c = cs[r]
-            if m == 1:
-                q = 0
-                for i in range(d):
-                    Wi = dW[p, r, i]
-                    Hi = sH * buf[p, r, i]
-                    out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
-                    for j in range(i + 1, d):
-                        Wj = dW[p, r, j]
-                        v = Hi * Wj - sH * buf[p, r, j] * Wi
-                        if davie:
-                            v += buf[p, r, o_lam + q] * c
-                        sym = 0.5 * Wi * Wj
-                        out[p, r, i, j] = sym + v
-                        out[p, r, j, i] = sym - v
-                        q += 1
-                continue
+            if draw:
+                for i in range(na):
+                    buf[0, 0, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
+                bp, br = 0, 0
+            else:
+                bp, br = p, r
             sq = np.sqrt(hr * inv_m)
             for j in range(d):
                 acc = 0.0
                 for k in range(m):
-                    acc += buf[p, r, k * d + j]
+                    acc += buf[bp, br, k * d + j]
                 shift[j] = sq * acc * inv_m - dW[p, r, j] * inv_m
                 s[j] = 0.0
             for q in range(npair):
                 A[q] = 0.0
             for k in range(m):
                 for j in range(d):
-                    w[j] = sq * buf[p, r, k * d + j] - shift[j]
-                    a[j] = sH * buf[p, r, o_zeta + k * d + j] + 0.5 * s[j]
+                    w[j] = sq * buf[bp, br, k * d + j] - shift[j]
+                    a[j] = sH * buf[bp, br, o_zeta + k * d + j] + 0.5 * s[j]
                     s[j] += w[j]
                 q = 0
                 for i in range(d):         # (g - gᵀ)_{ij}, g = Σ_k a_k ⊗ w_k
@@ -115,11 +176,14 @@ def _block_areas(dW, h, buf, m, davie, ito, out):
                 Wi = dW[p, r, i]
                 out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
                 for j in range(i + 1, d):
-                    v = A[q] + (buf[p, r, o_lam + q] * c if davie else 0.0)
+                    v = A[q] + (buf[bp, br, o_lam + q] * c if davie else 0.0)
                     sym = 0.5 * Wi * dW[p, r, j]
                     out[p, r, i, j] = sym + v
                     out[p, r, j, i] = sym - v
                     q += 1
+        if draw:
+            states[p, 0] = sh
+            states[p, 1] = sl
 
 
 # ----------------------------------------------------------------------------- exact d = 2 area

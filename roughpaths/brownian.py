@@ -95,14 +95,14 @@ import numbers
 
 import numpy as np
 
-from .validation import as_float_array, check_positive_int, check_rng
-from ._brownian_kernels import _block_areas, _exact_areas_d2
+from .validation import as_float_array, check_positive_int
+from ._brownian_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
-from .level2 import outer
 from .rough_path import RoughPath
+from .brownian_refine import refine  # noqa: F401  (its home is brownian_refine; kept importable here)
 
-__all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "refine", "DEFAULT_SUBSTEPS"]
+__all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "DEFAULT_SUBSTEPS"]
 
 #: Default number of substeps per grid step for the Lévy-area sampler, the same for every entry point
 #: (Davie's own method: exact second moments at the lowest cost).
@@ -155,11 +155,6 @@ def _seed_from_rng(rng) -> np.random.SeedSequence:
 
 
 # ---------------------------------------------------------------------------- kernels
-def _wedge(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``u ∧ v = u⊗v - v⊗u``, batched."""
-    return outer(u, v) - outer(v, u)
-
-
 def _levy_area_from_substeps(w: np.ndarray, H: np.ndarray) -> np.ndarray:
     r"""Chen-summed conditional-mean Lévy area of one step from its substeps.
 
@@ -177,17 +172,6 @@ def _levy_area_from_substeps(w: np.ndarray, H: np.ndarray) -> np.ndarray:
     s_excl = np.cumsum(w, axis=-2) - w
     g = np.matmul(np.swapaxes(H + 0.5 * s_excl, -1, -2), w)
     return g - np.swapaxes(g, -1, -2)
-
-
-def _antisym_normal(rng: np.random.Generator, shape: tuple, d: int) -> np.ndarray:
-    """Antisymmetric ``(..., d, d)`` with iid N(0, 1) entries above the diagonal."""
-    iu = np.triu_indices(d, 1)
-    out = np.zeros(shape + (d, d))
-    if iu[0].size:
-        z = rng.standard_normal(shape + (iu[0].size,))
-        out[..., iu[0], iu[1]] = z
-        out[..., iu[1], iu[0]] = -z
-    return out
 
 
 # ---------------------------------------------------------------------------- public API
@@ -307,151 +291,9 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
                           substeps=substeps, x0=x0).rough_path()
 
 
-# ---------------------------------------------------------------------------- refinement
-def _split(rng, W, L, h, rho, with_area: bool):
-    r"""Split steps ``(W, L)`` of length ``h`` into a first part of length ``rho h`` and the rest.
-
-    ``W (R, d)``, ``L (R, d, d)`` (Lévy areas) or None, ``h (R,)``. Returns
-    ``(w1, L1, w2, L2)`` with ``w1 + w2 = W`` and ``L1 + L2 + ½ (w1 ∧ w2 ... ) = L`` exactly
-    (the cross term of the split is ``Alt(w1 ⊗ w2) = ½ b ∧ W`` with ``b = w1 - rho W``).
-    """
-    R, d = W.shape
-    q = rho * (1.0 - rho)
-    hc = h[:, None]
-    b = rng.standard_normal((R, d)) * np.sqrt(q * hc)
-    if not with_area:
-        return rho * W + b, None, (1.0 - rho) * W - b, None
-    h1, h2 = rho * h, (1.0 - rho) * h
-    # prior: Davie-type pieces built on the prior increments (exact conditional second moments)
-    w1, w2 = rho * W + b, (1.0 - rho) * W - b
-    H1 = rng.standard_normal((R, d)) * np.sqrt(h1 / 12.0)[:, None]
-    H2 = rng.standard_normal((R, d)) * np.sqrt(h2 / 12.0)[:, None]
-    L1 = _wedge(H1, w1) + _antisym_normal(rng, (R,), d) * (h1 / np.sqrt(12.0))[:, None, None]
-    L2 = _wedge(H2, w2) + _antisym_normal(rng, (R,), d) * (h2 / np.sqrt(12.0))[:, None, None]
-    # Matheron update: Y <- Y + Cov(Y, Z | W) Var(Z | W)^{-1} (L - Z(Y)), Z(Y) = L1 + L2 + ½ b∧W
-    r = L - (L1 + L2 + 0.5 * _wedge(b, W))
-    hh = h[:, None, None]
-    u = np.einsum("...ij,...j->...i", r, W)
-    norm2 = np.einsum("...i,...i->...", W, W)[:, None, None]
-    v = (12.0 / hh ** 2) * (r - _wedge(u, W) / (hh + norm2))       # Var(Z|W)^{-1} r
-    vW = np.einsum("...ij,...j->...i", v, W)
-    T = _wedge(vW, W)                                                # v N + N v, N = W Wᵀ
-    b = b + 0.5 * q * hc * vW
-    L1 = L1 + (h1[:, None, None] ** 2 / 12.0) * v + (h1[:, None, None] / 12.0) * (rho ** 2 * T + 2 * q * hh * v)
-    L2 = L2 + (h2[:, None, None] ** 2 / 12.0) * v + (h2[:, None, None] / 12.0) * ((1 - rho) ** 2 * T + 2 * q * hh * v)
-    return rho * W + b, L1, (1.0 - rho) * W - b, L2
-
-
-def refine(X: RoughPath, factor, rng) -> RoughPath:
-    r"""Refine a Brownian rough path: split every step into ``factor`` equal substeps, Chen-consistently.
-
-    The fine path restricts back exactly: ``refine(X, m, rng).restrict(X.times)`` equals ``X``
-    to round-off (``chen_defect`` ~ 1e-16 relative), for every sample.
-
-    Parameters
-    ----------
-    X : RoughPath
-        A Brownian rough path (``kind`` ``"geometric"`` for Stratonovich, ``"ito"``, or level 1),
-        e.g. from :func:`brownian_rough_path`.
-    factor : int
-        Substeps per step, ``>= 1`` (``1`` returns ``X`` unchanged).
-    rng : numpy.random.Generator
-        Source of randomness, drawn from directly (not the driver's per-path streams: the
-        refined path depends on the whole batch and on ``factor``'s sequence of splits).
-
-    Returns
-    -------
-    RoughPath
-        Same kind, batch shape and ``x0``, on the grid with ``factor`` equal substeps per step.
-
-    Notes
-    -----
-    The step ``[0, h]`` is cut by successive binary splits ``h = δ + (h - δ)``. One split of a
-    step with increment ``W`` and Lévy area ``L`` draws the bridge point
-    ``b = w_1 - ρW ~ N(0, ρ(1-ρ)h I)`` and Davie-type Lévy areas ``L_k = H_k ∧ w_k + λ_k`` for both
-    parts, then corrects ``(b, L_1, L_2)`` by the linear (Matheron / Kalman) update
-    ``Y ← Y + Cov(Y, Z | W) Var(Z | W)^{-1} (L - Z(Y))`` for the constraint
-    ``Z(Y) = L_1 + L_2 + ½ b ∧ W = L``, which is linear in ``(b, L_1, L_2)`` given ``W``, with the
-    exact Brownian conditional covariances ``Var(L | W) = h²/12 + h (W⊗W-terms)/12``; its inverse
-    is in closed form (no linear solves).
-
-    What is exact:
-
-    * Chen: the refined path restricts to ``X`` exactly (to round-off), path by path;
-    * for ``factor = 2``: every second moment of the fine ``(w_1, L_1, w_2, L_2)``, jointly with the
-      coarse ``(W, L)`` and conditionally on ``W``, equals the Brownian one, provided the coarse
-      ``L`` has the Brownian conditional variance given ``W`` (true for :func:`brownian_rough_path`
-      with ``levy_area="davie"``); in particular the fine increments have mean ``W/2`` and
-      covariance ``h/4 I`` given ``W`` (the bridge), and fine Lévy areas variance ``(h/2)²/4``.
-
-    What is approximate:
-
-    * the fine increments are not exactly Gaussian given ``W`` (they are correlated with the coarse
-      area, as in the true conditional law given ``(W, L)``, which is not Gaussian either);
-    * higher moments (the fine Lévy areas are lighter-tailed than Brownian ones);
-    * for ``factor > 2``, second moments: each later split treats the previous split's output as if
-      it had the Brownian conditional law given its increment, which it has only on average. The
-      fine Lévy-area variance comes out too large: measured (d = 3, 2·10⁵ paths) by +7 % for
-      ``factor = 3``, +11 % for 4, +18 % for 8 (repeated halving is worse: +12 % at 4, +21 % at 8).
-      The fine increments keep the bridge covariance to sampling error (< 1 %), but explain too
-      little of the coarse area: the polygon through the refined points has Lévy-area variance
-      9 % (factor 4) / 5 % (factor 16) below the Brownian ``(1 - 1/m) h²/4``. A few
-      preconditioned Crank–Nicolson Metropolis sweeps on the increments (target: the bridge
-      conditioned on the coarse area under the Davie model) remove this bias (40 sweeps: +0.8 %
-      at ``factor = 8``), but cost ~40 times more; not done here.
-
-    Itô paths are converted to Stratonovich (``+ ½ h I``), refined, and converted back.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from roughpaths.rough_path import chen_defect
-    >>> rng = np.random.default_rng(2)
-    >>> X = brownian_rough_path(np.linspace(0, 1, 5), 2, rng, batch_shape=(10,))
-    >>> Y = refine(X, 3, rng)
-    >>> Y.n_steps, chen_defect(Y, X) < 1e-13
-    (12, True)
-    """
-    if not isinstance(X, RoughPath):
-        raise TypeError(f"X must be a RoughPath, got {type(X).__name__}; build one with "
-                        f"brownian_rough_path(times, dim, rng).")
-    m = check_positive_int(factor, "factor")
-    rng = check_rng(rng, "rng")
-    if X.level == 2 and X.kind not in ("geometric", "ito"):
-        raise ValueError(f"X.kind must be 'geometric' (Stratonovich) or 'ito' to refine as Brownian "
-                         f"motion, got {X.kind!r}; build X with brownian_rough_path.")
-    if m == 1:
-        return X
-    t, h = X.times, X.dt
-    N, d, batch = X.n_steps, X.dim, X.batch_shape
-    with_area = X.level == 2
-    W = X.increments.reshape(-1, d)
-    hr = np.broadcast_to(h, batch + (N,)).reshape(-1)
-    L = X.step_levy_areas.reshape(-1, d, d) if with_area else None
-    ws, Ls = [], []
-    rest_W, rest_L, rest_h = W, L, hr
-    for j in range(m - 1):
-        rho = 1.0 / (m - j)
-        w1, L1, rest_W, rest_L = _split(rng, rest_W, rest_L, rest_h, rho, with_area)
-        rest_h = (1.0 - rho) * rest_h
-        ws.append(w1)
-        Ls.append(L1)
-    ws.append(rest_W)
-    Ls.append(rest_L)
-    dw = np.stack(ws, axis=1).reshape(batch + (N * m, d))
-    fine_t = np.append((t[:-1, None] + h[:, None] * (np.arange(m) / m)).reshape(-1), t[-1])
-    if not with_area:
-        return RoughPath(dw, None, times=fine_t, x0=X.x0, check=False)
-    A = np.stack(Ls, axis=1).reshape(batch + (N * m, d, d))
-    areas = A + 0.5 * outer(dw, dw)
-    if X.kind == "ito":
-        fine_h = np.diff(fine_t)
-        areas[..., np.arange(d), np.arange(d)] -= 0.5 * fine_h[:, None]
-    return RoughPath(dw, areas, times=fine_t, x0=X.x0, kind=X.kind, check=False)
-
-
 # ---------------------------------------------------------------------------- the driver
 _BLOCK_BYTES = 2 << 20
+_NO_STATES = np.empty((0, 4), dtype=np.uint64)
 # tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
 _EXACT_T1 = (np.pi ** 2 / 6 - sum(1.0 / k ** 2 for k in range(1, _EXACT_TERMS + 1))) / (2 * np.pi ** 2)
 _EXACT_T2 = (np.pi ** 4 / 90 - sum(1.0 / k ** 4 for k in range(1, _EXACT_TERMS + 1))) / (4 * np.pi ** 4)
@@ -590,7 +432,8 @@ class BrownianDriver(SeededDriver):
         rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
         h_all = self._h
         x = np.array(self._flat(self._x0, d))
-        zbuf = np.empty(P * min(K, N) * max(na, 1)) if self.level == 2 else None
+        rows = 1 if area_streams is None or area_streams.states is not None else P * min(K, N)
+        zbuf = np.empty(rows * max(na, 1))      # one step's normals, or the block's (numpy fallback)
         davie = self.levy_area == "davie" and d > 1
         for k0 in range(0, N, K):
             k1 = min(N, k0 + K)
@@ -598,7 +441,8 @@ class BrownianDriver(SeededDriver):
             h = np.ascontiguousarray(h_all[k0:k1])
             dW = np.empty((P, k, d))
             inc_streams.fill(dW.reshape(P, k * d))
-            dW *= np.sqrt(h)[:, None]
+            x_start = x.copy()
+            _scale_accumulate(dW, np.sqrt(h), x)    # x: the position at the end of the block
             areas = None
             if self.levy_area == "exact":
                 if area_streams.states is None:  # pragma: no cover - only if numpy's algorithms change
@@ -608,13 +452,17 @@ class BrownianDriver(SeededDriver):
                 _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
                                 self.kind == "ito", areas)
             elif self.level == 2:
-                z = zbuf[:P * k * na].reshape(P, k * na)
-                area_streams.fill(z)
                 areas = np.empty((P, k, d, d))
-                _block_areas(dW, h, z.reshape(P, k, na), self.substeps, davie, self.kind == "ito", areas)
-            x0 = x.reshape(self.batch_shape + (d,))
+                if area_streams.states is not None:      # draw each step's normals inside the kernel
+                    _block_areas(dW, h, zbuf[:na].reshape(1, 1, na), area_streams.states, self.substeps, davie,
+                                 self.kind == "ito", areas)
+                else:
+                    z = zbuf[:P * k * na].reshape(P, k * na)
+                    area_streams.fill(z)
+                    _block_areas(dW, h, z.reshape(P, k, na), _NO_STATES, self.substeps, davie,
+                                 self.kind == "ito", areas)
             block = RoughPath(dW.reshape(self.batch_shape + (k, d)),
                               None if areas is None else areas.reshape(self.batch_shape + (k, d, d)),
-                              times=self.times[k0:k1 + 1], x0=x0.copy(), kind=rp_kind, check=False)
-            x += dW.sum(axis=1)
+                              times=self.times[k0:k1 + 1], x0=x_start.reshape(self.batch_shape + (d,)),
+                              kind=rp_kind, check=False)
             yield block
