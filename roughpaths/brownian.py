@@ -98,6 +98,8 @@ import numpy as np
 from .validation import as_float_array, check_positive_int
 from ._brownian_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
+from .levy_area import LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms, \
+    levy_areas_from_normals
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from .rough_path import RoughPath
 from .brownian_refine import refine  # noqa: F401  (its home is brownian_refine; kept importable here)
@@ -108,7 +110,8 @@ __all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_pa
 #: (Davie's own method: exact second moments at the lowest cost).
 DEFAULT_SUBSTEPS = 1
 
-_LEVY_METHODS = ("davie", "foster", "exact")
+_LEVY_METHODS = ("davie", "foster", "exact") + LEVY_AREA_METHODS + ("auto",)
+_FOURIER = LEVY_AREA_METHODS + ("auto",)
 #: Series terms drawn exactly by ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
 _EXACT_TERMS = 8
 _KINDS = ("stratonovich", "ito")
@@ -323,17 +326,22 @@ class BrownianDriver(SeededDriver):
         Start of the uniform grid (default 0).
     batch_shape : tuple of int
         Independent paths, default ``()``; path ``i`` is the ``i``-th in C order of the batch.
-    levy_area : {"davie", "foster", "exact"} or None
+    levy_area : {"davie", "foster", "exact", "fourier", "mrongowius-rossler", "wiktorsson", "auto"} or None
         Area method (default ``"davie"``, exact second moments); ``"exact"``: the exact law given
-        the increment, ``d = 2`` only (module docstring). ``None``: increments only (``level == 1``).
+        the increment, ``d = 2`` only (module docstring); the error-controlled Fourier samplers of
+        :mod:`roughpaths.levy_area` (``"auto"`` picks the cheapest per step size), with the target
+        ``levy_area_error``. ``None``: increments only (``level == 1``).
     substeps : int
-        Substeps ``m`` per step of the area sampler, default :data:`DEFAULT_SUBSTEPS` ``= 1``
-        (Davie's own method). Larger ``m`` lowers the L² error (``h/√(6m)`` for davie,
-        ``h/√(12m)`` for foster) at ``~2 m d`` more normals per step.
+        Substeps ``m`` per step of the ``"davie"``/``"foster"`` sampler, default
+        :data:`DEFAULT_SUBSTEPS` ``= 1`` (Davie's own method). Larger ``m`` lowers the L² error
+        (``h/√(6m)`` for davie, ``h/√(12m)`` for foster) at ``~2 m d`` more normals per step.
     kind : {"stratonovich", "ito"}
         Stratonovich (``RoughPath.kind == "geometric"``) or Itô areas.
     x0 : array_like, shape ``(d,)`` or ``(*batch_shape, d)``, optional
         Starting point (default 0).
+    levy_area_error : float or callable h -> float, optional
+        Per-component L² error per step for the Fourier samplers; default ``h^1.5`` (the accuracy at
+        which the order-1 schemes keep order 1 against Brownian motion).
     block_bytes : int
         Target memory of one block (increments, areas and random buffers), default 2 MiB (at
         least one step per block); it sets the default of :meth:`blocks`, never the numbers.
@@ -351,7 +359,9 @@ class BrownianDriver(SeededDriver):
       ``(m d if m > 1) + m d + (d(d-1)/2 if davie)`` normals: the bridge normals, the
       space-time normals and Davie's normals, in this order (see
       :mod:`roughpaths._brownian_kernels`); for ``"exact"`` a variable number, in the order
-      documented in ``_brownian_kernels._exact_areas_d2``.
+      documented in ``_brownian_kernels._exact_areas_d2``; for the Fourier samplers
+      ``levy_area_normals(method, d, n)`` normals with the ``(method, n)`` of the step's length, in the
+      order of :func:`roughpaths.levy_area.levy_areas_from_normals`.
 
     So a path's numbers depend only on ``seed``, ``i``, and (for the areas) ``levy_area`` and
     ``substeps``: not on the block size, on which paths are generated together (:meth:`select`),
@@ -376,10 +386,22 @@ class BrownianDriver(SeededDriver):
     """
 
     def __init__(self, dim, *, seed, times=None, dt=None, n_steps=None, t0=0.0, batch_shape=(),
-                 levy_area="davie", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES):
+                 levy_area="davie", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES,
+                 levy_area_error=None):
         self._init_common(dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes)
         self.levy_area = _check_levy_method(levy_area)
         self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
+        self.levy_area_error = None
+        self._fourier_plan = None
+        if self.levy_area in _FOURIER:
+            if substeps is not None:
+                raise ValueError(f"substeps applies to levy_area='davie' or 'foster'; levy_area="
+                                 f"{self.levy_area!r} sets its accuracy by levy_area_error (default h^1.5).")
+            self.levy_area_error = levy_area_error
+            self._fourier_plan = self._plan_fourier(levy_area_error)
+        elif levy_area_error is not None:
+            raise ValueError(f"levy_area_error applies to the error-controlled methods {_FOURIER}, not to "
+                             f"levy_area={self.levy_area!r}.")
         if self.levy_area == "exact":
             if self.dim != 2:
                 raise ValueError(f"levy_area='exact' is available for dim=2 only, got dim={self.dim}; use "
@@ -394,11 +416,28 @@ class BrownianDriver(SeededDriver):
     def _starts(self) -> dict:
         return {"_x0": self.dim}
 
+    def _plan_fourier(self, error):
+        """Per step: (method, terms, normals) of the error-controlled sampler (uniform grids: one entry)."""
+        h = np.asarray(self._h, dtype=np.float64)
+        uniq = np.unique(h)
+        plan = {}
+        for hk in uniq:
+            err = None if error is None else (error(float(hk)) if callable(error) else error)
+            if self.levy_area == "auto":
+                method, n = choose_levy_area_method(self.dim, float(hk), err)
+            else:
+                method = self.levy_area
+                n = levy_area_terms(method, self.dim, float(hk), err)
+            plan[float(hk)] = (method, n, levy_area_normals(method, self.dim, n))
+        return plan
+
     # ------------------------------------------------------------------ layout
     @property
     def _n_area_normals(self) -> int:
         if self.levy_area in (None, "exact"):
             return 0
+        if self._fourier_plan is not None:
+            return max(w for _, _, w in self._fourier_plan.values())
         d, m = self.dim, self.substeps
         return (m * d if m > 1 else 0) + m * d + (d * (d - 1) // 2 if self.levy_area == "davie" else 0)
 
@@ -409,6 +448,23 @@ class BrownianDriver(SeededDriver):
     def __repr__(self) -> str:
         return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
                 f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
+
+    def _fourier_areas(self, dW, h, area_streams):
+        """Areas of a block ``(P, k, d, d)`` from the error-controlled samplers, step by step in stream order."""
+        P, k, d = dW.shape
+        plan = [self._fourier_plan[float(hk)] for hk in h]
+        widths = np.array([w for _, _, w in plan])
+        z = np.empty((P, int(widths.sum())))
+        area_streams.fill(z)                     # each path's stream: the block's steps in order
+        offsets = np.concatenate([[0], np.cumsum(widths)])
+        areas = np.empty((P, k, d, d))
+        for j in range(k):
+            method, n, w = plan[j]
+            A = levy_areas_from_normals(dW[:, j], float(h[j]), z[:, offsets[j]:offsets[j + 1]], method, n)
+            areas[:, j] = A + 0.5 * dW[:, j, :, None] * dW[:, j, None, :]
+            if self.kind == "ito":
+                areas[:, j] -= 0.5 * float(h[j]) * np.eye(d)
+        return areas
 
     # ------------------------------------------------------------------ generation
     def blocks(self, max_steps=None):
@@ -451,6 +507,8 @@ class BrownianDriver(SeededDriver):
                 areas = np.empty((P, k, d, d))
                 _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
                                 self.kind == "ito", areas)
+            elif self._fourier_plan is not None:
+                areas = self._fourier_areas(dW, h, area_streams)
             elif self.level == 2:
                 areas = np.empty((P, k, d, d))
                 if area_streams.states is not None:      # draw each step's normals inside the kernel

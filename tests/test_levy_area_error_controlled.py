@@ -101,3 +101,25 @@ def test_bad_arguments_are_refused_clearly():
         levy_area_terms("fourier", 2, 1.0, error=1e-9)
     with pytest.raises(ValueError, match="normals must have last dimension"):
         levy_areas_from_normals(np.zeros(2), 0.1, np.zeros(3), "fourier", 1)
+
+
+@pytest.mark.parametrize("method", ["mrongowius-rossler", "wiktorsson", "fourier", "auto"])
+def test_brownian_driver_uses_the_error_controlled_samplers_on_its_streams(method):
+    """The driver's areas are levy_areas_from_normals of the documented per-path area stream, any blocks."""
+    from roughpaths import BrownianDriver
+
+    d, h, N, P = 3, 1 / 64, 10, 4
+    drv = BrownianDriver(d, seed=5, dt=h, n_steps=N, batch_shape=(P,), levy_area=method)
+    X = drv.rough_path()
+    m, n = choose_levy_area_method(d, h) if method == "auto" else (method, levy_area_terms(method, d, h))
+    w = levy_area_normals(m, d, n)
+    ss = np.random.SeedSequence(5)
+    for i in range(P):
+        g = np.random.Generator(np.random.PCG64(np.random.SeedSequence(ss.entropy, spawn_key=(i, 1))))
+        z = g.standard_normal(N * w).reshape(N, w)
+        A = levy_areas_from_normals(X.increments[i], h, z, m, n)
+        np.testing.assert_allclose(X.areas[i], A + 0.5 * X.increments[i][:, :, None] * X.increments[i][:, None, :],
+                                   rtol=0, atol=1e-15)
+    blocks = list(drv.blocks(max_steps=3))
+    np.testing.assert_array_equal(np.concatenate([b.areas for b in blocks], axis=1), X.areas)
+    np.testing.assert_array_equal(drv.select([2]).rough_path().areas[0], X.areas[2])
