@@ -98,8 +98,7 @@ import numpy as np
 from .validation import as_float_array, check_positive_int
 from ._brownian_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
-from .levy_area import LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms, \
-    levy_areas_from_normals
+from .levy_area import LEVY_AREA_METHODS, block_areas, step_plan
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from .rough_path import RoughPath
 from .brownian_refine import refine  # noqa: F401  (its home is brownian_refine; kept importable here)
@@ -398,7 +397,7 @@ class BrownianDriver(SeededDriver):
                 raise ValueError(f"substeps applies to levy_area='davie' or 'foster'; levy_area="
                                  f"{self.levy_area!r} sets its accuracy by levy_area_error (default h^1.5).")
             self.levy_area_error = levy_area_error
-            self._fourier_plan = self._plan_fourier(levy_area_error)
+            self._fourier_plan = step_plan(self.levy_area, self.dim, self._h, levy_area_error)
         elif levy_area_error is not None:
             raise ValueError(f"levy_area_error applies to the error-controlled methods {_FOURIER}, not to "
                              f"levy_area={self.levy_area!r}.")
@@ -415,21 +414,6 @@ class BrownianDriver(SeededDriver):
 
     def _starts(self) -> dict:
         return {"_x0": self.dim}
-
-    def _plan_fourier(self, error):
-        """Per step: (method, terms, normals) of the error-controlled sampler (uniform grids: one entry)."""
-        h = np.asarray(self._h, dtype=np.float64)
-        uniq = np.unique(h)
-        plan = {}
-        for hk in uniq:
-            err = None if error is None else (error(float(hk)) if callable(error) else error)
-            if self.levy_area == "auto":
-                method, n = choose_levy_area_method(self.dim, float(hk), err)
-            else:
-                method = self.levy_area
-                n = levy_area_terms(method, self.dim, float(hk), err)
-            plan[float(hk)] = (method, n, levy_area_normals(method, self.dim, n))
-        return plan
 
     # ------------------------------------------------------------------ layout
     @property
@@ -448,23 +432,6 @@ class BrownianDriver(SeededDriver):
     def __repr__(self) -> str:
         return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
                 f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
-
-    def _fourier_areas(self, dW, h, area_streams):
-        """Areas of a block ``(P, k, d, d)`` from the error-controlled samplers, step by step in stream order."""
-        P, k, d = dW.shape
-        plan = [self._fourier_plan[float(hk)] for hk in h]
-        widths = np.array([w for _, _, w in plan])
-        z = np.empty((P, int(widths.sum())))
-        area_streams.fill(z)                     # each path's stream: the block's steps in order
-        offsets = np.concatenate([[0], np.cumsum(widths)])
-        areas = np.empty((P, k, d, d))
-        for j in range(k):
-            method, n, w = plan[j]
-            A = levy_areas_from_normals(dW[:, j], float(h[j]), z[:, offsets[j]:offsets[j + 1]], method, n)
-            areas[:, j] = A + 0.5 * dW[:, j, :, None] * dW[:, j, None, :]
-            if self.kind == "ito":
-                areas[:, j] -= 0.5 * float(h[j]) * np.eye(d)
-        return areas
 
     # ------------------------------------------------------------------ generation
     def blocks(self, max_steps=None):
@@ -508,7 +475,10 @@ class BrownianDriver(SeededDriver):
                 _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
                                 self.kind == "ito", areas)
             elif self._fourier_plan is not None:
-                areas = self._fourier_areas(dW, h, area_streams)
+                widths = [self._fourier_plan[float(hk)][2] for hk in h]
+                z = np.empty((P, int(sum(widths))))
+                area_streams.fill(z)                 # each path's stream: the block's steps in order
+                areas = block_areas(dW, h, self._fourier_plan, z, self.kind == "ito")
             elif self.level == 2:
                 areas = np.empty((P, k, d, d))
                 if area_streams.states is not None:      # draw each step's normals inside the kernel

@@ -251,3 +251,37 @@ def sample_levy_areas(increments, h: float, rng, *, method: str = "auto", error:
         n = levy_area_terms(method, d, h, error)
     z = rng.standard_normal(w.shape[:-1] + (levy_area_normals(method, d, n),))
     return levy_areas_from_normals(w, h, z, method, n)
+
+
+# ---------------------------------------------------------------------- for the Brownian driver
+def step_plan(method: str, dim: int, steps, error=None) -> dict:
+    """``{h: (method, n, normals)}`` for every distinct step length ``h`` in ``steps`` (``"auto"`` resolved per ``h``).
+
+    ``error`` is a number, a callable ``h -> error``, or None (``h^1.5``).
+    """
+    plan = {}
+    for hk in np.unique(np.asarray(steps, dtype=np.float64)):
+        hk = float(hk)
+        err = None if error is None else (error(hk) if callable(error) else error)
+        if method == "auto":
+            m, n = choose_levy_area_method(dim, hk, err)
+        else:
+            m, n = _check_method(method, allow_auto=False), levy_area_terms(method, dim, hk, err)
+        plan[hk] = (m, n, levy_area_normals(m, dim, n))
+    return plan
+
+
+def block_areas(dW, h, plan, normals, ito: bool) -> np.ndarray:
+    """Full areas ``(P, k, d, d)`` of a block from its increments ``(P, k, d)``, step lengths ``(k,)`` and the
+    paths' normals ``(P, Σ widths)`` consumed step by step in order (Stratonovich, or Itô if ``ito``)."""
+    P, k, d = dW.shape
+    areas = np.empty((P, k, d, d))
+    off = 0
+    for j in range(k):
+        method, n, w = plan[float(h[j])]
+        A = levy_areas_from_normals(dW[:, j], float(h[j]), normals[:, off:off + w], method, n)
+        off += w
+        areas[:, j] = A + 0.5 * dW[:, j, :, None] * dW[:, j, None, :]
+        if ito:
+            areas[:, j] -= 0.5 * float(h[j]) * np.eye(d)
+    return areas
