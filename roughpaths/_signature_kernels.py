@@ -506,8 +506,9 @@ def lane_sig_ser(x, ub, ulo, uhi, nchunks, m, offsets):
 # word u w splits as index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
 # Backward through S = S_prev ⊗ exp(D) per segment (last to first):
 #   S_prev = S ⊗ exp(-D)                       (same Horner step, no storage of the forward pass)
-#   dL/dD  = VJP of D -> exp(D) applied to F = S_prev ▷ G   (left contraction)
-#   G_prev = G ◁ exp(D)                         (right contraction, Horner in the contraction)
+#   then backward through the Horner step itself (_step_vjp), which gives both the cotangent of
+#   D and G_prev = G ◁ exp(D) for about three Horner steps' work.
+# _lcon / _rcon (general contractions) serve the chunk cotangents and the log's backward pass.
 
 
 @njit(cache=True)
@@ -585,69 +586,60 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 
 @njit(cache=True)
-def _rcon_exp(g, delta, d, m, offsets, out, buf):
-    """``out <- g ◁ exp(delta)``: ``out_i = sum_j iota^j g_{i+j} / j!``, Horner in ``iota``.
+def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
 
-    ``iota`` contracts the last letter with ``delta``; for each ``i``: ``T = g_m``,
-    ``T <- g_k + iota(T) / (k + 1 - i)`` for ``k = m-1 .. i``. ``buf`` scratch of ``2 d^m``.
+    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
+    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
+    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
+    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
+    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``.
     """
-    half = d ** m
-    for i in range(1, m + 1):
-        om = offsets[m]
-        cur = 0
-        nxt = half
-        for p in range(d ** m):
-            buf[p] = g[om + p]
-        for k in range(m - 1, i - 1, -1):
-            f = 1.0 / (k + 1 - i)
-            nk = d ** k
-            ok = offsets[k]
-            for p in range(nk):
-                buf[nxt + p] = g[ok + p]
+    dim = offsets[m + 1]
+    for r in range(dim):
+        gprev[r] = g[r]
+    for q in range(d):
+        gdelta[q] = g[q]
+    for k in range(m, 1, -1):
+        # forward: T_1 = delta/k + S_1, T_{j+1} = T_j ⊗ delta/(k-j) + S_{j+1}
+        inv = 1.0 / k
+        for q in range(d):
+            tb[q] = delta[q] * inv + s[q]
+        size = d
+        for j in range(1, k - 1):
+            f = 1.0 / (k - j)
+            oj = offsets[j]
+            on = offsets[j + 1]
             for q in range(d):
                 e = delta[q] * f
-                base = cur + nk * q
-                for p in range(nk):
-                    buf[nxt + p] += buf[base + p] * e
-            cur, nxt = nxt, cur
-        oi = offsets[i]
-        for p in range(d ** i):
-            out[oi + p] = buf[cur + p]
-
-
-@njit(cache=True)
-def _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta):
-    """``gdelta <- d/d(delta) <f, exp(delta)>``; ``pw``, ``h`` scratch of sigdim."""
-    for q in range(d):
-        pw[q] = delta[q]
-    for j in range(2, m + 1):
-        o1 = offsets[j - 1]
-        oj = offsets[j]
-        n1 = d ** (j - 1)
-        inv = 1.0 / j
+                base = on + size * q
+                for p in range(size):
+                    tb[base + p] = tb[oj + p] * e + s[base + p]
+            size *= d
+        # backward: gB_k = G_k
+        ok = offsets[k]
+        nk = d ** k
+        for r in range(nk):
+            ga[r] = g[ok + r]
+        for j in range(k - 1, 0, -1):
+            f = 1.0 / (k - j)
+            nj = d ** j
+            oj = offsets[j]
+            for p in range(nj):
+                gb[p] = 0.0
+            for q in range(d):
+                e = delta[q] * f
+                base = nj * q
+                acc = 0.0
+                for p in range(nj):
+                    gb[p] += ga[base + p] * e
+                    acc += ga[base + p] * tb[oj + p]
+                gdelta[q] += acc * f
+            for p in range(nj):
+                gprev[oj + p] += gb[p]
+                ga[p] = gb[p]
         for q in range(d):
-            e = delta[q] * inv
-            for p in range(n1):
-                pw[oj + n1 * q + p] = pw[o1 + p] * e
-    for r in range(offsets[m + 1]):
-        h[r] = f[r]
-    for q in range(d):
-        gdelta[q] = 0.0
-    for j in range(m, 1, -1):
-        o1 = offsets[j - 1]
-        oj = offsets[j]
-        n1 = d ** (j - 1)
-        inv = 1.0 / j
-        for q in range(d):
-            acc = 0.0
-            e = delta[q] * inv
-            base = oj + n1 * q
-            for p in range(n1):
-                acc += h[base + p] * pw[o1 + p]
-                h[o1 + p] += h[base + p] * e
-            gdelta[q] += acc * inv
-    for q in range(d):
-        gdelta[q] += h[q]
+            gdelta[q] += ga[q] * inv
 
 
 @njit(cache=True)
@@ -655,9 +647,9 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
     """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
     dim = offsets[m + 1]
     buf = np.empty(2 * d ** m)
-    f = np.empty(dim)
-    pw = np.empty(dim)
-    h = np.empty(dim)
+    tb = np.empty(dim)
+    ga = np.empty(d ** m)
+    gb = np.empty(d ** m)
     gn = np.empty(dim)
     delta = np.empty(d)
     neg = np.empty(d)
@@ -667,11 +659,9 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
             delta[i] = x[b, k, i] - x[b, k - 1, i]
             neg[i] = -delta[i]
         _horner_step(s, neg, d, m, offsets, buf)
-        _lcon(1.0, s, g, d, m, offsets, f)
-        _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta)
+        _step_vjp(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
         for i in range(d):
             gd[b, k - 1, i] = gdelta[i]
-        _rcon_exp(g, delta, d, m, offsets, gn, buf)
         for r in range(dim):
             g[r] = gn[r]
 
