@@ -33,8 +33,8 @@ from .norms import (
 from .rough_path import RoughPath, chen_defect
 from .solve import Solution, solve
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, expm_batched
-from .signature import (logsignature, logsignature_vjp, rough_path_signature, signature,
-                        signature_vjp)
+from .signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
+                        signature, signature_vjp)
 from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
 from .tensor_algebra import (
     from_level2,
@@ -100,6 +100,7 @@ __all__ = [
     "logsignature",
     "signature_vjp",
     "logsignature_vjp",
+    "rough_path_signature_vjp",
     "rough_path_signature",
     "sigdim",
     "logsigdim",

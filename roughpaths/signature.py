@@ -25,7 +25,8 @@ from ._validation import as_float_array, check_positive_int
 from .tensor_algebra import (_log_flat, _lyndon_flat, _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim,
                              sigdim)
 
-__all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp", "logsignature_vjp"]
+__all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp", "logsignature_vjp",
+           "rough_path_signature_vjp"]
 
 # Work splitting depends on the input's size only (never on the thread count), so results are
 # bitwise identical for any number of threads. A path is cut into chunks (glued by Chen's identity)
@@ -394,3 +395,58 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
     lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
     out = _k.rough_sig_kernel(inc, lev, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)].reshape(batch + (sigdim(d, depth),))
+
+
+def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
+    r"""Vector–Jacobian product of :func:`rough_path_signature` w.r.t. the step increments and areas.
+
+    Parameters
+    ----------
+    X : RoughPath
+        Level 2, geometric (as for :func:`rough_path_signature`).
+    depth : int
+        Truncation level ``m >= 1``.
+    grad_output : array_like, shape ``(*X.batch_shape, sigdim(d, m))``
+        Cotangent ``G`` of the signature, in :func:`signature`'s layout.
+
+    Returns
+    -------
+    g_increments : ndarray, shape ``(*X.batch_shape, N, d)``
+        :math:`\partial \langle G, S \rangle / \partial X_{t_k, t_{k+1}}` (``X.increments``).
+    g_areas : ndarray, shape ``(*X.batch_shape, N, d, d)``
+        :math:`\partial \langle G, S \rangle / \partial \mathbb{X}_{t_k, t_{k+1}}` (``X.areas``).
+        The extension depends on an area only through its antisymmetric part (the Lévy area
+        :math:`\tfrac12(\mathbb{X} - \mathbb{X}^T)`), so this is antisymmetric.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from roughpaths import RoughPath
+    >>> X = RoughPath.from_path(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
+    >>> g = np.zeros(6); g[3] = 1.0                     # the word (1, 2)
+    >>> gi, ga = rough_path_signature_vjp(X, 2, g)
+    >>> gi                                              # d/d inc_0 of ½ x1 x2 + inc_0^1 inc_1^2
+    array([[1. , 0.5],
+           [0.5, 1. ]])
+    >>> ga[0]
+    array([[ 0. ,  0.5],
+           [-0.5,  0. ]])
+    """
+    from .rough_path import RoughPath
+
+    if not isinstance(X, RoughPath):
+        raise TypeError(f"X must be a RoughPath, got {type(X).__name__}.")
+    depth = _check_depth(depth)
+    sig = rough_path_signature(X, depth)                  # validates level and kind
+    d, n, batch = X.dim, X.n_steps, X.batch_shape
+    g = _check_grad(grad_output, batch, sigdim(d, depth), "rough_path_signature")
+    perm = _reversed_to_rowmajor(d, depth)
+    s_rev = np.empty((g.shape[0], sig.shape[-1]))
+    s_rev[:, perm] = sig.reshape((-1, sig.shape[-1]))
+    g_rev = np.empty_like(g)
+    g_rev[:, perm] = g
+    inc = np.ascontiguousarray(X.increments.reshape((-1, n, d)))
+    lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
+    ginc, glev = _k.rough_vjp_kernel(inc, lev, s_rev, g_rev, depth, _offsets(d, depth))
+    garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
+    return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))
