@@ -196,6 +196,12 @@ def logsignature(paths, depth: int) -> np.ndarray:
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
     _check_fits(flat.shape[0], d, depth, log=True)
     sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    if depth == 2:
+        # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas
+        iu, ju = np.triu_indices(d, k=1)
+        a = sig[:, d:].reshape(-1, d, d)
+        levy = 0.5 * (a[:, iu, ju] - a[:, ju, iu])
+        return np.concatenate([sig[:, :d], levy], axis=-1).reshape(batch + (-1,))
     return _lyndon_flat(_log_flat(sig, d, depth), d, depth).reshape(batch + (-1,))
 
 
