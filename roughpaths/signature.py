@@ -4,16 +4,24 @@ Output layouts (see :mod:`roughpaths.tensor_algebra`):
 
 * :func:`signature` — flat, levels ``1..depth`` concatenated, row-major words, no leading 1:
   the layout of ``iisignature.sig(path, depth)`` (and of ``esig.stream2sig`` minus its 1).
-  Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``CONVENTIONS.md``.
+  Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``docs/conventions.md``.
 * :func:`logsignature` — coordinates in the Lyndon basis (standard bracketing, ordered by
   length then lexicographically; :func:`roughpaths.tensor_algebra.lyndon_basis` names them),
   the coordinates of ``iisignature.logsig(path, iisignature.prepare(d, depth))``. Level-2
   coordinate of ``[i,j]`` (``i < j``) is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`.
 
+Gradients: :func:`signature_vjp`, :func:`logsignature_vjp` (w.r.t. the path points) and
+:func:`rough_path_signature_vjp` (w.r.t. the step increments and areas) are vector–Jacobian
+products, the quantities of ``iisignature.sigbackprop`` / ``logsigbackprop``.
+
 Kernels are numba-compiled and cached (:mod:`roughpaths._signature_kernels`): level 2 is a fused
-one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment, vectorised across
-work units (paths, or chunks of a long path glued by Chen's identity). The split of the work depends
-on the input's size only, so results are bitwise identical for any number of threads.
+one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment,
+run side by side on groups of work units (paths, or chunks of a long path glued by Chen's
+identity). The split of the work depends on the input's size only, so results are bitwise
+identical for any number of threads; small inputs run on one thread. The log-signature takes the
+truncated logarithm by Horner's scheme and the Lyndon coordinates by forward substitution with a
+sparse triangular map (:mod:`roughpaths._lyndon`, cached under a byte budget); a request whose
+arrays would not fit in the available memory is refused with a ``ValueError`` before allocating.
 """
 
 from __future__ import annotations
