@@ -42,8 +42,8 @@ from .solve import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
 from .solvers_level3 import Davie3, LogODE3
-from .signature import (logsignature, logsignature_vjp, rough_path_signature, signature,
-                        signature_vjp)
+from .signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
+                        signature, signature_vjp)
 from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
 from .tensor_algebra import (
     from_level2,
@@ -132,6 +132,7 @@ __all__ = [
     "logsignature",
     "signature_vjp",
     "logsignature_vjp",
+    "rough_path_signature_vjp",
     "rough_path_signature",
     "sigdim",
     "logsigdim",

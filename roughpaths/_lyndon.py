@@ -126,8 +126,14 @@ def lyndon_words(dim: int, depth: int) -> tuple:
     return tuple(sorted(words, key=lambda u: (len(u), u)))
 
 
-def _words_of_length(dim: int, k: int) -> list:
-    return [w for w in lyndon_words(dim, k) if len(w) == k]
+@lru_cache(maxsize=64)
+def _words_of_length(dim: int, k: int) -> tuple:
+    return tuple(w for w in lyndon_words(dim, k) if len(w) == k)
+
+
+@lru_cache(maxsize=64)
+def _positions(dim: int, k: int) -> dict:
+    return {w: i for i, w in enumerate(_words_of_length(dim, k))}
 
 
 def standard_factorisation(w: tuple) -> tuple:
@@ -164,16 +170,16 @@ def _factor_table(dim: int, k: int) -> tuple:
     """Per Lyndon word of length ``k``: length of ``u`` and positions of ``u``, ``v`` in their levels."""
     def build():
         words = _words_of_length(dim, k)
-        pos = {}
+        pos = [None] + [_positions(dim, length) for length in range(1, k)]
         a_len = np.empty(len(words), dtype=np.int64)
         pu = np.empty(len(words), dtype=np.int64)
         pv = np.empty(len(words), dtype=np.int64)
         for j, w in enumerate(words):
-            u, v = standard_factorisation(w)
-            for length in (len(u), len(v)):
-                if length not in pos:
-                    pos[length] = {x: i for i, x in enumerate(_words_of_length(dim, length))}
-            a_len[j], pu[j], pv[j] = len(u), pos[len(u)][u], pos[len(v)][v]
+            for i in range(1, k):                  # longest proper Lyndon suffix first
+                pv_j = pos[k - i].get(w[i:])
+                if pv_j is not None:
+                    break
+            a_len[j], pu[j], pv[j] = i, pos[i][w[:i]], pv_j
         return a_len, pu, pv
     return _CACHE.get(("fac", dim, k), build)
 
@@ -247,11 +253,19 @@ def lyndon_projection(dim: int, k: int) -> tuple:
             m = sp.csr_matrix((n_k, n_k))
         else:
             ri, ci, vi = [], [], []
+            table = None
+            if dim ** k <= 2 ** 24:                          # direct lookup word -> Lyndon position
+                table = np.full(dim ** k, -1, dtype=np.int64)
+                table[lidx] = np.arange(n_k)
             for rows in _row_blocks(n_k, 2 ** (k - 1)):      # bounded temporaries
                 terms, sgn = _expand_rows(dim, k, rows)
-                p = np.searchsorted(lidx, terms)
-                p[p >= n_k] = 0
-                hit = lidx[p] == terms
+                if table is not None:
+                    p = table[terms]
+                    hit = p >= 0
+                else:
+                    p = np.searchsorted(lidx, terms)
+                    p[p >= n_k] = 0
+                    hit = lidx[p] == terms
                 ri.append(p[hit])
                 ci.append(np.broadcast_to(rows[:, None], terms.shape)[hit])
                 vi.append(sgn[hit].astype(np.float64))

@@ -6,7 +6,11 @@ no leading 1), exactly as ``iisignature.sig``. ``offsets[k]`` is the start of le
 (``offsets[1] = 0``, ``offsets[m + 1] = sigdim``).
 
 Kernels work on C-contiguous ``(B, n, d)`` batches and write ``(B, sigdim)``. A long path with
-a small batch is cut into chunks signed in parallel and glued back with Chen's identity.
+a small batch is cut into chunks signed separately and glued back with Chen's identity. The
+public kernels below (no leading underscore) are serial, release the GIL and take a range of work
+items (``lo, hi``): :mod:`roughpaths._signature_threads` runs ranges on a thread pool whose
+calling thread works too, so a busy machine never makes a call wait for a thread that the OS
+has not scheduled (numba's ``prange`` waits for every worker).
 
 Precision: no ``fastmath`` (the results must agree with iisignature to 1e-12, and re-association
 brings nothing measurable here: the loops are latency- or memory-bound).
@@ -15,7 +19,7 @@ brings nothing measurable here: the loops are latency- or memory-bound).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 # ---------------------------------------------------------------------------------- level 2
 # The level-2 signature of a piecewise-linear path y (y_0 = 0) has symmetric part ½ X⊗X (X the
@@ -98,90 +102,6 @@ def _area_chunk(x, b, lo, hi, out):
         _area_chunk_generic(x, b, lo, hi, out)
 
 
-@njit(cache=True, parallel=True)
-def sig2_kernel(x, nchunks):
-    """Level-2 signatures of a ``(B, n, d)`` batch, shape ``(B, d + d*d)``.
-
-    Each path is cut into ``nchunks`` chunks (processed in parallel with the batch) whose
-    ``(increment, Lévy area)`` are glued by Chen: ``2A = 2A_1 + 2A_2 + X_1 ∧ X_2``.
-    """
-    nb, n, d = x.shape
-    npair = d * (d - 1) // 2
-    width = d + npair
-    part = np.zeros((nb * nchunks, width))
-    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
-    for t in prange(nb * nchunks):
-        b = t // nchunks
-        c = t - b * nchunks
-        lo = min(c * seg, n - 1)
-        hi = min(lo + seg, n - 1)
-        if hi > lo:
-            _area_chunk(x, b, lo, hi, part[t])
-    out = np.empty((nb, d + d * d))
-    for b in prange(nb):
-        tot = np.zeros(width)
-        for c in range(nchunks):
-            p = part[b * nchunks + c]
-            q = 0
-            for i in range(d):
-                for j in range(i + 1, d):
-                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
-                    q += 1
-            for i in range(d):
-                tot[i] += p[i]
-        for i in range(d):
-            out[b, i] = tot[i]
-        q = 0
-        for i in range(d):
-            out[b, d + i * d + i] = 0.5 * tot[i] * tot[i]
-            for j in range(i + 1, d):
-                sym = 0.5 * tot[i] * tot[j]
-                out[b, d + i * d + j] = sym + 0.5 * tot[d + q]
-                out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
-                q += 1
-    return out
-
-
-@njit(cache=True)
-def sig2_kernel_ser(x, nchunks):
-    """Serial twin of :func:`sig2_kernel` (same arithmetic, bitwise the same result)."""
-    nb, n, d = x.shape
-    npair = d * (d - 1) // 2
-    width = d + npair
-    part = np.zeros((nb * nchunks, width))
-    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
-    for t in range(nb * nchunks):
-        b = t // nchunks
-        c = t - b * nchunks
-        lo = min(c * seg, n - 1)
-        hi = min(lo + seg, n - 1)
-        if hi > lo:
-            _area_chunk(x, b, lo, hi, part[t])
-    out = np.empty((nb, d + d * d))
-    for b in range(nb):
-        tot = np.zeros(width)
-        for c in range(nchunks):
-            p = part[b * nchunks + c]
-            q = 0
-            for i in range(d):
-                for j in range(i + 1, d):
-                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
-                    q += 1
-            for i in range(d):
-                tot[i] += p[i]
-        for i in range(d):
-            out[b, i] = tot[i]
-        q = 0
-        for i in range(d):
-            out[b, d + i * d + i] = 0.5 * tot[i] * tot[i]
-            for j in range(i + 1, d):
-                sym = 0.5 * tot[i] * tot[j]
-                out[b, d + i * d + j] = sym + 0.5 * tot[d + q]
-                out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
-                q += 1
-    return out
-
-
 # ---------------------------------------------------------------------------------- depth >= 3
 # Internally level k is stored in *reversed* word order: word (i_1..i_k) at sum_j i_j d^(j-1), so
 # that a tensor product a_j ⊗ b_l is out[p + d^j q] = a[p] b[q] with a long, contiguous inner loop
@@ -254,32 +174,6 @@ def _exp_lie2(x, a, d, m, offsets, out, p, q):
             out[r] += q[r]
 
 
-@njit(cache=True, parallel=True)
-def rough_sig_kernel(inc, lev, m, offsets):
-    """``prod_k exp(inc_k + lev_k)`` over steps of a ``(B, N, d)`` / ``(B, N, d, d)`` batch (reversed layout)."""
-    nb, nsteps, d = inc.shape
-    dim = offsets[m + 1]
-    out = np.zeros((nb, dim))
-    for b in prange(nb):
-        e = np.empty(dim)
-        p = np.empty(dim)
-        q = np.empty(dim)
-        for k in range(nsteps):
-            _exp_lie2(inc[b, k], lev[b, k], d, m, offsets, e, p, q)
-            mul_inplace(out[b], e, d, m, offsets)
-    return out
-
-
-@njit(cache=True, parallel=True)
-def stream_sum(x):
-    """Parallel streaming sum of a flat array (a memory-bandwidth reference for benchmarks)."""
-    n = x.shape[0]
-    total = 0.0
-    for i in prange(n):
-        total += x[i]
-    return total
-
-
 # ---------------------------------------------------------------------------------- log, Lyndon
 # Row-major layout (iisignature's): (a_i ⊗ b_j)[p * d^j + q] = a_i[p] b_j[q].
 
@@ -323,46 +217,13 @@ def _lyndon_one(z, lev_off, lidx, indptr, indices, data, out, out_off):
         out[out_off + i] = v
 
 
-# Each batch kernel exists twice, parallel and serial, with the same per-element code: small
-# inputs take the serial one (no thread start-up); results are bitwise the same either way.
-@njit(cache=True, parallel=True)
-def log_batch_par(a, d, m, offsets):
-    """Row-major ``log(1 + a)`` of each row of ``a`` (B, sigdim)."""
-    nb, dim = a.shape
-    out = np.empty((nb, dim))
-    for b in prange(nb):
-        t = np.empty(dim)
-        _log_one(a[b], d, m, offsets, out[b], t)
-    return out
-
-
-@njit(cache=True)
-def log_batch_ser(a, d, m, offsets):
-    nb, dim = a.shape
-    out = np.empty((nb, dim))
-    t = np.empty(dim)
-    for b in range(nb):
-        _log_one(a[b], d, m, offsets, out[b], t)
-    return out
-
-
-@njit(cache=True, parallel=True)
-def lyndon_batch_par(z, lev_off, lidx, indptr, indices, data, out, out_off):
-    """Lyndon coordinates of one level (forward substitution with the sparse ``M``), per row."""
-    for b in prange(z.shape[0]):
-        _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
-
-
-@njit(cache=True)
-def lyndon_batch_ser(z, lev_off, lidx, indptr, indices, data, out, out_off):
-    for b in range(z.shape[0]):
-        _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
-
-
 # ---------------------------------------------------------------------------------- lane kernel
-# Depth >= 3 signatures, SIMD across "lanes": LANES work units (a path, or a chunk of a long path)
+# Depth >= 3 signatures across "lanes": LANES work units (a path, or a chunk of a long path)
 # advance together, one segment per step; every array is (entries, LANES) flattened, so each
-# innermost loop is LANES independent multiply-adds (vectorised whatever d and the level size).
+# innermost loop is LANES independent multiply-adds whatever d and the level size. This amortises
+# the loop overhead of the short per-level loops (1.2-2.5x over one unit at a time for d = 3..5);
+# LLVM does not turn these 8-wide loops into packed SIMD under numba (checked in the assembly:
+# scalar vmulsd/vaddsd), which is where pysiglib's remaining 2-4x lead comes from.
 # A unit that has run out of segments gets zero increments (exp(0) = 1 leaves it bitwise intact),
 # so a unit's result depends only on its own data: the grouping and the number of threads never
 # change a bit of the result.
@@ -455,59 +316,14 @@ def _glue(part, nchunks, b, m, offsets, out):
         mul_inplace(out[b], part[b * nchunks + c], d, m, offsets)
 
 
-@njit(cache=True, parallel=True)
-def lane_parts_par(x, ub, ulo, uhi, m, offsets):
-    """Signature of every work unit (reversed layout), shape ``(units, sigdim)``."""
-    d = x.shape[2]
-    ngroups = (ub.shape[0] + LANES - 1) // LANES
-    part = np.empty((ub.shape[0], offsets[m + 1]))
-    for g in prange(ngroups):
-        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
-    return part
-
-
-@njit(cache=True)
-def lane_parts_ser(x, ub, ulo, uhi, m, offsets):
-    d = x.shape[2]
-    ngroups = (ub.shape[0] + LANES - 1) // LANES
-    part = np.empty((ub.shape[0], offsets[m + 1]))
-    for g in range(ngroups):
-        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
-    return part
-
-
-@njit(cache=True, parallel=True)
-def lane_sig_par(x, ub, ulo, uhi, nchunks, m, offsets):
-    """Depth-``m`` signatures of ``(B, n, d)`` paths (reversed layout), units glued by Chen."""
-    nb, n, d = x.shape
-    part = lane_parts_par(x, ub, ulo, uhi, m, offsets)
-    if nchunks == 1:
-        return part
-    out = np.empty((nb, offsets[m + 1]))
-    for b in prange(nb):
-        _glue(part, nchunks, b, m, offsets, out)
-    return out
-
-
-@njit(cache=True)
-def lane_sig_ser(x, ub, ulo, uhi, nchunks, m, offsets):
-    nb, n, d = x.shape
-    part = lane_parts_ser(x, ub, ulo, uhi, m, offsets)
-    if nchunks == 1:
-        return part
-    out = np.empty((nb, offsets[m + 1]))
-    for b in range(nb):
-        _glue(part, nchunks, b, m, offsets, out)
-    return out
-
-
 # ---------------------------------------------------------------------------------- gradients
 # Vector-Jacobian products, reversed layout (word (i_1..i_k) at sum_j i_j d^(j-1)), so that a
 # word u w splits as index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
 # Backward through S = S_prev ⊗ exp(D) per segment (last to first):
 #   S_prev = S ⊗ exp(-D)                       (same Horner step, no storage of the forward pass)
-#   dL/dD  = VJP of D -> exp(D) applied to F = S_prev ▷ G   (left contraction)
-#   G_prev = G ◁ exp(D)                         (right contraction, Horner in the contraction)
+#   then backward through the Horner step itself (_step_vjp), which gives both the cotangent of
+#   D and G_prev = G ◁ exp(D) for about three Horner steps' work.
+# _lcon / _rcon (general contractions) serve the chunk cotangents and the log's backward pass.
 
 
 @njit(cache=True)
@@ -585,69 +401,60 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 
 @njit(cache=True)
-def _rcon_exp(g, delta, d, m, offsets, out, buf):
-    """``out <- g ◁ exp(delta)``: ``out_i = sum_j iota^j g_{i+j} / j!``, Horner in ``iota``.
+def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
 
-    ``iota`` contracts the last letter with ``delta``; for each ``i``: ``T = g_m``,
-    ``T <- g_k + iota(T) / (k + 1 - i)`` for ``k = m-1 .. i``. ``buf`` scratch of ``2 d^m``.
+    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
+    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
+    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
+    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
+    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``.
     """
-    half = d ** m
-    for i in range(1, m + 1):
-        om = offsets[m]
-        cur = 0
-        nxt = half
-        for p in range(d ** m):
-            buf[p] = g[om + p]
-        for k in range(m - 1, i - 1, -1):
-            f = 1.0 / (k + 1 - i)
-            nk = d ** k
-            ok = offsets[k]
-            for p in range(nk):
-                buf[nxt + p] = g[ok + p]
+    dim = offsets[m + 1]
+    for r in range(dim):
+        gprev[r] = g[r]
+    for q in range(d):
+        gdelta[q] = g[q]
+    for k in range(m, 1, -1):
+        # forward: T_1 = delta/k + S_1, T_{j+1} = T_j ⊗ delta/(k-j) + S_{j+1}
+        inv = 1.0 / k
+        for q in range(d):
+            tb[q] = delta[q] * inv + s[q]
+        size = d
+        for j in range(1, k - 1):
+            f = 1.0 / (k - j)
+            oj = offsets[j]
+            on = offsets[j + 1]
             for q in range(d):
                 e = delta[q] * f
-                base = cur + nk * q
-                for p in range(nk):
-                    buf[nxt + p] += buf[base + p] * e
-            cur, nxt = nxt, cur
-        oi = offsets[i]
-        for p in range(d ** i):
-            out[oi + p] = buf[cur + p]
-
-
-@njit(cache=True)
-def _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta):
-    """``gdelta <- d/d(delta) <f, exp(delta)>``; ``pw``, ``h`` scratch of sigdim."""
-    for q in range(d):
-        pw[q] = delta[q]
-    for j in range(2, m + 1):
-        o1 = offsets[j - 1]
-        oj = offsets[j]
-        n1 = d ** (j - 1)
-        inv = 1.0 / j
+                base = on + size * q
+                for p in range(size):
+                    tb[base + p] = tb[oj + p] * e + s[base + p]
+            size *= d
+        # backward: gB_k = G_k
+        ok = offsets[k]
+        nk = d ** k
+        for r in range(nk):
+            ga[r] = g[ok + r]
+        for j in range(k - 1, 0, -1):
+            f = 1.0 / (k - j)
+            nj = d ** j
+            oj = offsets[j]
+            for p in range(nj):
+                gb[p] = 0.0
+            for q in range(d):
+                e = delta[q] * f
+                base = nj * q
+                acc = 0.0
+                for p in range(nj):
+                    gb[p] += ga[base + p] * e
+                    acc += ga[base + p] * tb[oj + p]
+                gdelta[q] += acc * f
+            for p in range(nj):
+                gprev[oj + p] += gb[p]
+                ga[p] = gb[p]
         for q in range(d):
-            e = delta[q] * inv
-            for p in range(n1):
-                pw[oj + n1 * q + p] = pw[o1 + p] * e
-    for r in range(offsets[m + 1]):
-        h[r] = f[r]
-    for q in range(d):
-        gdelta[q] = 0.0
-    for j in range(m, 1, -1):
-        o1 = offsets[j - 1]
-        oj = offsets[j]
-        n1 = d ** (j - 1)
-        inv = 1.0 / j
-        for q in range(d):
-            acc = 0.0
-            e = delta[q] * inv
-            base = oj + n1 * q
-            for p in range(n1):
-                acc += h[base + p] * pw[o1 + p]
-                h[o1 + p] += h[base + p] * e
-            gdelta[q] += acc * inv
-    for q in range(d):
-        gdelta[q] += h[q]
+            gdelta[q] += ga[q] * inv
 
 
 @njit(cache=True)
@@ -655,9 +462,9 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
     """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
     dim = offsets[m + 1]
     buf = np.empty(2 * d ** m)
-    f = np.empty(dim)
-    pw = np.empty(dim)
-    h = np.empty(dim)
+    tb = np.empty(dim)
+    ga = np.empty(d ** m)
+    gb = np.empty(d ** m)
     gn = np.empty(dim)
     delta = np.empty(d)
     neg = np.empty(d)
@@ -667,11 +474,9 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
             delta[i] = x[b, k, i] - x[b, k - 1, i]
             neg[i] = -delta[i]
         _horner_step(s, neg, d, m, offsets, buf)
-        _lcon(1.0, s, g, d, m, offsets, f)
-        _exp_vjp(f, delta, d, m, offsets, pw, h, gdelta)
+        _step_vjp(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
         for i in range(d):
             gd[b, k - 1, i] = gdelta[i]
-        _rcon_exp(g, delta, d, m, offsets, gn, buf)
         for r in range(dim):
             g[r] = gn[r]
 
@@ -691,31 +496,6 @@ def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
     for cc in range(c):
         mul_inplace(pre, part[b * nchunks + cc], d, m, offsets)
     _lcon(1.0, pre, tmp, d, m, offsets, g)
-
-
-@njit(cache=True, parallel=True)
-def sig_vjp_par(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot):
-    """Cotangent of every segment increment, ``(B, n-1, d)``, given unit signatures and ``gtot`` (B, sigdim)."""
-    nb, n, d = x.shape
-    gd = np.zeros((nb, max(n - 1, 0), d))
-    for u in prange(ub.shape[0]):
-        g = np.empty(offsets[m + 1])
-        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
-        s = part[u].copy()
-        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
-    return gd
-
-
-@njit(cache=True)
-def sig_vjp_ser(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot):
-    nb, n, d = x.shape
-    gd = np.zeros((nb, max(n - 1, 0), d))
-    for u in range(ub.shape[0]):
-        g = np.empty(offsets[m + 1])
-        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
-        s = part[u].copy()
-        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
-    return gd
 
 
 @njit(cache=True)
@@ -763,23 +543,6 @@ def _log_vjp_one(a, g, d, m, offsets, ga):
         ga[u] += cm * gc[u]
 
 
-@njit(cache=True, parallel=True)
-def log_vjp_par(a, g, d, m, offsets):
-    """Row-wise :func:`_log_vjp_one` over a batch ``(B, sigdim)``."""
-    out = np.empty_like(a)
-    for b in prange(a.shape[0]):
-        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
-    return out
-
-
-@njit(cache=True)
-def log_vjp_ser(a, g, d, m, offsets):
-    out = np.empty_like(a)
-    for b in range(a.shape[0]):
-        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
-    return out
-
-
 @njit(cache=True)
 def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
     """Transpose of one level of the Lyndon projection: ``gz[lidx] = M^{-T} gc`` (back substitution)."""
@@ -794,3 +557,222 @@ def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
                 y[indices[t]] -= data[t] * yr
         for i in range(n):
             gz[b, lev_off + lidx[i]] = y[i]
+
+
+# ---------------------------------------------------------------------------------- rough-path gradient
+@njit(cache=True)
+def _rough_vjp_one(inc, lev, s, g, d, m, offsets, ginc, glev):
+    """Backward through ``S = prod_k exp(inc_k + lev_k)`` for one path (reversed layout).
+
+    ``s`` is the final signature (overwritten), ``g`` its cotangent (overwritten). Per step, last
+    to first: ``S_prev = S ⊗ exp(-z)``, cotangent of ``E = exp(z)`` is ``S_prev ▷ G``,
+    ``G <- G ◁ E``, and the cotangent of ``z`` comes from the powers ``P_n = P_{n-1} ⊗ z / n``.
+    """
+    dim = offsets[m + 1]
+    nsteps = inc.shape[0]
+    e = np.empty(dim)
+    en = np.empty(dim)
+    p = np.empty(dim)
+    q = np.empty(dim)
+    ge = np.empty(dim)
+    gn = np.empty(dim)
+    z = np.zeros(dim)
+    pw = np.zeros((m + 1, dim))
+    gp = np.empty(dim)
+    gz = np.empty(dim)
+    tmp = np.empty(dim)
+    neg_x = np.empty(d)
+    neg_a = np.empty((d, d))
+    o2 = offsets[2] if m >= 2 else 0
+    for k in range(nsteps - 1, -1, -1):
+        for i in range(d):
+            neg_x[i] = -inc[k, i]
+            for j in range(d):
+                neg_a[i, j] = -lev[k, i, j]
+        _exp_lie2(neg_x, neg_a, d, m, offsets, en, p, q)
+        mul_inplace(s, en, d, m, offsets)                     # s = S_prev
+        _exp_lie2(inc[k], lev[k], d, m, offsets, e, p, q)
+        _lcon(1.0, s, g, d, m, offsets, ge)                   # cotangent of E
+        _rcon(1.0, g, e, d, m, offsets, gn)
+        # powers of z (levels 1 and 2 only)
+        for r in range(dim):
+            z[r] = 0.0
+        for i in range(d):
+            z[i] = inc[k, i]
+        if m >= 2:
+            for i in range(d):
+                for j in range(d):
+                    z[o2 + i + d * j] = lev[k, i, j]
+        for r in range(dim):
+            pw[1, r] = z[r]
+        for n in range(2, m + 1):
+            _mul_rev(0.0, pw[n - 1], z, d, m, offsets, pw[n])
+            for r in range(dim):
+                pw[n, r] /= n
+        # backward: E = sum_n P_n, P_n = P_{n-1} ⊗ z / n
+        for r in range(dim):
+            gp[r] = ge[r]
+            gz[r] = 0.0
+        for n in range(m, 1, -1):
+            _lcon(0.0, pw[n - 1], gp, d, m, offsets, tmp)      # P_{n-1} ▷ gP_n
+            for r in range(dim):
+                gz[r] += tmp[r] / n
+            _rcon(0.0, gp, z, d, m, offsets, tmp)              # gP_n ◁ z
+            for r in range(dim):
+                gp[r] = ge[r] + tmp[r] / n
+        for r in range(dim):
+            gz[r] += gp[r]
+        for i in range(d):
+            ginc[k, i] = gz[i]
+        if m >= 2:
+            for i in range(d):
+                for j in range(d):
+                    glev[k, i, j] = gz[o2 + i + d * j]
+        for r in range(dim):
+            g[r] = gn[r]
+
+
+# ---------------------------------------------------------------------------------- entry points
+# Serial, GIL-free kernels over a range [lo, hi) of work items; results do not depend on the split.
+_NOGIL = dict(cache=True, nogil=True)
+
+
+@njit(**_NOGIL)
+def sig2_tasks(x, nchunks, lo, hi, part):
+    """``(increment, twice the Lévy area)`` of chunks ``t = lo..hi-1`` (path ``t // nchunks``) into ``part``."""
+    n = x.shape[1]
+    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
+    for t in range(lo, hi):
+        b = t // nchunks
+        c = t - b * nchunks
+        a = min(c * seg, n - 1)
+        e = min(a + seg, n - 1)
+        for r in range(part.shape[1]):
+            part[t, r] = 0.0
+        if e > a:
+            _area_chunk(x, b, a, e, part[t])
+
+
+@njit(**_NOGIL)
+def sig2_glue(part, nb, nchunks, d):
+    """Level-2 signatures ``(B, d + d*d)`` from the chunk data, glued by Chen: ``2A = 2A_1 + 2A_2 + X_1 ∧ X_2``."""
+    width = part.shape[1]
+    out = np.empty((nb, d + d * d))
+    tot = np.empty(width)
+    for b in range(nb):
+        for r in range(width):
+            tot[r] = 0.0
+        for c in range(nchunks):
+            p = part[b * nchunks + c]
+            q = 0
+            for i in range(d):
+                for j in range(i + 1, d):
+                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
+                    q += 1
+            for i in range(d):
+                tot[i] += p[i]
+        for i in range(d):
+            out[b, i] = tot[i]
+        q = 0
+        for i in range(d):
+            out[b, d + i * d + i] = 0.5 * tot[i] * tot[i]
+            for j in range(i + 1, d):
+                sym = 0.5 * tot[i] * tot[j]
+                out[b, d + i * d + j] = sym + 0.5 * tot[d + q]
+                out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
+                q += 1
+    return out
+
+
+@njit(**_NOGIL)
+def lane_groups(x, ub, ulo, uhi, m, offsets, lo, hi, part):
+    """Signatures (reversed layout) of the units of lane groups ``lo..hi-1`` into ``part`` (units, sigdim)."""
+    d = x.shape[2]
+    for g in range(lo, hi):
+        _lane_run(x, ub, ulo, uhi, g, d, m, offsets, part)
+
+
+@njit(**_NOGIL)
+def lane_glue(part, nb, nchunks, m, offsets):
+    """Per path, the Chen product of its units' signatures, in order (reversed layout)."""
+    out = np.empty((nb, offsets[m + 1]))
+    for b in range(nb):
+        _glue(part, nchunks, b, m, offsets, out)
+    return out
+
+
+@njit(**_NOGIL)
+def sig_vjp_units(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    """Cotangents of the segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d)."""
+    d = x.shape[2]
+    g = np.empty(offsets[m + 1])
+    for u in range(lo, hi):
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+        s = part[u].copy()
+        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+
+
+@njit(**_NOGIL)
+def log_rows(a, d, m, offsets, lo, hi, out):
+    """Row-major ``log(1 + a)`` of rows ``lo..hi-1`` of ``a`` (B, sigdim) into ``out``."""
+    t = np.empty(a.shape[1])
+    for b in range(lo, hi):
+        _log_one(a[b], d, m, offsets, out[b], t)
+
+
+@njit(**_NOGIL)
+def lyndon_rows(z, lev_off, lidx, indptr, indices, data, out, out_off, lo, hi):
+    """Lyndon coordinates of one level (forward substitution with the sparse ``M``), rows ``lo..hi-1``."""
+    for b in range(lo, hi):
+        _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
+
+
+@njit(**_NOGIL)
+def log_vjp_rows(a, g, d, m, offsets, lo, hi, out):
+    """Row-wise :func:`_log_vjp_one` (reversed layout) for rows ``lo..hi-1``."""
+    for b in range(lo, hi):
+        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+
+
+@njit(**_NOGIL)
+def rough_sig_rows(inc, lev, m, offsets, lo, hi, out):
+    """``prod_k exp(inc_k + lev_k)`` (reversed layout) for paths ``lo..hi-1`` into ``out`` (B, sigdim)."""
+    d = inc.shape[2]
+    dim = offsets[m + 1]
+    e = np.empty(dim)
+    p = np.empty(dim)
+    q = np.empty(dim)
+    for b in range(lo, hi):
+        for r in range(dim):
+            out[b, r] = 0.0
+        for k in range(inc.shape[1]):
+            _exp_lie2(inc[b, k], lev[b, k], d, m, offsets, e, p, q)
+            mul_inplace(out[b], e, d, m, offsets)
+
+
+@njit(**_NOGIL)
+def rough_vjp_rows(inc, lev, s, g, m, offsets, lo, hi, ginc, glev):
+    """Cotangents of the step increments / Lévy areas of paths ``lo..hi-1``."""
+    d = inc.shape[2]
+    for b in range(lo, hi):
+        _rough_vjp_one(inc[b], lev[b], s[b].copy(), g[b].copy(), d, m, offsets, ginc[b], glev[b])
+
+
+@njit(**_NOGIL)
+def scalar_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
+    """Signatures (reversed layout) of units ``lo..hi-1`` one at a time (few units: no idle lanes).
+
+    Same arithmetic, operation for operation, as the lane kernel (bitwise the same result).
+    """
+    d = x.shape[2]
+    buf = np.empty(2 * d ** (m - 1))
+    delta = np.empty(d)
+    for u in range(lo, hi):
+        s = part[u]
+        for r in range(s.shape[0]):
+            s[r] = 0.0
+        b = ub[u]
+        for k in range(ulo[u] + 1, uhi[u] + 1):
+            for i in range(d):
+                delta[i] = x[b, k, i] - x[b, k - 1, i]
+            _horner_step(s, delta, d, m, offsets, buf)

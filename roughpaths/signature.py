@@ -4,16 +4,24 @@ Output layouts (see :mod:`roughpaths.tensor_algebra`):
 
 * :func:`signature` — flat, levels ``1..depth`` concatenated, row-major words, no leading 1:
   the layout of ``iisignature.sig(path, depth)`` (and of ``esig.stream2sig`` minus its 1).
-  Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``CONVENTIONS.md``.
+  Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``docs/conventions.md``.
 * :func:`logsignature` — coordinates in the Lyndon basis (standard bracketing, ordered by
   length then lexicographically; :func:`roughpaths.tensor_algebra.lyndon_basis` names them),
   the coordinates of ``iisignature.logsig(path, iisignature.prepare(d, depth))``. Level-2
   coordinate of ``[i,j]`` (``i < j``) is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`.
 
+Gradients: :func:`signature_vjp`, :func:`logsignature_vjp` (w.r.t. the path points) and
+:func:`rough_path_signature_vjp` (w.r.t. the step increments and areas) are vector–Jacobian
+products, the quantities of ``iisignature.sigbackprop`` / ``logsigbackprop``.
+
 Kernels are numba-compiled and cached (:mod:`roughpaths._signature_kernels`): level 2 is a fused
-one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment, vectorised across
-work units (paths, or chunks of a long path glued by Chen's identity). The split of the work depends
-on the input's size only, so results are bitwise identical for any number of threads.
+one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment,
+run side by side on groups of work units (paths, or chunks of a long path glued by Chen's
+identity). The split of the work depends on the input's size only, so results are bitwise
+identical for any number of threads; small inputs run on one thread. The log-signature takes the
+truncated logarithm by Horner's scheme and the Lyndon coordinates by forward substitution with a
+sparse triangular map (:mod:`roughpaths._lyndon`, cached under a byte budget); a request whose
+arrays would not fit in the available memory is refused with a ``ValueError`` before allocating.
 """
 
 from __future__ import annotations
@@ -21,21 +29,22 @@ from __future__ import annotations
 import numpy as np
 
 from . import _signature_kernels as _k
+from . import _signature_threads as _threads
 from .validation import as_float_array, check_positive_int
 from .tensor_algebra import (_log_flat, _lyndon_flat, _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim,
                              sigdim)
 
-__all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp", "logsignature_vjp"]
+__all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp", "logsignature_vjp",
+           "rough_path_signature_vjp"]
 
 # Work splitting depends on the input's size only (never on the thread count), so results are
 # bitwise identical for any number of threads. A path is cut into chunks (glued by Chen's identity)
 # only when the batch alone gives fewer than _TARGET_UNITS work units; a chunk has at least
-# _MIN_CHUNK segments. Inputs below _SERIAL_WORK flops-ish run on one thread (no start-up cost).
+# _MIN_CHUNK segments. Small inputs run on the calling thread (see _signature_threads).
 _TARGET_UNITS = 64
 _MIN_CHUNK = 256
 _MIN_CHUNK_L2 = 8192
 _TARGET_UNITS_L2 = 16
-_SERIAL_WORK = 1 << 18
 
 
 def _offsets(dim: int, depth: int) -> np.ndarray:
@@ -110,6 +119,25 @@ def _check_paths(paths) -> np.ndarray:
     return x
 
 
+def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
+    """Signature (reversed layout) of every work unit of a ``(B, n, d)`` batch, shape ``(units, sigdim)``."""
+    nb, n, d = x.shape
+    units = _units(nb, n, nchunks)
+    off = _offsets(d, depth)
+    dim = sigdim(d, depth)
+    nunits = nb * nchunks
+    part = np.empty((nunits, dim))
+    per_unit = (n / nchunks) * 1.5 * d ** depth
+    if nunits < _k.LANES:                     # too few units to fill the lanes: one at a time
+        _threads.run(lambda lo, hi: _k.scalar_units(x, *units, depth, off, lo, hi, part),
+                     _threads.ranges(nunits, per_unit))
+    else:
+        ngroups = -(-nunits // _k.LANES)
+        _threads.run(lambda lo, hi: _k.lane_groups(x, *units, depth, off, lo, hi, part),
+                     _threads.ranges(ngroups, per_unit * _k.LANES))
+    return part
+
+
 def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     """Signatures of a validated ``(B, n, d)`` C-contiguous batch, shape ``(B, sigdim)``."""
     nb, n, d = x.shape
@@ -117,16 +145,16 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
         return np.zeros((nb, sigdim(d, depth)))
     if depth == 1:
         return x[:, -1, :] - x[:, 0, :]
-    dim = sigdim(d, depth)
-    serial = nb * n * dim < _SERIAL_WORK
     if depth == 2:
-        serial = serial or nb * _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2) < 2
-        kern = _k.sig2_kernel_ser if serial else _k.sig2_kernel
-        return kern(x, _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2))
+        nchunks = _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2)
+        part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
+        _threads.run(lambda lo, hi: _k.sig2_tasks(x, nchunks, lo, hi, part),
+                     _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
+        return _k.sig2_glue(part, nb, nchunks, d)
     nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
-    serial = serial or nb * nchunks <= _k.LANES            # one lane group: nothing to share
-    kern = _k.lane_sig_ser if serial else _k.lane_sig_par
-    out = kern(x, *_units(nb, n, nchunks), nchunks, depth, _offsets(d, depth))
+    out = _reversed_parts(x, depth, nchunks)
+    if nchunks > 1:
+        out = _k.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
 
 
@@ -195,6 +223,12 @@ def logsignature(paths, depth: int) -> np.ndarray:
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
     _check_fits(flat.shape[0], d, depth, log=True)
     sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    if depth == 2:
+        # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas
+        iu, ju = np.triu_indices(d, k=1)
+        a = sig[:, d:].reshape(-1, d, d)
+        levy = 0.5 * (a[:, iu, ju] - a[:, ju, iu])
+        return np.concatenate([sig[:, :d], levy], axis=-1).reshape(batch + (-1,))
     return _lyndon_flat(_log_flat(sig, d, depth), d, depth).reshape(batch + (-1,))
 
 
@@ -230,9 +264,10 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     g_rev[:, perm] = g_row
     nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
     units = _units(nb, n, nchunks)
-    serial = nb * n * sigdim(d, depth) < _SERIAL_WORK or nb * nchunks < 2
-    part = (_k.lane_parts_ser if serial else _k.lane_parts_par)(x, *units, depth, off)
-    gd = (_k.sig_vjp_ser if serial else _k.sig_vjp_par)(x, *units, nchunks, depth, off, part, g_rev)
+    part = _reversed_parts(x, depth, nchunks)
+    gd = np.zeros((nb, n - 1, d))
+    _threads.run(lambda lo, hi: _k.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+                 _threads.ranges(nb * nchunks, (n / nchunks) * 5 * d ** depth))
     return _increments_to_points(gd, n)
 
 
@@ -331,8 +366,9 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     sig_rev[:, perm] = sig
     g_log_rev = np.empty_like(g_log_row)
     g_log_rev[:, perm] = g_log_row
-    serial = sig.size < _SERIAL_WORK or sig.shape[0] < 2
-    g_sig_rev = (_k.log_vjp_ser if serial else _k.log_vjp_par)(sig_rev, g_log_rev, d, depth, off)
+    g_sig_rev = np.empty_like(sig_rev)
+    _threads.run(lambda lo, hi: _k.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
+                 _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
     return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
 
 
@@ -390,5 +426,67 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
     d, n, batch = X.dim, X.n_steps, X.batch_shape
     inc = np.ascontiguousarray(X.increments.reshape((-1, n, d)))
     lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
-    out = _k.rough_sig_kernel(inc, lev, depth, _offsets(d, depth))
+    out = np.empty((inc.shape[0], sigdim(d, depth)))
+    off = _offsets(d, depth)
+    _threads.run(lambda lo, hi: _k.rough_sig_rows(inc, lev, depth, off, lo, hi, out),
+                 _threads.ranges(inc.shape[0], n * depth * sigdim(d, depth)))
     return out[:, _reversed_to_rowmajor(d, depth)].reshape(batch + (sigdim(d, depth),))
+
+
+def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
+    r"""Vector–Jacobian product of :func:`rough_path_signature` w.r.t. the step increments and areas.
+
+    Parameters
+    ----------
+    X : RoughPath
+        Level 2, geometric (as for :func:`rough_path_signature`).
+    depth : int
+        Truncation level ``m >= 1``.
+    grad_output : array_like, shape ``(*X.batch_shape, sigdim(d, m))``
+        Cotangent ``G`` of the signature, in :func:`signature`'s layout.
+
+    Returns
+    -------
+    g_increments : ndarray, shape ``(*X.batch_shape, N, d)``
+        :math:`\partial \langle G, S \rangle / \partial X_{t_k, t_{k+1}}` (``X.increments``).
+    g_areas : ndarray, shape ``(*X.batch_shape, N, d, d)``
+        :math:`\partial \langle G, S \rangle / \partial \mathbb{X}_{t_k, t_{k+1}}` (``X.areas``).
+        The extension depends on an area only through its antisymmetric part (the Lévy area
+        :math:`\tfrac12(\mathbb{X} - \mathbb{X}^T)`), so this is antisymmetric.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from roughpaths import RoughPath
+    >>> X = RoughPath.from_path(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
+    >>> g = np.zeros(6); g[3] = 1.0                     # the word (1, 2)
+    >>> gi, ga = rough_path_signature_vjp(X, 2, g)
+    >>> gi                                              # d/d inc_0 of ½ x1 x2 + inc_0^1 inc_1^2
+    array([[1. , 0.5],
+           [0.5, 1. ]])
+    >>> ga[0]
+    array([[ 0. ,  0.5],
+           [-0.5,  0. ]])
+    """
+    from .rough_path import RoughPath
+
+    if not isinstance(X, RoughPath):
+        raise TypeError(f"X must be a RoughPath, got {type(X).__name__}.")
+    depth = _check_depth(depth)
+    sig = rough_path_signature(X, depth)                  # validates level and kind
+    d, n, batch = X.dim, X.n_steps, X.batch_shape
+    g = _check_grad(grad_output, batch, sigdim(d, depth), "rough_path_signature")
+    perm = _reversed_to_rowmajor(d, depth)
+    s_rev = np.empty((g.shape[0], sig.shape[-1]))
+    s_rev[:, perm] = sig.reshape((-1, sig.shape[-1]))
+    g_rev = np.empty_like(g)
+    g_rev[:, perm] = g
+    inc = np.ascontiguousarray(X.increments.reshape((-1, n, d)))
+    lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
+    ginc = np.zeros(inc.shape)
+    glev = np.zeros(lev.shape)
+    off = _offsets(d, depth)
+    _threads.run(lambda lo, hi: _k.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
+                 _threads.ranges(inc.shape[0], 4 * n * depth * depth * sigdim(d, depth)))
+    garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
+    return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))

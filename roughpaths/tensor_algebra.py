@@ -15,7 +15,7 @@ level is *implicit*:
   :func:`tensor_log`) have ``c_0 = 0``.
 
 Level 2 is the area in the project's ordering: entry ``[i, j]`` is the word ``(i, j)``, i.e.
-:math:`\int (X^i - X^i_s)\,dX^j` for a signature (``CONVENTIONS.md``); :func:`to_level2` /
+:math:`\int (X^i - X^i_s)\,dX^j` for a signature (``docs/conventions.md``); :func:`to_level2` /
 :func:`from_level2` convert to and from the pair ``(x, a)`` of :mod:`roughpaths.level2`.
 
 Every function broadcasts over leading batch axes ``...``; the depth is read from the length of
@@ -40,6 +40,7 @@ from functools import lru_cache
 import numpy as np
 
 from . import _signature_kernels as _k
+from . import _signature_threads as _threads
 from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix, lyndon_projection,
                       lyndon_words)
 from .validation import as_float_array, check_positive_int, check_same_batch
@@ -94,14 +95,13 @@ def _offsets(dim: int, depth: int) -> np.ndarray:
     return off
 
 
-# Below this many flat entries a batch is processed on one thread (no thread start-up).
-_SERIAL_ENTRIES = 1 << 15
-
-
 def _log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
-    kern = _k.log_batch_ser if a.size < _SERIAL_ENTRIES or a.shape[0] < 2 else _k.log_batch_par
-    return kern(a, dim, depth, _offsets(dim, depth))
+    off = _offsets(dim, depth)
+    out = np.empty_like(a)
+    _threads.run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
+                 _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
+    return out
 
 
 def _lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
@@ -120,11 +120,11 @@ def _lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Lyndon coordinates of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
     off = _offsets(dim, depth)
     out = np.empty((z.shape[0], logsigdim(dim, depth)))
-    kern = _k.lyndon_batch_ser if z.size < _SERIAL_ENTRIES or z.shape[0] < 2 else _k.lyndon_batch_par
     start = 0
     for k in range(1, depth + 1):
         lidx, indptr, indices, data = lyndon_projection(dim, k)
-        kern(z, off[k], lidx, indptr, indices, data, out, start)
+        _threads.run(lambda lo, hi: _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, start, lo, hi),
+                     _threads.ranges(z.shape[0], float(lidx.shape[0] + indices.shape[0])))
         start += lidx.shape[0]
     return out
 

@@ -172,15 +172,19 @@ def test_chunked_kernels_match_iisignature(rng, m, nchunks):
     d = 3
     x = _paths(rng, (2,), 1000, d)
     ref = iisignature.sig(x, m)
+    xc = np.ascontiguousarray(x)
     if m == 2:
-        got = kern.sig2_kernel(np.ascontiguousarray(x), nchunks)
+        part = np.empty((2 * nchunks, d + d * (d - 1) // 2))
+        kern.sig2_tasks(xc, nchunks, 0, 2 * nchunks, part)
+        got = kern.sig2_glue(part, 2, nchunks, d)
     else:
         off = np.zeros(m + 2, dtype=np.int64)
         for k in range(1, m + 1):
             off[k + 1] = off[k] + d ** k
         ub, lo, hi = _units(x.shape[0], x.shape[1], nchunks)
-        got = kern.lane_sig_par(np.ascontiguousarray(x), ub, lo, hi, nchunks, m, off)
-        got = got[:, _reversed_to_rowmajor(d, m)]
+        part = np.empty((2 * nchunks, off[m + 1]))
+        kern.scalar_units(xc, ub, lo, hi, m, off, 0, 2 * nchunks, part)
+        got = kern.lane_glue(part, 2, nchunks, m, off)[:, _reversed_to_rowmajor(d, m)]
     np.testing.assert_allclose(got, ref, rtol=0, atol=TOL)
 
 

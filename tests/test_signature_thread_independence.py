@@ -1,9 +1,10 @@
-"""Claim: signatures and log-signatures are bitwise identical for any number of threads.
+"""Claim: signatures, log-signatures and their gradients are bitwise identical for any number of threads.
 
-The split of the work (chunks of a long path, groups of paths) depends on the input's size only;
-each work unit is computed by the same arithmetic whichever thread runs it, and the units are
-glued by Chen's identity in a fixed order. So ``numba.set_num_threads(1)`` and ``(2)`` give the
-same bits, and the serial twins of the parallel kernels give the same bits as the parallel ones.
+The split of a path into chunks depends on the input's size only; each work unit is computed by
+the same arithmetic whichever thread runs it (and whichever range of units a thread takes), and
+the units are glued by Chen's identity in a fixed order. So ``numba.set_num_threads(1)`` and
+``(2)`` give the same bits, the lane kernel (units side by side) gives the same bits as the
+one-unit-at-a-time kernel, and splitting the work into other ranges changes nothing.
 """
 
 import numba
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 from roughpaths import _signature_kernels as kern
-from roughpaths.signature import _offsets, _units, logsignature, signature
+from roughpaths.signature import _offsets, _units, logsignature, signature, signature_vjp
 
 
 def _path(shape, seed=3):
@@ -38,11 +39,31 @@ def test_one_thread_equals_two_threads(shape, m):
 
 
 @pytest.mark.parametrize("nchunks", [1, 5])
-def test_serial_twin_equals_parallel_kernel(nchunks):
+def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks):
     x = np.ascontiguousarray(_path((9, 700, 3)))
     m = 4
     units = _units(9, 700, nchunks)
-    par = kern.lane_sig_par(x, *units, nchunks, m, _offsets(3, m))
-    ser = kern.lane_sig_ser(x, *units, nchunks, m, _offsets(3, m))
-    assert par.tobytes() == ser.tobytes()
-    assert kern.sig2_kernel(x, nchunks).tobytes() == kern.sig2_kernel_ser(x, nchunks).tobytes()
+    nu = 9 * nchunks
+    off = _offsets(3, m)
+    one = np.empty((nu, off[m + 1]))
+    kern.scalar_units(x, *units, m, off, 0, nu, one)
+    lanes = np.empty_like(one)
+    groups = -(-nu // kern.LANES)
+    for g in range(groups):                       # one range per group, in reverse order
+        kern.lane_groups(x, *units, m, off, groups - 1 - g, groups - g, lanes)
+    assert one.tobytes() == lanes.tobytes()
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs numba with at least 2 threads")
+def test_gradients_one_thread_equals_two_threads():
+    x = _path((20, 400, 3))
+    g = np.random.default_rng(1).standard_normal((20, 39))
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = signature_vjp(x, 3, g)
+        numba.set_num_threads(2)
+        two = signature_vjp(x, 3, g)
+    finally:
+        numba.set_num_threads(before)
+    assert one.tobytes() == two.tobytes()

@@ -1,0 +1,86 @@
+"""Work sharing for the signature kernels (private).
+
+:func:`run` executes ``fn(lo, hi)`` over a list of item ranges on a persistent thread pool. The
+kernels release the GIL. Ranges are taken from a shared counter by whoever is free, *including the
+calling thread*, and the call returns as soon as every range is done: a pool thread that the OS
+has not scheduled yet (a busy machine) simply finds nothing left to do, so the call never waits
+for it, and at worst waits for one range that a descheduled thread had started. Small jobs run
+on the calling thread only (no thread hand-off at all).
+
+The split into ranges never changes a result: every item is computed by the same code whatever
+thread runs it. The number of threads is numba's (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+import numba
+
+__all__ = ["run", "ranges"]
+
+#: Below this much work (roughly, floating-point operations) a job stays on the calling thread.
+SERIAL_WORK = 1 << 18
+#: Target work per range (enough to amortise a hand-off of a few tens of microseconds).
+RANGE_WORK = 1 << 17
+
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+
+
+def _pool(workers: int) -> ThreadPoolExecutor:
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None or _POOL._max_workers < workers:
+            _POOL = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="roughpaths-sig")
+        return _POOL
+
+
+def ranges(n_items: int, work_per_item: float) -> list:
+    """Split ``range(n_items)`` into contiguous ``(lo, hi)`` ranges of about :data:`RANGE_WORK` each."""
+    if n_items <= 0:
+        return []
+    total = n_items * max(work_per_item, 1.0)
+    if total < SERIAL_WORK:
+        return [(0, n_items)]
+    k = int(min(n_items, max(1, total // RANGE_WORK), 256))
+    step = -(-n_items // k)
+    return [(lo, min(lo + step, n_items)) for lo in range(0, n_items, step)]
+
+
+def run(fn, parts: list) -> None:
+    """Call ``fn(lo, hi)`` for every range in ``parts``, shared between the caller and the pool."""
+    threads = numba.get_num_threads()
+    if threads <= 1 or len(parts) <= 1:
+        for lo, hi in parts:
+            fn(lo, hi)
+        return
+    counter = itertools.count()
+    remaining = [len(parts)]
+    lock = threading.Lock()
+    done = threading.Event()
+    errors: list = []
+
+    def work() -> None:
+        while not done.is_set():
+            i = next(counter)
+            if i >= len(parts):
+                return
+            try:
+                fn(*parts[i])
+            except BaseException as exc:      # re-raised in the caller
+                errors.append(exc)
+            with lock:
+                remaining[0] -= 1
+                if remaining[0] == 0:
+                    done.set()
+
+    pool = _pool(threads - 1)
+    for _ in range(min(threads - 1, len(parts) - 1)):
+        pool.submit(work)
+    work()
+    done.wait()
+    if errors:
+        raise errors[0]
