@@ -166,7 +166,7 @@ def test_numba_streams_equal_numpy_fallback_and_raw_normals_equal_numpy():
     (dict(seed=1, dt=-0.1, n_steps=3), ValueError, "dt"),
     (dict(seed=1, dt=0.1, n_steps=0), ValueError, "n_steps"),
     (dict(seed=1, times=[0.0, 0.5, 0.5]), ValueError, "times"),
-    (dict(seed=1, dt=0.1, n_steps=3, levy_area="wiktorsson"), ValueError, "levy_area"),
+    (dict(seed=1, dt=0.1, n_steps=3, levy_area="wiktorson"), ValueError, "levy_area"),
     (dict(seed=1, dt=0.1, n_steps=3, substeps=0), ValueError, "substeps"),
     (dict(seed=1, dt=0.1, n_steps=3, kind="strat"), ValueError, "kind"),
     (dict(seed=1, dt=0.1, n_steps=3, batch_shape=(-2,)), ValueError, "batch_shape"),
@@ -217,3 +217,10 @@ def test_one_shot_wrappers_sample_the_driver_stream():
     np.testing.assert_array_equal(dW, Z.increments)
     np.testing.assert_array_equal(XX, Z.areas)
     assert rng.random() == twin.random()           # the wrapper advanced rng by exactly two draws
+
+
+def test_error_controlled_methods_refuse_substeps_and_other_methods_refuse_an_error_target():
+    with pytest.raises(ValueError, match="levy_area_error"):
+        BrownianDriver(2, seed=1, dt=0.1, n_steps=3, levy_area="mrongowius-rossler", substeps=4)
+    with pytest.raises(ValueError, match="levy_area_error applies"):
+        BrownianDriver(2, seed=1, dt=0.1, n_steps=3, levy_area="davie", levy_area_error=1e-3)
