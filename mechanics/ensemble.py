@@ -39,7 +39,7 @@ from typing import Callable
 
 import numpy as np
 
-from roughpaths import BrownianDriver, solve
+from roughpaths import BrownianDriver, register_format, solve
 from roughpaths.validation import as_float_array, check_positive_int
 
 from .statistics import (
@@ -110,6 +110,50 @@ class EnsembleResult:
         mean, m2 = split_moment_features(rm.mean, n)
         se_mean, se_m2 = split_moment_features(rm.standard_error, n)
         return mean, m2, se_mean, se_m2
+
+
+def _moments_to_arrays(rm, prefix, arrays):
+    arrays[prefix + "count"] = np.array(rm.count, dtype=np.int64)
+    arrays[prefix + "mean"] = rm.mean
+    arrays[prefix + "scatter"] = rm.scatter
+
+
+def _moments_from_arrays(arrays, prefix):
+    mean = arrays[prefix + "mean"]
+    rm = RunningMoments(mean.shape[0])
+    rm.count = int(arrays[prefix + "count"])
+    rm.mean = np.array(mean, dtype=np.float64)
+    rm.scatter = np.array(arrays[prefix + "scatter"], dtype=np.float64)
+    return rm
+
+
+def _encode_ensemble(res: "EnsembleResult"):
+    arrays = {"snapshot_times": np.asarray(res.snapshot_times, dtype=np.float64)}
+    _moments_to_arrays(res.final, "final_", arrays)
+    if res.time_average is not None:
+        _moments_to_arrays(res.time_average, "time_average_", arrays)
+    for k, rm in enumerate(res.snapshots):
+        _moments_to_arrays(rm, f"snapshot{k}_", arrays)
+    if res.final_states is not None:
+        arrays["final_states"] = res.final_states
+    extra = {"n_paths": res.n_paths, "n_steps": res.n_steps, "dt": res.dt, "seed": res.seed,
+             "state_dim": res.state_dim, "n_snapshots": len(res.snapshots),
+             "has_time_average": res.time_average is not None}
+    return extra, arrays
+
+
+def _decode_ensemble(meta, arrays):
+    return EnsembleResult(
+        final=_moments_from_arrays(arrays, "final_"),
+        time_average=_moments_from_arrays(arrays, "time_average_") if meta["has_time_average"] else None,
+        snapshot_times=arrays["snapshot_times"],
+        snapshots=[_moments_from_arrays(arrays, f"snapshot{k}_") for k in range(meta["n_snapshots"])],
+        final_states=arrays.get("final_states"), n_paths=meta["n_paths"], n_steps=meta["n_steps"],
+        dt=meta["dt"], seed=meta["seed"], state_dim=meta["state_dim"])
+
+
+# roughpaths.save / roughpaths.load write and read ensemble results (format in roughpaths.io)
+register_format("EnsembleResult", EnsembleResult, _encode_ensemble, _decode_ensemble)
 
 
 @dataclass(frozen=True)

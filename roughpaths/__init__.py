@@ -21,7 +21,7 @@ from .coloured_noise import (
     sample_coloured_noise,
 )
 from .integral import rough_integral
-from .io import load, load_metadata, save
+from .io import load, load_metadata, register_format, save
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals, sample_levy_areas)
 from .level2 import level2_exp, level2_inv, level2_log, level2_mul
@@ -97,6 +97,7 @@ __all__ = [
     "save",
     "load",
     "load_metadata",
+    "register_format",
     # rough paths, group, Brownian lifts, norms, signatures
     "RoughPath",
     "chen_defect",

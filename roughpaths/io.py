@@ -28,7 +28,10 @@ An ``.npz`` archive with these entries:
 
 * for a ``RoughPath``: the arrays ``times`` ``(N + 1,)``, ``increments`` ``(..., N, d)``,
   ``areas`` ``(..., N, d, d)`` (absent for a level-1 path) and ``x0`` ``(..., d)``;
-* for a ``Solution``: the arrays ``times`` ``(K,)`` and ``states`` ``(..., K, e)``.
+* for a ``Solution``: the arrays ``times`` ``(K,)``, ``states`` ``(..., K, e)`` and ``failed_step``
+  (``int64``, the batch shape; see :attr:`roughpaths.Solution.failed_step`);
+* for a type registered by another package (:func:`register_format`; ``mechanics`` registers
+  ``EnsembleResult``): the arrays and metadata entries its encoder writes.
 
 Writes are atomic: the file is written under a temporary name in the target folder and renamed
 over the target only once complete, so a crash never leaves a half-written file under the name.
@@ -48,7 +51,7 @@ import numpy as np
 from .rough_path import RoughPath
 from .solve import Solution
 
-__all__ = ["save", "load", "load_metadata", "FORMAT", "FORMAT_VERSION"]
+__all__ = ["save", "load", "load_metadata", "register_format", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "roughpaths-npz"
 FORMAT_VERSION = 1
@@ -61,6 +64,30 @@ _CONVENTIONS = {
     "reference": "docs/conventions.md",
 }
 _ARRAYS = {"RoughPath": ("times", "increments", "x0"), "Solution": ("times", "states")}
+#: Other packages' types: name -> (class, encode(obj) -> (extra metadata dict, arrays dict),
+#: decode(metadata, arrays) -> obj). ``mechanics`` registers its ``EnsembleResult`` here.
+_CODECS: dict = {}
+
+
+def register_format(name: str, cls: type, encode, decode) -> None:
+    """Teach :func:`save` and :func:`load` another type (used by ``mechanics`` for ``EnsembleResult``).
+
+    Parameters
+    ----------
+    name : str
+        The ``type`` written into the metadata.
+    cls : type
+        Instances of ``cls`` are saved with ``encode``.
+    encode : callable ``obj -> (extra, arrays)``
+        JSON-serialisable metadata entries and a dict of numpy arrays (any dtype but object).
+    decode : callable ``(metadata, arrays) -> obj``
+        The inverse; ``arrays`` holds every array that ``encode`` wrote.
+    """
+    if not isinstance(name, str) or name in _ARRAYS:
+        raise ValueError(f"name must be a new type name (not one of {sorted(_ARRAYS)}), got {name!r}.")
+    if not isinstance(cls, type) or not callable(encode) or not callable(decode):
+        raise TypeError("register_format needs a class and two callables (encode, decode).")
+    _CODECS[name] = (cls, encode, decode)
 
 
 def _package_version() -> str:
@@ -151,10 +178,20 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
     elif isinstance(obj, Solution):
         kind = "Solution"
         arrays = {"times": obj.times, "states": obj.states}
+        if obj.failed_step is not None:
+            arrays["failed_step"] = np.asarray(obj.failed_step, dtype=np.int64)
         extra = {"stats": _to_json(dict(obj.stats), "Solution.stats")}
     else:
-        raise TypeError(f"save() writes a RoughPath or a Solution, got {type(obj).__name__}; for other arrays "
-                        f"use numpy.savez.")
+        for name, (cls, encode, _) in _CODECS.items():
+            if isinstance(obj, cls):
+                kind = name
+                extra, arrays = encode(obj)
+                extra = _to_json(dict(extra), name)
+                break
+        else:
+            raise TypeError(f"save() writes a RoughPath, a Solution or a registered type "
+                            f"({sorted(_CODECS) or 'none registered'}), got {type(obj).__name__}; for other "
+                            f"arrays use numpy.savez.")
     if seed is not None and not isinstance(seed, (int, np.integer)):
         raise TypeError(f"seed must be an int or None, got {seed!r} ({type(seed).__name__}).")
     if metadata is not None and not isinstance(metadata, dict):
@@ -172,7 +209,7 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
         "user": _to_json(metadata or {}, "metadata"),
         **extra,
     }
-    payload = {name: np.ascontiguousarray(a) for name, a in arrays.items()}
+    payload = {name: np.asarray(a, order="C") for name, a in arrays.items()}   # keeps 0-d arrays 0-d
     payload[_META_KEY] = np.array(json.dumps(meta, ensure_ascii=False))
 
     target = Path(os.fspath(path))
@@ -225,8 +262,10 @@ def _metadata(p: Path, data) -> dict:
         raise ValueError(f"{p} uses format version {version} (written by {meta.get('package')} "
                          f"{meta.get('package_version')}), newer than the version this roughpaths "
                          f"{_package_version()} reads ({FORMAT_VERSION}); upgrade roughpaths-mechanics to load it.")
-    if meta.get("type") not in _ARRAYS:
-        raise ValueError(f"{p}: unknown object type {meta.get('type')!r} (expected one of {sorted(_ARRAYS)}).")
+    if meta.get("type") not in _ARRAYS and meta.get("type") not in _CODECS:
+        hint = " (import mechanics to load an EnsembleResult)" if meta.get("type") == "EnsembleResult" else ""
+        raise ValueError(f"{p}: unknown object type {meta.get('type')!r} (expected one of "
+                         f"{sorted(_ARRAYS) + sorted(_CODECS)}){hint}.")
     return meta
 
 
@@ -282,19 +321,37 @@ def load(path):
     with data:
         meta = _metadata(p, data)
         kind = meta["type"]
+        if kind in _CODECS:
+            try:
+                arrays = {n: data[n] for n in data.files if n != _META_KEY}
+            except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
+                raise ValueError(f"{p}: an array is unreadable ({exc}); the file is corrupt or truncated.") from None
+            try:
+                return _CODECS[kind][2](_from_json(meta), arrays)
+            except (KeyError, ValueError, TypeError) as exc:
+                raise ValueError(f"{p}: the stored {kind} is inconsistent ({exc}); the file is corrupt.") from None
         names = _ARRAYS[kind] + (("areas",) if kind == "RoughPath" and meta.get("level") == 2 else ())
         missing = [n for n in names if n not in data.files]
         if missing:
             raise ValueError(f"{p}: the {kind} arrays {missing} are missing; the file is corrupt.")
         try:
             arrays = {n: data[n] for n in names}
+            data_files = tuple(data.files)
+            failed_arr = data["failed_step"] if "failed_step" in data_files else None
         except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
             raise ValueError(f"{p}: an array is unreadable ({exc}); the file is corrupt or truncated.") from None
+    if failed_arr is not None and (failed_arr.dtype != np.int64 or failed_arr.shape != arrays["states"].shape[:-2]):
+        raise ValueError(f"{p}: array 'failed_step' has dtype {failed_arr.dtype} and shape {failed_arr.shape}, "
+                         f"expected int64 of the batch shape; the file is corrupt.")
     for n, a in arrays.items():
         if a.dtype != np.float64:
             raise ValueError(f"{p}: array {n!r} has dtype {a.dtype}, expected float64; the file is corrupt.")
     if kind == "Solution":
-        return Solution(times=arrays["times"], states=arrays["states"], stats=_from_json(meta.get("stats", {})))
+        failed = None
+        if "failed_step" in data_files:
+            failed = failed_arr
+        return Solution(times=arrays["times"], states=arrays["states"], failed_step=failed,
+                        stats=_from_json(meta.get("stats", {})))
     try:
         return RoughPath(arrays["increments"], arrays.get("areas"), times=arrays["times"], x0=arrays["x0"],
                          kind=meta.get("kind"))

@@ -74,6 +74,8 @@ class Solution:
     @property
     def failed(self) -> np.ndarray:
         """Boolean mask ``(...)`` of the batch members that became non-finite."""
+        if self.failed_step is None:
+            return np.zeros(self.states.shape[:-2], dtype=bool)
         return self.failed_step >= 0
 
     def __repr__(self) -> str:

@@ -211,7 +211,7 @@ def test_inconsistent_rough_path_is_refused(saved):
 def test_missing_file_and_bad_arguments(tmp_path):
     with pytest.raises(FileNotFoundError, match="nope.npz"):
         load(tmp_path / "nope.npz")
-    with pytest.raises(TypeError, match="writes a RoughPath or a Solution, got ndarray"):
+    with pytest.raises(TypeError, match="writes a RoughPath, a Solution or a registered type .*, got ndarray"):
         save(np.zeros(3), tmp_path / "a.npz")
     X = RoughPath.from_path(np.zeros((3, 2)))
     with pytest.raises(TypeError, match=r"metadata\['f'\] = .* has type builtin_function"):
