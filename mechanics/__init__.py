@@ -4,7 +4,7 @@ Lie–Poisson / Euler–Poincaré equations with SALT noise, the Lévy-area corr
 dissipation, Casimir-preserving integrators, the stochastic rigid body and heavy top, Gibbs measures,
 and the coloured-noise Wong–Zakai anomaly, built on :mod:`roughpaths`.
 
-Conventions (``CONVENTIONS.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
+Conventions (``docs/conventions.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
 velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``h̃ = h + ⟨μ, ℓ⟩``; the
 paper's printed signs are available as ``convention="paper"``.
 """

@@ -1,6 +1,6 @@
 r"""Equilibria of the modified (Lévy-area-shifted) rigid body and their stability; phase portraits.
 
-The deterministic part of the rough-path-correct (RP) rigid body of ``CONVENTIONS.md`` is
+The deterministic part of the rough-path-correct (RP) rigid body of ``docs/conventions.md`` is
 
 .. math::
 
@@ -104,7 +104,7 @@ def _check_theta(theta) -> float:
 def isotropic_levy_shift(sigma, s, convention: str = "rp") -> np.ndarray:
     r"""The Lévy-area velocity ``c`` for isotropic noise ``ξ_i = σ e_i`` on so(3) ≅ R³.
 
-    ``convention="rp"`` (default, ``CONVENTIONS.md``): ``c = +½ Σ_ij s^{ij} ξ_i × ξ_j
+    ``convention="rp"`` (default, ``docs/conventions.md``): ``c = +½ Σ_ij s^{ij} ξ_i × ξ_j
     = σ² (s23, −s13, s12)``. ``convention="paper"``: the paper's printed ``−½`` (torque sign
     flipped), ``c = −σ² (s23, −s13, s12)``.
 
@@ -574,7 +574,7 @@ def lagrange_top_sleeping_stability(I1, I3, omega3, mgl):
 
     Symmetric top ``𝕀 = diag(I1, I1, I3)``, ``h = ½Π·𝕀⁻¹Π + χ·Γ`` with ``χ = M g ℓ e3`` (centre of
     mass on the symmetry axis at distance ``ℓ``), Lie–Poisson equations on se(3)* in the
-    ``CONVENTIONS.md`` form ``Π̇ = Π × Ω + Γ × χ``, ``Γ̇ = Γ × Ω``. The upright spin is an equilibrium
+    ``docs/conventions.md`` form ``Π̇ = Π × Ω + Γ × χ``, ``Γ̇ = Γ × Ω``. The upright spin is an equilibrium
     for every ``ω3``; it is linearly (and, by energy–Casimir, nonlinearly) stable iff
     ``Π3² > 4 I1 M g ℓ`` (the fast-top criterion). The body-frame linearisation has the eigenvalues
     ``± √(4 I1 M g ℓ − Π3²) / (2 I1)`` (each twice) plus two zeros along the Casimir directions.

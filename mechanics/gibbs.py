@@ -1,6 +1,6 @@
 r"""The Gibbs measure of the dissipative stochastic rigid body on the sphere ``|Π| = r``.
 
-Theorem 3.1 (with the ½ of ``CONVENTIONS.md``): for isotropic noise ``ξ_i = σ e_i`` the RP
+Theorem 3.1 (with the ½ of ``docs/conventions.md``): for isotropic noise ``ξ_i = σ e_i`` the RP
 equation
 
 .. math::

@@ -9,7 +9,7 @@ r"""The stochastic heavy top: Lie–Poisson on se(3)* with :math:`\mu = (\Pi, \G
     d\Gamma &= \Gamma\times W\,dt + \sum_i\Gamma\times\xi_i\circ dX^i,\qquad W = \Omega + c,
 
 with :math:`c = \tfrac12\mathsf s^{ij}\xi_i\times\xi_j` for noise in the so(3) part. The gravity term is
-:math:`\Gamma\times\chi` (``CONVENTIONS.md``); the paper's (heavytoplevy) prints :math:`+\chi\times\gamma`,
+:math:`\Gamma\times\chi` (``docs/conventions.md``); the paper's (heavytoplevy) prints :math:`+\chi\times\gamma`,
 which does not conserve :math:`h` — ``convention="paper"`` reproduces it (it is the flow of
 :math:`\tfrac12\Pi\cdot\mathbb I^{-1}\Pi - \chi\cdot\Gamma`) together with the flipped Lévy torque.
 Casimirs :math:`|\Gamma|^2` and :math:`\Pi\cdot\Gamma` are conserved in both conventions.

@@ -14,7 +14,7 @@ Conventions
 * With this convention :math:`\mu \mapsto \mathrm{ad}^*_\xi \mu` is an anti-homomorphism:
   :math:`[\mathrm{ad}^*_\xi, \mathrm{ad}^*_\eta] = -\mathrm{ad}^*_{[\xi,\eta]}` (matrix commutator), and the
   linear vector fields :math:`V_i(\mu) = \mathrm{ad}^*_{\xi_i}\mu` have Jacobi–Lie bracket
-  (``CONVENTIONS.md``: :math:`[V,W] = DW\,V - DV\,W`) :math:`[V_i, V_j](\mu) = \mathrm{ad}^*_{[\xi_i,\xi_j]}\mu`.
+  (``docs/conventions.md``: :math:`[V,W] = DW\,V - DV\,W`) :math:`[V_i, V_j](\mu) = \mathrm{ad}^*_{[\xi_i,\xi_j]}\mu`.
 * ``Ad_star_exp(sigma, mu)`` is :math:`\exp(\mathrm{ad}^*_\sigma)\,\mu = \mathrm{Ad}_{\exp\sigma}^{T}\mu`: the
   time-1 flow of :math:`\dot\mu = \mathrm{ad}^*_\sigma\mu`. It maps every coadjoint orbit to itself, so
   it preserves every Casimir exactly (up to round-off).

@@ -9,7 +9,7 @@ path :math:`\mathbf X = (X, \mathbb X)` in :math:`\mathbb R^m`, is
     w(\mu) = \nabla\tilde h(\mu) + \vartheta\,\big(\mathrm{ad}^*_{\nabla\tilde h(\mu)}\mu\big)^\sharp,
 
 with the modified Hamiltonian :math:`\tilde h(\mu) = h(\mu) + \langle\mu, \ell\rangle` and the Lévy-area
-velocity :math:`\ell = \tfrac12\sum_{i,j}\mathsf s^{ij}[\xi_i,\xi_j]` (``CONVENTIONS.md``; ``ad*`` as in
+velocity :math:`\ell = \tfrac12\sum_{i,j}\mathsf s^{ij}[\xi_i,\xi_j]` (``docs/conventions.md``; ``ad*`` as in
 :mod:`mechanics.lie_algebra`, i.e. :math:`\mathrm{ad}^*_\xi\Pi = \Pi\times\xi` on so(3)).
 
 Why :math:`+\ell`: the noise fields :math:`V_i(\mu) = \mathrm{ad}^*_{\xi_i}\mu` have Jacobi–Lie bracket

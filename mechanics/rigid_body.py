@@ -1,6 +1,6 @@
 r"""The stochastic rigid body on so(3)* ≅ R³ (body angular momentum :math:`\Pi`).
 
-Rough-path-correct equation (``CONVENTIONS.md``), with :math:`W = \mathbb I^{-1}\Pi + c`:
+Rough-path-correct equation (``docs/conventions.md``), with :math:`W = \mathbb I^{-1}\Pi + c`:
 
 .. math::
 

@@ -9,7 +9,7 @@ Rigid body (paper eq. (srbcoloured), **no added drift**): with :math:`\Omega = \
 
 driven by the (smooth) coloured noise ``B^ε = ∫ y/ε dt`` of :mod:`roughpaths.coloured_noise`.
 
-Limit (Friz–Oberhauser, ``CONVENTIONS.md``). ``B^ε`` converges as a rough path to
+Limit (Friz–Oberhauser, ``docs/conventions.md``). ``B^ε`` converges as a rough path to
 ``(MB, M BB^{Strat} Mᵀ + N(t−s))`` with ``M = A⁻¹D`` and ``N = Alt(ΣA⁻ᵀ)`` (**B^ε coordinates**).
 Driving the fields :math:`V_i(\Pi) = \Pi\times\xi_i` by ``MB`` is driving the fields
 :math:`\Pi\times\xi'_k` by ``B`` with ``ξ'_k = Σ_i M_{ik} ξ_i = σ M[:, k]`` (the columns of ``σA⁻¹D``);

@@ -1,6 +1,6 @@
 r"""Brownian motion lifted to a level-2 rough path (Stratonovich or Itô), sampled on a grid.
 
-Conventions (``CONVENTIONS.md``)
+Conventions (``docs/conventions.md``)
 --------------------------------
 * area ``XX[..., i, j]`` over a step ``[s, t]`` is :math:`\int_s^t (W^i_r - W^i_s)\,\circ dW^j_r`
   (``iisignature`` ordering);

@@ -10,7 +10,7 @@ The process (paper, Section 4.2 and appendix "Coloured noise as a rough path")
 with ``A`` (n×n) whose eigenvalues have positive real part and ``D`` (n×m), ``B`` an m-dimensional
 Brownian motion. ``y`` has the ε-independent stationary covariance ``Σ``, ``AΣ + ΣAᵀ = DDᵀ``.
 
-Limit (``CONVENTIONS.md``, "Coloured noise"). As ε → 0 the canonical (Young) lift of ``B^ε``
+Limit (``docs/conventions.md``, "Coloured noise"). As ε → 0 the canonical (Young) lift of ``B^ε``
 converges to
 
 .. math::

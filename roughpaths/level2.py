@@ -4,7 +4,7 @@ An element is a pair ``x`` of shape ``(..., d)`` (level 1) and ``a`` of shape ``
 (level 2), standing for :math:`1 + x + a` in the tensor algebra truncated at depth 2.
 All functions broadcast over leading batch axes.
 
-Conventions (``CONVENTIONS.md``):
+Conventions (``docs/conventions.md``):
 
 * product :math:`(x, a)\cdot(y, b) = (x + y,\; a + b + x\otimes y)` (Chen's identity);
 * inverse :math:`(x, a)^{-1} = (-x,\; -a + x\otimes x)`;

@@ -4,7 +4,7 @@ Output layouts (see :mod:`roughpaths.tensor_algebra`):
 
 * :func:`signature` — flat, levels ``1..depth`` concatenated, row-major words, no leading 1:
   the layout of ``iisignature.sig(path, depth)`` (and of ``esig.stream2sig`` minus its 1).
-  Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``CONVENTIONS.md``.
+  Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``docs/conventions.md``.
 * :func:`logsignature` — coordinates in the Lyndon basis (standard bracketing, ordered by
   length then lexicographically; :func:`roughpaths.tensor_algebra.lyndon_basis` names them),
   the coordinates of ``iisignature.logsig(path, iisignature.prepare(d, depth))``. Level-2

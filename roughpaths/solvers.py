@@ -11,7 +11,7 @@ Each solver is a small class with two class attributes and one method:
   increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` at level 1), vectorised
   over the batch (leading axes broadcast).
 
-Conventions (``CONVENTIONS.md``): area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`, bracket
+Conventions (``docs/conventions.md``): area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`, bracket
 :math:`[V, W] = DW\cdot V - DV\cdot W`, Lévy area :math:`A = \tfrac12(\mathbb{X} - \mathbb{X}^T)`.
 
 ============  =====  ==============  ============  ==================================================

@@ -15,7 +15,7 @@ level is *implicit*:
   :func:`tensor_log`) have ``c_0 = 0``.
 
 Level 2 is the area in the project's ordering: entry ``[i, j]`` is the word ``(i, j)``, i.e.
-:math:`\int (X^i - X^i_s)\,dX^j` for a signature (``CONVENTIONS.md``); :func:`to_level2` /
+:math:`\int (X^i - X^i_s)\,dX^j` for a signature (``docs/conventions.md``); :func:`to_level2` /
 :func:`from_level2` convert to and from the pair ``(x, a)`` of :mod:`roughpaths.level2`.
 
 Every function broadcasts over leading batch axes ``...``; the depth is read from the length of

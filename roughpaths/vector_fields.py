@@ -5,7 +5,7 @@ The rough differential equation is
 .. math:: dY = V_0(Y)\,dt + \sum_{i=1}^d V_i(Y)\,d\mathbf{X}^i, \qquad V_i : \mathbb{R}^e \to \mathbb{R}^e .
 
 A family is one object; every method is vectorised over leading batch axes of ``y`` (shape
-``(..., e)``). Conventions (``CONVENTIONS.md``):
+``(..., e)``). Conventions (``docs/conventions.md``):
 
 * ``fields(y)[..., a, i]`` is :math:`V_i^a(y)` (shape ``(..., e, d)``);
 * ``jacobians(y)[..., i, a, b]`` is :math:`\partial_b V_i^a(y)` (shape ``(..., d, e, e)``);
