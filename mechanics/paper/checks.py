@@ -4,7 +4,7 @@ Each check is a function ``check(ctx) -> CheckResult`` (see :class:`mechanics.pa
 that computes a *predicted* number from the theory (closed form, quadrature) and a *measured* one
 from a simulation or an independent computation with the library, compares them with a stated
 tolerance, and says pass or fail. Sizes come from ``ctx.size(...)`` (``tiny`` / ``default`` /
-``full``); at default sizes all checks and figures finish in under 5 minutes on 2 cores.
+``full``; their measured cost: ``docs/main-job.md``, section Cost).
 
 The mathematics lives in :mod:`roughpaths` and :mod:`mechanics` (public names only); this module
 only calls it, through the same entry points as the tests (the Gibbs check of Theorem 3.1 through
