@@ -22,6 +22,7 @@ import argparse
 import os
 import signal
 import sys
+import threading
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -257,7 +258,8 @@ def run(opts: Options) -> int:
     folder = RunFolder(opts.output)
     run_info = {"seed": opts.seed, "convention": opts.convention, "scale": opts.scale, "only": opts.only,
                 "versions": versions()}
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    in_main_thread = threading.current_thread() is threading.main_thread()   # signals: main thread only
+    previous = signal.signal(signal.SIGTERM, _on_sigterm) if in_main_thread else None
     try:
         with folder:
             folder.open(run_info, overwrite=opts.overwrite, resume=opts.resume, notify=prog.message)
@@ -293,7 +295,8 @@ def run(opts: Options) -> int:
                          "INCOMPLETE): continue it with the same options and --resume")
         raise
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        if in_main_thread:
+            signal.signal(signal.SIGTERM, previous)
     bad = [r for r in checks + figures if r.status in (FAIL, ERROR)]
     n_pass = sum(c.status == PASS for c in checks)
     prog.message(f"{PROG}: {len(figures)} figures, checks {n_pass}/{len(checks)} passed"
