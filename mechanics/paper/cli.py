@@ -28,10 +28,10 @@ import traceback
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 
+import importlib
+
 import mechanics
 
-from .checks import CHECKS
-from .figures import FIGURES
 from .output import OutputError, RunFolder
 from .report import (
     ERROR,
@@ -48,7 +48,7 @@ from .report import (
 )
 from .tasks import Context, Progress
 
-__all__ = ["main", "build_parser", "parse_options", "Options", "UsageError", "run"]
+__all__ = ["main", "build_parser", "parse_options", "Options", "UsageError", "run", "registries"]
 
 PROG = "levy-area-paper"
 SCALES = ("tiny", "default", "full")
@@ -56,6 +56,16 @@ CONVENTIONS = ("rp", "paper")
 DEFAULT_OUTPUT = "paper-output"
 #: environment variable overriding the default size scale (used by the tests: ``tiny``)
 SCALE_ENV = "LEVY_AREA_PAPER_SCALE"
+
+
+def registries() -> tuple[dict, dict]:
+    """The registries ``(FIGURES, CHECKS)`` of :mod:`mechanics.paper.figures` and :mod:`~.checks`.
+
+    Loaded on first use rather than when this module is imported: they bring in matplotlib and
+    scipy's integrators (about a second), which ``--help`` and a mistyped option do not need.
+    """
+    return (importlib.import_module("mechanics.paper.figures").FIGURES,
+            importlib.import_module("mechanics.paper.checks").CHECKS)
 
 
 class UsageError(Exception):
@@ -158,7 +168,7 @@ def parse_options(argv: list[str] | None) -> Options:
         raise UsageError("--output must be a folder name, got an empty string")
     only = None
     if ns.only is not None:
-        figs, chks = list(FIGURES), list(CHECKS)
+        figs, chks = (list(r) for r in registries())
         known = figs + chks
         only = []
         for chunk in ns.only:
@@ -188,7 +198,8 @@ def _run_tasks(opts: Options, folder: RunFolder, prog: Progress):
     selected = set(opts.only) if opts.only else None
     figures, checks, sizes, timings, reused = [], [], {}, {}, []
     cache: dict = {}
-    for kind, registry in (("figure", FIGURES), ("check", CHECKS)):
+    figure_registry, check_registry = registries()
+    for kind, registry in (("figure", figure_registry), ("check", check_registry)):
         for name, task in registry.items():
             if selected is not None and name not in selected:
                 continue
@@ -234,11 +245,12 @@ def _short(v):
 
 
 def _list() -> int:
+    figure_registry, check_registry = registries()
     print("figures:")
-    for name, t in FIGURES.items():
+    for name, t in figure_registry.items():
         print(f"  {name:<14} {t.title}")
     print("checks:")
-    for name, t in CHECKS.items():
+    for name, t in check_registry.items():
         print(f"  {name:<14} {t.title}")
     return 0
 

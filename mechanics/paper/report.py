@@ -19,12 +19,10 @@ import json
 import platform
 import sys
 from dataclasses import asdict, dataclass, field
+from importlib import metadata
 from typing import Any
 
 import numpy as np
-import matplotlib
-import numba
-import scipy
 
 import mechanics
 import roughpaths
@@ -131,8 +129,12 @@ def result_from_json(data: dict) -> CheckResult | FigureResult:
 def versions() -> dict:
     """Versions of Python, the platform and the packages the run depends on."""
     out = {"python": sys.version.split()[0], "platform": platform.platform()}
-    for mod in (np, scipy, matplotlib, numba, roughpaths, mechanics):
-        out[mod.__name__] = getattr(mod, "__version__", "?")
+    for dist in ("numpy", "scipy", "matplotlib", "numba"):   # without importing matplotlib (start-up time)
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:  # pragma: no cover - a core dependency
+            out[dist] = "not installed"
+    out["roughpaths"], out["mechanics"] = roughpaths.__version__, mechanics.__version__
     return out
 
 
