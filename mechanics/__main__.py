@@ -1,13 +1,14 @@
 """Main job: ``python -m mechanics`` (also the console script ``levy-area-paper``).
 
-Reproduces the paper's figures and theorem checks; see :mod:`mechanics.cli` and ``--help``.
+Reproduces the paper's figures and theorem checks; the application lives in :mod:`mechanics.paper`
+(see :mod:`mechanics.paper.cli` and ``--help``).
 """
 
 from __future__ import annotations
 
 import sys
 
-from .cli import main
+from mechanics.paper.cli import main
 
 __all__ = ["main"]
 

@@ -1,6 +1,6 @@
 """roughpaths: level-2 (and level-N) geometric rough paths, fractional Brownian motion, signatures, Brownian lifts, norms and RDE solvers.
 
-Conventions are fixed once, in ``CONVENTIONS.md`` of the project: the area ``XX[i, j]`` is
+Conventions are fixed once, in ``docs/conventions.md`` of the project: the area ``XX[i, j]`` is
 ``∫ (X^i - X^i_s) dX^j`` (iisignature ordering), the Lévy area is ``½(XX - XXᵀ)``, and the
 Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """

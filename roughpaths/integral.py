@@ -7,7 +7,7 @@ Gubinelli derivative :math:`Y'` (:math:`Y_t - Y_s = Y'_s X_{s,t} + O(|t-s|^{2\al
           + Y'_{t_k}\,\mathbb{X}_{t_k,t_{k+1}}, \qquad
           (Y'\mathbb{X})^a = \sum_{i,j} Y'^{\,a}_{j\,i}\,\mathbb{X}^{ij},
 
-with the area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j` (``CONVENTIONS.md``). Index layout:
+with the area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j` (``docs/conventions.md``). Index layout:
 ``Y[..., a, j]`` is the coefficient of :math:`dX^j` in component ``a``; ``Yp[..., a, j, i]`` is
 :math:`\partial Y^a_j / \partial X^i`. For :math:`Y = F(X)`, :math:`Y' = DF(X)`.
 

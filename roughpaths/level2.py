@@ -6,7 +6,7 @@ All functions broadcast over leading batch axes and check their input: real, fin
 ``x`` ending in ``d`` and ``a`` ending in ``(d, d)`` with the same ``d``, batch axes that broadcast
 (anything else is a ``TypeError`` / ``ValueError`` naming the argument).
 
-Conventions (``CONVENTIONS.md``):
+Conventions (``docs/conventions.md``):
 
 * product :math:`(x, a)\cdot(y, b) = (x + y,\; a + b + x\otimes y)` (Chen's identity);
 * inverse :math:`(x, a)^{-1} = (-x,\; -a + x\otimes x)`;

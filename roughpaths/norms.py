@@ -14,7 +14,7 @@ Tensor norms
   :math:`\mathbb{R}^{d\times d} = \mathbb{R}^d\otimes\mathbb{R}^d`, i.e. the Hilbert tensor norm
   (admissible; equivalent to the projective norm up to a factor depending on ``d`` only).
 
-Areas follow ``CONVENTIONS.md``: :math:`\mathbb{X}^{ij}_{s,t} = \int_s^t (X^i_r - X^i_s)\,dX^j_r`,
+Areas follow ``docs/conventions.md``: :math:`\mathbb{X}^{ij}_{s,t} = \int_s^t (X^i_r - X^i_s)\,dX^j_r`,
 combined over pairs by Chen's identity.
 
 Definitions (``X`` a rough path on the grid :math:`t_0 < \dots < t_N`)

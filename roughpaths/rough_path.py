@@ -6,7 +6,7 @@ batch, the per-step increments :math:`X_{t_k, t_{k+1}}` and per-step areas
 ``s < t`` follows from these by Chen's identity, so the stored object is Chen-consistent by
 construction.
 
-Conventions (``CONVENTIONS.md``)
+Conventions (``docs/conventions.md``)
 --------------------------------
 * area: ``XX[..., i, j]`` over ``[s, t]`` is :math:`\int_s^t (X^i_r - X^i_s)\,dX^j_r`
   (the ordering of ``iisignature`` and ``esig``: word ``(i, j)`` ↔ entry ``[i, j]``);

@@ -6,7 +6,7 @@ increment a step consumes, its declared orders, its calculus, the invariants it 
 :class:`~roughpaths.vector_fields.VectorFields`; :mod:`mechanics` adds coadjoint solvers for
 Lie–Poisson systems under the same contract, so that one :func:`roughpaths.solve` integrates both.
 
-Conventions (``CONVENTIONS.md``): area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`, bracket
+Conventions (``docs/conventions.md``): area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`, bracket
 :math:`[V, W] = DW\cdot V - DV\cdot W`, Lévy area :math:`A = \tfrac12(\mathbb{X} - \mathbb{X}^T)`.
 
 ============  =====  ==============  ============  ==================================================

@@ -8,7 +8,7 @@ A family is one object; every method is vectorised over leading batch axes of ``
 ``(..., e)``). Naming, said once: the maths' :math:`V_0` is the drift (``drift=`` here and in
 :func:`roughpaths.solve`), and the driving fields :math:`V_1..V_d` are indexed from 0 in the API
 (``fields(y)[..., :, i]`` and ``bracket(i, j)`` refer to :math:`V_{i+1}`). Fields may depend on time,
-:math:`V_i(t, y)` (``time_dependent=True``); autonomous fields are the default. Conventions (``CONVENTIONS.md``):
+:math:`V_i(t, y)` (``time_dependent=True``); autonomous fields are the default. Conventions (``docs/conventions.md``):
 
 * ``fields(y)[..., a, i]`` is :math:`V_i^a(y)` (shape ``(..., e, d)``);
 * ``jacobians(y)[..., i, a, b]`` is :math:`\partial_b V_i^a(y)` (shape ``(..., d, e, e)``);

@@ -3,18 +3,24 @@
 Claims: options parse to the documented values; every user error (bad option value, unknown name,
 existing non-empty output folder, unwritable folder) is exactly one line on stderr and exit code 2,
 never a traceback, and leaves an existing folder untouched; a tiny end-to-end run writes the
-figures (PNG + npz), ``report.md`` and a self-contained ``report.html``.
+figures (PNG + npz), ``report.md``, a self-contained ``report.html``, ``results.json`` and a
+``manifest.json`` listing every file. The output folder's safety (atomic writes, lock, resume) is
+tested in ``tests/test_main_job_output.py``.
 """
 
 from __future__ import annotations
 
 import io
+import json
+import subprocess
+import sys
 
 import pytest
 
-from mechanics.cli import SCALE_ENV, Progress, UsageError, main, parse_options
-from mechanics.checks import CHECKS
-from mechanics.figures import FIGURES
+from mechanics.paper.checks import CHECKS
+from mechanics.paper.cli import SCALE_ENV, UsageError, main, parse_options
+from mechanics.paper.figures import FIGURES
+from mechanics.paper.tasks import Progress
 
 
 # ------------------------------------------------------------------------------------ option parsing
@@ -22,8 +28,8 @@ def test_defaults(monkeypatch):
     monkeypatch.delenv(SCALE_ENV, raising=False)
     o = parse_options([])
     assert str(o.output) == "paper-output"
-    assert (o.convention, o.seed, o.scale, o.only, o.quiet, o.overwrite) == ("rp", 0, "default", None, False,
-                                                                              False)
+    assert (o.convention, o.seed, o.scale, o.only, o.quiet, o.overwrite, o.resume) == (
+        "rp", 0, "default", None, False, False, False)
 
 
 def test_values(monkeypatch):
@@ -42,6 +48,8 @@ def test_only_names_and_groups():
     assert o.only == list(dict.fromkeys([names[0], names[-1]]))
     assert parse_options(["--only", "checks"]).only == names
     assert parse_options(["--only", "figures,checks"]).only == list(FIGURES) + names
+    # report order whatever the order given, so a resumed run compares equal
+    assert parse_options(["--only", f"{names[-1]},{names[0]}"]).only == [names[0], names[-1]]
 
 
 @pytest.mark.parametrize("argv, fragment", [
@@ -53,6 +61,7 @@ def test_only_names_and_groups():
     (["--bogus"], "unrecognized arguments"),
     (["--full", "--tiny"], "not allowed with"),
     (["--output", ""], "--output"),
+    (["--resume", "--list"], "--resume"),
 ])
 def test_bad_options_one_line_exit_2(argv, fragment, capsys, tmp_path):
     with pytest.raises(UsageError):
@@ -153,9 +162,13 @@ def test_tiny_end_to_end_run(tiny_paper_run):
         assert f"`{name}`" in md
     assert "seed **3**" in md
     assert "http://" not in page and "https://" not in page  # self-contained
-    for name, task in FIGURES.items():
-        if task.missing_modules():
-            continue
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["complete"] and manifest["seed"] == 3 and manifest["scale"] == "tiny"
+    assert sorted(f["name"] for f in manifest["files"]) == sorted(p.name for p in out.iterdir()
+                                                                   if p.name != "manifest.json")
+    results = json.loads((out / "results.json").read_text())
+    assert [c["name"] for c in results["checks"]] == list(CHECKS)
+    for name in FIGURES:
         assert (out / f"{name}.png").stat().st_size > 10_000, name
         assert (out / f"{name}.npz").exists(), name
         assert f"id='{name}'" in page and "data:image/png;base64," in page

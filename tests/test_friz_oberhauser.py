@@ -1,6 +1,6 @@
 """Friz–Oberhauser, pathwise: perturbing the area by ``s (t - s)`` equals adding the drift ``½ Σ s^{ij}[V_i, V_j]``.
 
-Claim (``CONVENTIONS.md``, the paper's Theorem A.1 with its slips corrected): for a geometric rough
+Claim (``docs/conventions.md``, the paper's Theorem A.1 with its slips corrected): for a geometric rough
 path ``X`` and antisymmetric ``s``, the solution of ``dY = V_i(Y) dX̃^i`` with
 ``X̃ = (X, XX + s (t - s))`` equals the solution of ``dY = ½ Σ_{i,j} s^{ij}[V_i, V_j](Y) dt + V_i(Y) dX^i``,
 with the Jacobi–Lie bracket ``[V, W] = DW·V − DV·W``.

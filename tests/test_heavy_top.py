@@ -1,7 +1,7 @@
 """The stochastic heavy top on se(3)*.
 
 Claims: the vector field is dΠ = Π×W + Γ×χ, dΓ = Γ×W (W = I⁻¹Π + c), i.e. the Lie–Poisson flow of
-h = ½Π·I⁻¹Π + χ·Γ (CONVENTIONS.md: Γ × χ, not the paper's + χ × γ); the Casimirs |Γ|² and Π·Γ are
+h = ½Π·I⁻¹Π + χ·Γ (docs/conventions.md: Γ × χ, not the paper's + χ × γ); the Casimirs |Γ|² and Π·Γ are
 conserved to round-off by the coadjoint schemes, with noise and Lévy torque; without noise the
 energy h is conserved to (at least) second order in dt by Lie–Heun (fitted slope ≈ 3), exactly (to
 round-off) by the chord-solved implicit midpoint, to first order only by Lie–Euler, and the paper's printed gravity sign does not conserve h at all.

@@ -93,7 +93,7 @@ def test_ad_star_is_antihomomorphism_and_bracket_of_noise_fields(algebra, rng):
     x, y, mu = rng.standard_normal((3, n))
     ax, ay = algebra.ad_star_matrix(x), algebra.ad_star_matrix(y)
     np.testing.assert_allclose(ax @ ay - ay @ ax, -algebra.ad_star_matrix(algebra.bracket(x, y)), atol=1e-12)
-    # Jacobi–Lie bracket of V_x = ad*_x μ and V_y (CONVENTIONS: [V,W] = DW V - DV W) = ad*_{[x,y]} μ
+    # Jacobi–Lie bracket of V_x = ad*_x μ and V_y (docs/conventions.md: [V,W] = DW V - DV W) = ad*_{[x,y]} μ
     vw = ay @ (ax @ mu) - ax @ (ay @ mu)
     np.testing.assert_allclose(vw, algebra.ad_star(algebra.bracket(x, y), mu), atol=1e-12)
     np.testing.assert_allclose(algebra.coadjoint_orbit_tangent(mu) @ x, algebra.ad_star(x, mu), atol=1e-13)

@@ -1,4 +1,4 @@
-"""Proposition 2.1 (with the sign of CONVENTIONS.md): perturbing the area is a drift.
+"""Proposition 2.1 (with the sign of docs/conventions.md): perturbing the area is a drift.
 
 Claim: for every geometric rough path X and antisymmetric s, the Lie–Poisson RDE
 dμ = ad*_{∇h} μ dt + ad*_{ξ_i} μ dX̃^i driven by X̃ = X.perturb(s) (area XX + s(t-s)) and the corrected
@@ -53,7 +53,7 @@ def test_integrators_perturbed_path_equals_corrected_system(method, algebra, rng
 
 
 def test_levy_velocity_closed_form():
-    """ℓ = ½ s^{ij} ξ_i × ξ_j, for ξ_i = σ e_i: σ² (s23, -s13, s12) (CONVENTIONS.md)."""
+    """ℓ = ½ s^{ij} ξ_i × ξ_j, for ξ_i = σ e_i: σ² (s23, -s13, s12) (docs/conventions.md)."""
     rb = rigid_body([1.0, 2.0, 3.0], sigma=0.05, s=S)
     naive = 0.5 * sum(S[i, j] * np.cross(0.05 * np.eye(3)[i], 0.05 * np.eye(3)[j]) for i in range(3) for j in range(3))
     np.testing.assert_allclose(rb.levy_velocity, naive, atol=1e-15)

@@ -13,7 +13,7 @@ fields given as plain callables (inner RK4, finite-difference Jacobian) matches 
 ``Davie`` converges with fitted order 1 (it is Euler for ``Y' = C Y`` here); the transposed
 area (``C^T``-type ordering ``M_i M_j``) or a missing ½ in the Lévy-area generator differ by O(1).
 For the rigid-body fields ``V_i(Π) = Π × ξ_i`` the solution is the rotation ``Π' = Π × c`` with
-``c = ½ Σ s^{ij} ξ_i × ξ_j`` (``CONVENTIONS.md``).
+``c = ½ Σ s^{ij} ξ_i × ξ_j`` (``docs/conventions.md``).
 """
 
 import numpy as np

@@ -1,19 +1,55 @@
 #!/usr/bin/env bash
 # Create (once) the project's virtual environment and install the package into it.
-# Usage: tools/setup_env.sh [EXTRAS]   e.g. tools/setup_env.sh test
+# Usage: tools/setup_env.sh [EXTRAS]   e.g. tools/setup_env.sh test,docs
 # Prints the path of the environment's python on its last line; pip's output goes to
 # $VENV/setup.log and is shown only if a step fails.
+#
+# Nothing is installed when nothing changed: $VENV/.setup-stamp records a hash of pyproject.toml and
+# of the environment's Python version, and the extras installed; the install runs again only when
+# that hash differs or an extra is missing (so ./run.sh after ./test.sh does not reinstall).
+# After an install, the numba kernels are compiled once (a --tiny run of the main job and a few
+# library calls; numba caches them on disk), so the first real call starts at once.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV="${VENV:-.venv}"
 EXTRAS="${1:-}"
-if [ ! -x "$VENV/bin/python" ]; then
+PY="$VENV/bin/python"
+STAMP="$VENV/.setup-stamp"
+
+digest() {  # sha256 of stdin, with whatever the system has
+    if command -v sha256sum >/dev/null 2>&1; then sha256sum | cut -d' ' -f1
+    elif command -v shasum >/dev/null 2>&1; then shasum -a 256 | cut -d' ' -f1
+    else python3 -c 'import hashlib, sys; print(hashlib.sha256(sys.stdin.buffer.read()).hexdigest())'
+    fi
+}
+# the inputs of an install: the package metadata and the environment's Python version
+inputs_hash() { { cat pyproject.toml; grep -i '^version' "$VENV/pyvenv.cfg" 2>/dev/null || true; } | digest; }
+# "a,b" -> "a b" sorted, unique, without empties
+norm_extras() { tr ', ' '\n\n' <<<"$1" | sed '/^$/d' | sort -u | tr '\n' ' ' | sed 's/ $//'; }
+
+if [ -x "$PY" ] && [ -f "$STAMP" ] && [ -x "$VENV/bin/levy-area-paper" ]; then
+    stamp_hash="$(sed -n 1p "$STAMP")"
+    stamp_extras="$(sed -n 2p "$STAMP")"
+    missing=""
+    for e in $(norm_extras "$EXTRAS"); do
+        case " $stamp_extras " in *" $e "*) ;; *) missing="$missing $e" ;; esac
+    done
+    if [ "$stamp_hash" = "$(inputs_hash)" ] && [ -z "$missing" ]; then
+        echo "$PY"
+        exit 0
+    fi
+    # install the union, so that a later call with fewer extras finds everything
+    EXTRAS="$stamp_extras $EXTRAS"
+fi
+EXTRAS="$(norm_extras "$EXTRAS" | tr ' ' ',')"
+
+if [ ! -x "$PY" ]; then
     echo "Creating the virtual environment $VENV (first run only) ..." >&2
     python3 -m venv "$VENV" >&2
 fi
-PY="$VENV/bin/python"
 LOG="$VENV/setup.log"
 : > "$LOG"
+rm -f "$STAMP"
 pipi() {
     if ! "$PY" -m pip install --disable-pip-version-check "$@" >>"$LOG" 2>&1; then
         echo "pip install $* failed; its output:" >&2
@@ -21,7 +57,7 @@ pipi() {
         exit 1
     fi
 }
-echo "Installing the package${EXTRAS:+ with extras [$EXTRAS]} into $VENV ..." >&2
+echo "Installing the package${EXTRAS:+ with extras [$EXTRAS]} into $VENV (again only when pyproject.toml changes) ..." >&2
 pipi --upgrade pip setuptools wheel numpy
 if [[ "$EXTRAS" == *test* || "$EXTRAS" == *bench* ]]; then
     # iisignature's setup.py imports numpy at build time: build it against the numpy above.
@@ -32,4 +68,24 @@ if [ -n "$EXTRAS" ]; then
 else
     pipi -e .
 fi
+
+# Compile the numba kernels once (cached on disk by numba): the main job's, at tiny sizes, and the
+# signature and norm kernels; afterwards the first call of a user does not wait for the compiler.
+echo "Compiling the numba kernels once (about a minute) ..." >&2
+WARM="$(mktemp -d)"
+rc=0
+"$PY" -m mechanics --tiny --quiet --output "$WARM/run" >>"$LOG" 2>&1 || rc=$?
+[ "$rc" -le 1 ] || echo "warning: the warm-up run failed (exit $rc, see $LOG)" >&2   # 1: a tiny-size check failed
+"$PY" - >>"$LOG" 2>&1 <<'EOF' || echo "warning: compiling the signature kernels failed (see $LOG)" >&2
+import numpy as np
+import roughpaths as rp
+
+x = np.random.default_rng(0).standard_normal((2, 9, 3)).cumsum(axis=1)
+rp.signature(x, 3)
+rp.logsignature(x, 3)
+rp.p_variation(x[0], 2.5)
+EOF
+rm -rf "$WARM"
+
+{ inputs_hash; norm_extras "$EXTRAS"; } > "$STAMP"
 echo "$PY"

@@ -2,7 +2,7 @@
 
 Run with ``python docs/tutorials/friz_oberhauser.py`` (``TUTORIAL_SMALL=1`` for reduced sizes).
 
-Claim (paper Theorem A.1, with the sign and factor of CONVENTIONS.md): solving
+Claim (paper Theorem A.1, with the sign and factor of docs/conventions.md): solving
 ``dY = V_i(Y) dX^i`` driven by ``(X, XX + s (t − s))`` gives the same solution as driving by ``X`` and
 adding the drift ``½ Σ_{i,j} s^{ij} [V_i, V_j]``, with ``[V, W] = DW·V − DV·W``. The paper prints
 ``½ Σ_{i≤j}`` (half of it); the opposite sign is the other classic slip.

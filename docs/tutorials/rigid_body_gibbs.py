@@ -2,7 +2,7 @@
 
 Run with ``python docs/tutorials/rigid_body_gibbs.py`` (``TUTORIAL_SMALL=1`` for reduced sizes).
 
-The rough-path rigid body of CONVENTIONS.md, body frame, isotropic noise ``ξ_i = σ e_i``:
+The rough-path rigid body of docs/conventions.md, body frame, isotropic noise ``ξ_i = σ e_i``:
 
     dΠ = Π × W dt + θ Π × (Π × W) dt + Σ_i Π × ξ_i ∘ dW^i,   W = 𝕀⁻¹Π + c,   c = σ² (s23, −s13, s12),
 

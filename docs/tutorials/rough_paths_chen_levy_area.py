@@ -3,7 +3,7 @@
 Run it with ``python docs/tutorials/rough_paths_chen_levy_area.py``. Set the environment variable
 ``TUTORIAL_SMALL=1`` for reduced sizes (the test suite does).
 
-Conventions (CONVENTIONS.md): the area is ``XX[i, j]_{s,t} = ∫_s^t (X^i_r - X^i_s) dX^j_r`` (the
+Conventions (docs/conventions.md): the area is ``XX[i, j]_{s,t} = ∫_s^t (X^i_r - X^i_s) dX^j_r`` (the
 ordering of iisignature and esig), the Lévy area is ``A = ½(XX - XXᵀ)`` *with* the ½.
 """
 

@@ -1,40 +1,47 @@
 """Registry of the paper's theorem / proposition checks run by the main job.
 
-Each check is a function ``check(ctx) -> CheckResult`` (see :class:`mechanics.report.CheckResult`)
+Each check is a function ``check(ctx) -> CheckResult`` (see :class:`mechanics.paper.report.CheckResult`)
 that computes a *predicted* number from the theory (closed form, quadrature) and a *measured* one
 from a simulation or an independent computation with the library, compares them with a stated
 tolerance, and says pass or fail. Sizes come from ``ctx.size(...)`` (``tiny`` / ``default`` /
-``full``); at default sizes all checks and figures finish in under 5 minutes on 2 cores.
+``full``; their measured cost: ``docs/main-job.md``, section Cost).
 
-The mathematics lives in :mod:`roughpaths` and :mod:`mechanics`; this module only calls it.
-Conventions: ``CONVENTIONS.md`` (area ``XX[i,j] = ∫(X^i - X^i_s) dX^j``, Lévy area ``½(XX - XXᵀ)``,
+The mathematics lives in :mod:`roughpaths` and :mod:`mechanics` (public names only); this module
+only calls it, through the same entry points as the tests (the Gibbs check of Theorem 3.1 through
+:func:`mechanics.run_ensemble`, as ``tests/test_theorem_3_1_gibbs.py``).
+Conventions: ``docs/conventions.md`` (area ``XX[i,j] = ∫(X^i - X^i_s) dX^j``, Lévy area ``½(XX - XXᵀ)``,
 bracket ``[V,W] = DW·V - DV·W``, Friz–Oberhauser drift ``½ Σ s^{ij}[V_i,V_j]``).
 """
 
 from __future__ import annotations
 
+from concurrent.futures import Executor, Future
+
 import numpy as np
+from scipy.integrate import solve_ivp
 
-from .report import CheckResult, Task
+import mechanics
+import roughpaths
 
-__all__ = ["CHECKS", "register"]
+from .model import INERTIA, PI0, SIGMA, THETA, hemisphere_mean, paper_body, s_matrix, standard_error
+from .report import CheckResult
+from .tasks import registry_decorator
+
+__all__ = ["CHECKS"]
 
 #: name -> Task, in report order
-CHECKS: dict[str, Task] = {}
+CHECKS: dict = {}
+register = registry_decorator(CHECKS)
+E3 = PI0
 
 
-def register(name: str, title: str, requires: tuple = ()):
-    """Decorator adding a check to :data:`CHECKS`."""
-
-    def deco(func):
-        CHECKS[name] = Task(name=name, title=title, func=func, requires=tuple(requires))
-        return func
-
-    return deco
+def _brownian(rng, batch: int, n: int, d: int, T: float = 1.0):
+    """A batch of Stratonovich Brownian rough paths on a uniform grid of ``[0, T]``."""
+    return roughpaths.brownian_rough_path(np.linspace(0.0, T, n + 1), d, rng, batch_shape=(batch,))
 
 
 # --------------------------------------------------------------------------------------------- rough paths
-@register("chen", "Chen's identity for level-2 rough paths", requires=("roughpaths.rough_path",))
+@register("chen", "Chen's identity for level-2 rough paths")
 def check_chen(ctx) -> CheckResult:
     """Chen: XX_{0,T} = XX_{0,u} + XX_{u,T} + X_{0,u}⊗X_{u,T}, and = the naive sum over the steps."""
     rng = ctx.rng("chen")
@@ -59,7 +66,7 @@ def check_chen(ctx) -> CheckResult:
     return CheckResult(
         "chen",
         "Chen's identity XX_{s,t} = XX_{s,u} + XX_{u,t} + X_{s,u} ⊗ X_{u,t} on Brownian rough paths, and "
-        "XX_{0,T} = the iterated sum over the grid steps (CONVENTIONS.md ordering XX[i,j] = ∫(X^i-X^i_s)dX^j).",
+        "XX_{0,T} = the iterated sum over the grid steps (docs/conventions.md ordering XX[i,j] = ∫(X^i-X^i_s)dX^j).",
         predicted=0.0, measured=measured,
         tolerance=f"max abs defect <= {tol:g}; transposed cross term differs by O(1)",
         passed=measured <= tol and e_wrong > 1e-3,
@@ -68,17 +75,14 @@ def check_chen(ctx) -> CheckResult:
     )
 
 
-@register("levy_log", "Level-2 log of a geometric path is its Lévy area ½(XX − XXᵀ)",
-          requires=("roughpaths.rough_path", "roughpaths.level2"))
+@register("levy_log", "Level-2 log of a geometric path is its Lévy area ½(XX − XXᵀ)")
 def check_levy_log(ctx) -> CheckResult:
-    """log(X, XX) at level 2 is XX − ½ X⊗X = Alt(XX) for geometric paths (CONVENTIONS.md)."""
-    from roughpaths.level2 import level2_log
-
+    """log(X, XX) at level 2 is XX − ½ X⊗X = Alt(XX) for geometric paths (docs/conventions.md)."""
     rng = ctx.rng("levy_log")
     n = ctx.size("levy_log.steps", tiny=100, default=2_000, full=20_000)
     X = _brownian(rng, 32, n, 3)
     x, xx = X.increment(X.times[0], X.times[-1]), X.area(X.times[0], X.times[-1])
-    out = level2_log(x, xx)
+    out = roughpaths.level2_log(x, xx)
     log2 = out[1] if isinstance(out, tuple) else out
     levy = X.levy_area(X.times[0], X.times[-1])
     err = float(np.max(np.abs(log2 - levy)))
@@ -94,49 +98,20 @@ def check_levy_log(ctx) -> CheckResult:
     )
 
 
-# --------------------------------------------------------------------------------------------- helpers
-def _brownian(rng, batch: int, n: int, d: int, T: float = 1.0):
-    """A batch of Stratonovich Brownian rough paths on [0, T] (library sampler if present)."""
-    times = np.linspace(0.0, T, n + 1)
-    try:
-        from roughpaths.brownian import brownian_rough_path
-    except ImportError:
-        brownian_rough_path = None
-    if brownian_rough_path is not None:
-        return _call_brownian(brownian_rough_path, times, d, batch, rng)
-    from roughpaths.rough_path import RoughPath
-
-    dw = rng.standard_normal((batch, n, d)) * np.sqrt(T / n)
-    w = np.concatenate([np.zeros((batch, 1, d)), np.cumsum(dw, axis=1)], axis=1)
-    return RoughPath.from_path(w, times=times)
-
-
-def _call_brownian(func, times, d, batch, rng):
-    return func(times, d, rng, batch_shape=(batch,))
-
-
-def _sem(x, axis=0):
-    x = np.asarray(x, dtype=np.float64)
-    return np.std(x, axis=axis, ddof=1) / np.sqrt(x.shape[axis])
-
-
-@register("brownian_levy_area", "Lévy area of Brownian motion: mean 0, variance t²/4 (with the ½)",
-          requires=("roughpaths.brownian",))
+@register("brownian_levy_area", "Lévy area of Brownian motion: mean 0, variance t²/4 (with the ½)")
 def check_brownian_levy_area(ctx) -> CheckResult:
     """E[A12²] = t²/4 for A = ½(XX − XXᵀ) of the Stratonovich lift; Itô lift: E[XX_ii] = 0."""
-    from roughpaths.brownian import brownian_rough_path
-
     P = ctx.size("brownian.paths", tiny=2_000, default=40_000, full=400_000)
     t = 2.0
-    X = brownian_rough_path(np.linspace(0.0, t, 5), 2, ctx.rng("brownian"), batch_shape=(P,))
+    X = roughpaths.brownian_rough_path(np.linspace(0.0, t, 5), 2, ctx.rng("brownian"), batch_shape=(P,))
     a = X.levy_area(0.0, t)[..., 0, 1]
-    m2, se = float(np.mean(a**2)), float(_sem(a**2))
-    ito = brownian_rough_path(np.linspace(0.0, t, 5), 2, ctx.rng("brownian-ito"), batch_shape=(P,), kind="ito")
+    m2, se = float(np.mean(a**2)), float(standard_error(a**2))
+    ito = roughpaths.brownian_rough_path(np.linspace(0.0, t, 5), 2, ctx.rng("brownian-ito"), batch_shape=(P,), kind="ito")
     diag = ito.area(0.0, t)[..., [0, 1], [0, 1]]
     ito_mean = float(np.mean(diag))
-    ito_se = float(_sem(diag.ravel()))
+    ito_se = float(standard_error(diag.ravel()))
     pred = t**2 / 4
-    ok = abs(m2 - pred) <= 4 * se and abs(float(np.mean(a))) <= 4 * float(_sem(a)) and abs(ito_mean) <= 4 * ito_se
+    ok = abs(m2 - pred) <= 4 * se and abs(float(np.mean(a))) <= 4 * float(standard_error(a)) and abs(ito_mean) <= 4 * ito_se
     wrong = abs(m2 - t**2) > 4 * se  # without the ½ the variance would be t²
     return CheckResult(
         "brownian_levy_area",
@@ -144,43 +119,37 @@ def check_brownian_levy_area(ctx) -> CheckResult:
         "and E[A²] = t²/4; the Itô lift has E[XX_ii] = 0 (XX^Itô = XX^Strat − ½(t−s)I).",
         predicted=pred, measured=m2, tolerance="4 standard errors (mean, E[A²], Itô diagonal)",
         passed=ok and wrong,
-        details=f"{P} paths; E[A] = {np.mean(a):+.4f} ± {_sem(a):.4f}; E[A²] = {m2:.4f} ± {se:.4f}; Itô E[XX_ii] = "
+        details=f"{P} paths; E[A] = {np.mean(a):+.4f} ± {standard_error(a):.4f}; E[A²] = {m2:.4f} ± {se:.4f}; Itô E[XX_ii] = "
                 f"{ito_mean:+.4f} ± {ito_se:.4f}; the variance without the ½ (t² = {t**2:g}) is rejected: {wrong}",
     )
 
 
-@register("friz_oberhauser", "Friz–Oberhauser: area perturbation s(t−s) = drift ½ Σ s^{ij}[V_i,V_j]",
-          requires=("roughpaths.solve", "roughpaths.vector_fields", "roughpaths.brownian", "roughpaths.solvers"))
+@register("friz_oberhauser", "Friz–Oberhauser: area perturbation s(t−s) = drift ½ Σ s^{ij}[V_i,V_j]")
 def check_friz_oberhauser(ctx) -> CheckResult:
     """Pathwise: solve on X.perturb(s) vs on X with the FO drift; difference -> 0 with the mesh."""
-    from roughpaths.brownian import brownian_rough_path
-    from roughpaths.solve import solve
-    from roughpaths.solvers import Davie
-    from roughpaths.vector_fields import LinearVectorFields
-
     rng = ctx.rng("friz_oberhauser")
     P = ctx.size("fo.paths", tiny=8, default=64, full=256)
     kmax = ctx.size("fo.log2_steps", tiny=8, default=11, full=13)
     d, e = 3, 3
     M = rng.standard_normal((d, e, e)) * 0.5
     s = np.array([[0.0, 0.7, -0.4], [-0.7, 0.0, 0.3], [0.4, -0.3, 0.0]])
-    V = LinearVectorFields(M)
+    V = roughpaths.LinearVectorFields(M)
     y0 = np.ones(e)
-    X = brownian_rough_path(np.linspace(0.0, 1.0, 2**kmax + 1), d, rng, batch_shape=(P,))
+    X = roughpaths.brownian_rough_path(np.linspace(0.0, 1.0, 2**kmax + 1), d, rng, batch_shape=(P,))
     hs, errs = [], []
     for k in range(kmax - 4, kmax + 1):
         Xk = X.restrict(X.times[:: 2 ** (kmax - k)])
-        y_area = solve(V, Xk.perturb(s), y0, Davie(), save_at="end").states[..., -1, :]
-        y_drift = solve(V, Xk, y0, Davie(), drift=V.friz_oberhauser_drift(s), save_at="end").states[..., -1, :]
+        y_area = roughpaths.solve(V, Xk.perturb(s), y0, roughpaths.Davie(), save_at="end").states[..., -1, :]
+        y_drift = roughpaths.solve(V, Xk, y0, roughpaths.Davie(), drift=V.friz_oberhauser_drift(s), save_at="end").states[..., -1, :]
         hs.append(1.0 / 2**k)
         errs.append(float(np.sqrt(np.mean(np.sum((y_area - y_drift) ** 2, axis=-1)))))
     slope = float(np.polyfit(np.log(hs), np.log(errs), 1)[0])
     # wrong variants at the finest mesh: opposite sign, and the paper's ½ Σ_{i<=j} (half the drift)
     Xf = X
-    y_area = solve(V, Xf.perturb(s), y0, Davie(), save_at="end").states[..., -1, :]
+    y_area = roughpaths.solve(V, Xf.perturb(s), y0, roughpaths.Davie(), save_at="end").states[..., -1, :]
     gaps = {}
     for name, factor in (("opposite sign", -1.0), ("half (paper's Thm A.1)", 0.5)):
-        y_w = solve(V, Xf, y0, Davie(), drift=V.friz_oberhauser_drift(factor * s), save_at="end").states[..., -1, :]
+        y_w = roughpaths.solve(V, Xf, y0, roughpaths.Davie(), drift=V.friz_oberhauser_drift(factor * s), save_at="end").states[..., -1, :]
         gaps[name] = float(np.sqrt(np.mean(np.sum((y_area - y_w) ** 2, axis=-1))))
     ok = slope >= 0.8 and errs[-1] < 0.2 * min(gaps.values())
     return CheckResult(
@@ -197,41 +166,26 @@ def check_friz_oberhauser(ctx) -> CheckResult:
 
 
 # --------------------------------------------------------------------------------------------- rigid body
-_RB = ("mechanics.rigid_body", "mechanics.integrators")
-INERTIA = (1.0, 2.0, 3.0)
-SIGMA, THETA = 0.05, 1.0
-E3 = np.array([0.0, 0.0, 1.0])
-
-
-def _s(s12=0.0, s13=0.0, s23=0.0):
-    return np.array([[0.0, s12, s13], [-s12, 0.0, s23], [-s13, -s23, 0.0]])
-
-
-@register("prop21", "Proposition 2.1: perturbed driver = corrected rigid body, pathwise",
-          requires=_RB + ("roughpaths.brownian",))
+@register("prop21", "Proposition 2.1: perturbed driver = corrected rigid body, pathwise")
 def check_prop21(ctx) -> CheckResult:
     """The rigid body with s driven by X equals the one with s = 0 driven by X.perturb(s)."""
-    from mechanics.integrators import LieHeun, simulate
-    from mechanics.rigid_body import rigid_body
-    from roughpaths.brownian import brownian_rough_path
-
     P = ctx.size("prop21.paths", tiny=4, default=32, full=128)
     n = ctx.size("prop21.steps", tiny=200, default=4_000, full=20_000)
-    s = _s(s12=-50.0, s13=25.0, s23=25.0)
-    X = brownian_rough_path(np.linspace(0.0, 10.0, n + 1), 3, ctx.rng("prop21"), batch_shape=(P,))
+    s = s_matrix(s12=-50.0, s13=25.0, s23=25.0)
+    X = roughpaths.brownian_rough_path(np.linspace(0.0, 10.0, n + 1), 3, ctx.rng("prop21"), batch_shape=(P,))
     # θ = 0: Proposition 2.1 is about the Euler–Poincaré / Lie–Poisson equation; the perturbation of the
     # driver does not touch the dissipation (which Theorem 3.1 builds from h̃), see mechanics.wong_zakai
-    _, a = simulate(rigid_body(INERTIA, sigma=SIGMA, s=s), E3, X, LieHeun())
-    _, b = simulate(rigid_body(INERTIA, sigma=SIGMA), E3, X.perturb(s), LieHeun())
-    _, c = simulate(rigid_body(INERTIA, sigma=SIGMA, s=s, convention="paper"), E3, X, LieHeun())
+    _, a = mechanics.simulate(paper_body(s, theta=0.0), E3, X, mechanics.LieHeun())
+    _, b = mechanics.simulate(paper_body(None, theta=0.0), E3, X.perturb(s), mechanics.LieHeun())
+    _, c = mechanics.simulate(paper_body(s, theta=0.0, convention="paper"), E3, X, mechanics.LieHeun())
     gap = float(np.max(np.abs(a - b)))
     wrong = float(np.max(np.abs(c - b)))
     tol = 1e-10
     return CheckResult(
         "prop21",
-        "Proposition 2.1 (discrete form, no dissipation): the Lévy-corrected rigid body (rp sign, c = +½ s^{ij} ξ_i × ξ_j) driven by "
-        "the Brownian rough path X coincides with the uncorrected one driven by X.perturb(s); the paper's printed "
-        "sign (−½) does not.",
+        "Proposition 2.1 (discrete form, no dissipation): the Lévy-corrected rigid body (rp sign, c = +½ s^{ij} "
+        "ξ_i × ξ_j) driven by the Brownian rough path X coincides with the uncorrected one driven by X.perturb(s); "
+        "the paper's printed sign (−½) does not.",
         predicted=0.0, measured=gap, tolerance=f"max |difference| ≤ {tol:g}; printed sign: O(1)",
         passed=gap <= tol and wrong > 1e-2,
         details=f"{P} paths x {n} steps on [0, 10], s12 = −50, s13 = s23 = 25, σ = 0.05; with the paper's sign the "
@@ -239,15 +193,12 @@ def check_prop21(ctx) -> CheckResult:
     )
 
 
-@register("casimir", "Coadjoint integrators keep |Π| to round-off", requires=_RB)
+@register("casimir", "Coadjoint integrators keep |Π| to round-off")
 def check_casimir(ctx) -> CheckResult:
-    from mechanics.integrators import simulate_brownian
-    from mechanics.rigid_body import rigid_body
-
     n = ctx.size("casimir.steps", tiny=1_000, default=10_000, full=100_000)
     P = ctx.size("casimir.paths", tiny=16, default=64, full=1_000)
-    body = rigid_body(INERTIA, sigma=0.5, s=_s(s13=25.0), theta=THETA)
-    _, out = simulate_brownian(body, E3, 0.01, n, ctx.rng("casimir"), n_paths=P, save_every=n)
+    body = paper_body(s_matrix(s13=25.0), sigma=0.5)
+    _, out = mechanics.simulate_brownian(body, E3, 0.01, n, ctx.rng("casimir"), n_paths=P, save_every=n)
     err = float(np.max(np.abs(np.linalg.norm(out, axis=-1) - 1.0)))
     tol = 1e-12
     return CheckResult(
@@ -256,100 +207,104 @@ def check_casimir(ctx) -> CheckResult:
         details=f"{P} paths x {n} steps, dt = 0.01, σ = 0.5, s13 = 25, θ = 1 (Lie–Heun)")
 
 
-def _time_averages(ctx, body, name, P, T, dt, burn):
-    """Per-path time averages (after burn-in) of Π and Π Πᵀ for paths started at e3.
+class _SerialExecutor(Executor):
+    """Runs each submitted task at once, in order, and advances a progress bar (the serial default
+    of :func:`mechanics.run_ensemble`, with progress)."""
 
-    Simulated in chunks (progress bar, memory independent of ``T``): the saved states of each chunk
-    are folded into running sums.
+    def __init__(self, bar):
+        self.bar = bar
+
+    def submit(self, fn, /, *args, **kwargs):
+        future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as exc:
+            future.set_exception(exc)
+        self.bar.update(1)
+        return future
+
+
+def _ensemble_time_average(ctx, body, label, *, P, T, dt, burn, chunk=16):
+    """Across-path mean and standard error of the per-path time averages of Π over ``(burn, T]``.
+
+    Through the public ensemble entry point :func:`mechanics.run_ensemble` (as the test of Theorem
+    3.1); the seed is derived from the run's seed and ``label``.
     """
-    from mechanics.integrators import simulate_brownian
-
-    save = max(1, int(round(0.05 / dt)))
-    n = int(round(T / dt))
-    n -= n % save
-    chunk = max(save, (min(n, 20_000) // save) * save)
-    rng = ctx.rng(name)
-    mu = np.tile(E3, (P, 1))
-    s1, s2, count, done = np.zeros((P, 3)), np.zeros((P, 3, 3)), 0, 0
-    with ctx.progress.bar(f"{name}: {P} paths x {n:,} steps", n) as bar:
-        while done < n:
-            k = min(chunk, n - done)
-            times, out = simulate_brownian(body, mu, dt, k, rng, n_paths=P, save_every=save)
-            mu = out[:, -1].copy()
-            t_abs = done * dt + times[1:]
-            keep = out[:, 1:][:, t_abs >= burn]
-            s1 += keep.sum(axis=1)
-            s2 += np.einsum("pki,pkj->pij", keep, keep)
-            count += keep.shape[1]
-            done += k
-            bar.update(k)
-    return s1 / count, s2 / count
+    n_chunks = -(-P // chunk)
+    with ctx.progress.bar(f"{label}: {P} paths x {int(round(T / dt)):,} steps", n_chunks) as bar:
+        res = mechanics.run_ensemble(body, E3, dt=dt, n_steps=int(round(T / dt)), n_paths=P,
+                                     seed=ctx.seed_for(label), burn_in=int(round(burn / dt)),
+                                     average_every=max(1, int(round(0.05 / dt))), chunk_size=chunk,
+                                     executor=_SerialExecutor(bar))
+    ta = res.time_average
+    return ta.mean[:3], ta.standard_error[:3]
 
 
-def _conditional_gibbs_mean(g, sign=1.0):
-    f = lambda P: np.concatenate([P * (np.sign(P[..., 2:3]) == sign), (np.sign(P[..., 2:3]) == sign)], -1)
-    e = g.expectation(f)
-    return e[:3] / e[3]
-
-
-@register("gibbs_mean", "Theorem 3.1: the Lévy area recentres the Gibbs measure exp(−2θh̃/σ²)",
-          requires=_RB + ("mechanics.gibbs",))
+@register("gibbs_mean", "Theorem 3.1: the Lévy area recentres the Gibbs measure exp(−2θh̃/σ²)")
 def check_gibbs_mean(ctx) -> CheckResult:
-    from mechanics.gibbs import GibbsMeasure
-    from mechanics.rigid_body import rigid_body
+    """Time averages of the Lévy-corrected rigid body against the Gibbs mean of h̃ (north basin).
 
+    Rejected variants: the same time averages against the Gibbs means of the uncorrected ``h`` and of
+    the printed torque sign; and the time averages of the uncorrected body and of the printed-sign
+    body against the Gibbs mean of ``h̃``.
+    """
     P = ctx.size("gibbs.paths", tiny=8, default=64, full=512)
     T = ctx.size("gibbs.T", tiny=40.0, default=300.0, full=1_000.0)
     dt = ctx.size("gibbs.dt", tiny=0.01, default=0.005, full=0.002)
+    # the wrong models miss by hundreds of standard errors: fewer paths suffice to reject them
+    P_wrong = ctx.size("gibbs.paths_wrong_models", tiny=8, default=16, full=32)
+    burn = 30.0
     lines, ok_all, meas, preds = [], True, [], []
-    for s in (_s(s13=25.0), _s(s23=25.0)):
-        body = rigid_body(INERTIA, sigma=SIGMA, s=s, theta=THETA)
-        m, _ = _time_averages(ctx, body, "gibbs s13=25" if s[0, 2] else "gibbs s23=25", P, T, dt, burn=30.0)
-        mean, se = m.mean(axis=0), _sem(m)
-        g = GibbsMeasure(INERTIA, body.levy_velocity, sigma=SIGMA, theta=THETA)
-        pred = _conditional_gibbs_mean(g)
-        g0 = GibbsMeasure(INERTIA, None, sigma=SIGMA, theta=THETA)  # the model without the correction
-        pred0 = _conditional_gibbs_mean(g0)
-        gpaper = GibbsMeasure(INERTIA, -body.levy_velocity, sigma=SIGMA, theta=THETA)  # printed torque sign
-        predp = _conditional_gibbs_mean(gpaper)
+    for s in (s_matrix(s13=25.0), s_matrix(s23=25.0)):
+        lab = "s13=25" if s[0, 2] else "s23=25"
+        body = paper_body(s)
+        mean, se = _ensemble_time_average(ctx, body, f"gibbs {lab}", P=P, T=T, dt=dt, burn=burn)
         tol = 4 * se + 2 * dt
+        pred = hemisphere_mean(mechanics.GibbsMeasure(INERTIA, body.levy_velocity, sigma=SIGMA, theta=THETA))
         ok = bool(np.all(np.abs(mean - pred) <= tol))
-        reject0 = bool(np.any(np.abs(mean - pred0) > tol))
-        rejectp = bool(np.any(np.abs(mean - predp) > tol))
-        ok_all &= ok and reject0 and rejectp
+        # wrong predictions for the right dynamics: the uncorrected h, the printed torque sign
+        pred0 = hemisphere_mean(mechanics.GibbsMeasure(INERTIA, None, sigma=SIGMA, theta=THETA))
+        predp = hemisphere_mean(mechanics.GibbsMeasure(INERTIA, -body.levy_velocity, sigma=SIGMA, theta=THETA))
+        reject = {"Gibbs of uncorrected h": bool(np.any(np.abs(mean - pred0) > tol)),
+                  "Gibbs with printed sign": bool(np.any(np.abs(mean - predp) > tol))}
+        # wrong dynamics against the right prediction: s ignored, the paper's printed sign
+        for name, wrong_body in (("uncorrected body", paper_body(None)),
+                                 ("printed-sign body", paper_body(s, convention="paper"))):
+            m_w, se_w = _ensemble_time_average(ctx, wrong_body, f"gibbs {lab} {name}", P=P_wrong, T=T, dt=dt,
+                                               burn=burn)
+            reject[name] = bool(np.any(np.abs(m_w - pred) > 4 * se_w + 2 * dt))
+        ok_all &= ok and all(reject.values())
         meas.append(mean)
         preds.append(pred)
-        lab = "s13 = 25" if s[0, 2] else "s23 = 25"
         lines.append(f"{lab}: measured E[Π] = {np.round(mean, 4)} ± {np.round(se, 4)}, Gibbs (h̃) {np.round(pred, 4)}; "
-                     f"uncorrected model {np.round(pred0, 4)} rejected: {reject0}; printed-sign torque "
-                     f"{np.round(predp, 4)} rejected: {rejectp}")
+                     f"uncorrected {np.round(pred0, 4)}, printed sign {np.round(predp, 4)}; rejected: "
+                     + ", ".join(f"{k} {v}" for k, v in reject.items()))
     return CheckResult(
         "gibbs_mean",
         "Theorem 3.1 (rp form): the dissipative stochastic rigid body with Lévy torque c = σ²(s23, −s13, s12) has "
-        "invariant density ∝ exp(−2θh̃/σ²), h̃ = ½Π·𝕀⁻¹Π + c·Π. Time-averaged E[Π] of long runs from e3 (north basin) "
-        "against the Gibbs mean by quadrature (conditioned on Π3 > 0), for s13 = 25 and s23 = 25.",
+        "invariant density ∝ exp(−2θh̃/σ²), h̃ = ½Π·𝕀⁻¹Π + c·Π. Time-averaged E[Π] of long runs from e3 (north basin, "
+        "mechanics.run_ensemble) against the Gibbs mean by quadrature (conditioned on Π3 > 0), for s13 = 25 and "
+        "s23 = 25.",
         predicted=np.array(preds), measured=np.array(meas),
-        tolerance="|measured − predicted| ≤ 4 SE + 2 dt per component; uncorrected and printed-sign models rejected",
-        passed=ok_all, details=f"{P} paths x T = {T:g}, dt = {dt:g}, burn-in 30\n" + "\n".join(lines))
+        tolerance="|measured − predicted| ≤ 4 SE + 2 dt per component; the uncorrected and printed-sign models "
+                  "(as predictions and as dynamics) rejected",
+        passed=ok_all, details=f"{P} paths ({P_wrong} for each wrong model) x T = {T:g}, dt = {dt:g}, burn-in "
+                               f"{burn:g}\n" + "\n".join(lines))
 
 
-@register("uniform_no_dissipation", "Proposition 3.1: without dissipation the law tends to uniform on the sphere",
-          requires=_RB)
+@register("uniform_no_dissipation", "Proposition 3.1: without dissipation the law tends to uniform on the sphere")
 def check_uniform(ctx) -> CheckResult:
-    from mechanics.integrators import simulate_brownian
-    from mechanics.rigid_body import rigid_body
-
     P = ctx.size("uniform.paths", tiny=200, default=2_000, full=10_000)
     T, dt = 30.0, 0.02
-    body = rigid_body(INERTIA, sigma=0.5, s=_s(s12=-2.0, s13=1.0, s23=1.0), theta=0.0)
+    body = paper_body(s_matrix(s12=-2.0, s13=1.0, s23=1.0), sigma=0.5, theta=0.0)
     n = int(T / dt)
-    _, out = simulate_brownian(body, E3, dt, n, ctx.rng("uniform"), n_paths=P, save_every=n)
+    _, out = mechanics.simulate_brownian(body, E3, dt, n, ctx.rng("uniform"), n_paths=P, save_every=n)
     Pi = out[:, -1]
     second = np.einsum("pi,pj->pij", Pi, Pi)
     m2 = second.mean(axis=0)
-    se2 = _sem(second)
+    se2 = standard_error(second)
     err = float(np.max(np.abs(m2 - np.eye(3) / 3) / se2))
-    err_mean = float(np.max(np.abs(Pi.mean(axis=0)) / _sem(Pi)))
+    err_mean = float(np.max(np.abs(Pi.mean(axis=0)) / standard_error(Pi)))
     return CheckResult(
         "uniform_no_dissipation",
         "Proposition 3.1: with θ = 0 (no dissipation) the law of Π_t tends to the uniform law on the sphere, with "
@@ -359,22 +314,18 @@ def check_uniform(ctx) -> CheckResult:
         details=f"{P} paths, dt = {dt:g}; max |E[ΠΠᵀ] − I/3|/SE = {err:.2f}, max |E[Π]|/SE = {err_mean:.2f}")
 
 
-@register("girsanov", "Girsanov constant u^k = ½ s^{ij} c^k_{ij}", requires=("mechanics.rigid_body",
-                                                                              "mechanics.lie_poisson"))
+@register("girsanov", "Girsanov constant u^k = ½ s^{ij} c^k_{ij}")
 def check_girsanov(ctx) -> CheckResult:
-    from mechanics.lie_poisson import girsanov_shift
-    from mechanics.rigid_body import rigid_body
-
-    s = _s(s12=-50.0, s13=25.0, s23=25.0)
-    body = rigid_body(INERTIA, xi=np.eye(3), s=s, theta=THETA)
-    u = girsanov_shift(body)
+    s = s_matrix(s12=-50.0, s13=25.0, s23=25.0)
+    body = mechanics.rigid_body(INERTIA, xi=np.eye(3), s=s, theta=THETA)
+    u = mechanics.girsanov_shift(body)
     # independent oracle: so(3) structure constants c^k_ij = ε_ijk, u^k = ½ Σ s^{ij} ε_ijk
     eps = np.zeros((3, 3, 3))
     for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
         eps[i, j, k], eps[j, i, k] = 1.0, -1.0
     pred = 0.5 * np.einsum("ij,ijk->k", s, eps)
     err = float(np.max(np.abs(u - pred)))
-    paper = girsanov_shift(body, convention="paper")
+    paper = mechanics.girsanov_shift(body, convention="paper")
     return CheckResult(
         "girsanov", "Girsanov: the corrected drift is a constant shift u of the driver, u^k = ½ Σ s^{ij} c^k_{ij} "
         "(ξ_k = e_k on so(3)); the paper's (LieDepXis) drops the ½.",
@@ -383,17 +334,11 @@ def check_girsanov(ctx) -> CheckResult:
         details=f"paper's printed value: {np.round(paper, 6)}")
 
 
-@register("equilibria", "Shifted equilibria: derived from h̃, confirmed by a long deterministic run",
-          requires=("mechanics.equilibria", "mechanics.rigid_body"))
+@register("equilibria", "Shifted equilibria: derived from h̃, confirmed by a long deterministic run")
 def check_equilibria(ctx) -> CheckResult:
-    from scipy.integrate import solve_ivp
-
-    from mechanics.equilibria import rigid_body_equilibria
-    from mechanics.rigid_body import rigid_body
-
     s13 = 25.0
-    c = rigid_body(INERTIA, sigma=SIGMA, s=_s(s13=s13), theta=THETA).levy_velocity
-    eqs = rigid_body_equilibria(INERTIA, c, theta=THETA)
+    c = paper_body(s_matrix(s13=s13)).levy_velocity
+    eqs = mechanics.rigid_body_equilibria(INERTIA, c, theta=THETA)
     north = min((e for e in eqs if e.kind == "minimum" and e.point[2] > 0), key=lambda e: np.linalg.norm(e.point - E3))
     Iinv = 1.0 / np.asarray(INERTIA)
 
@@ -418,22 +363,20 @@ def check_equilibria(ctx) -> CheckResult:
 
 
 # --------------------------------------------------------------------------------------------- coloured noise
-@register("coloured_area_rate", "Coloured noise: E[XX^ε_{0,T}]/T → ΣA⁻ᵀ, Lévy perturbation N = Alt(ΣA⁻ᵀ)",
-          requires=("roughpaths.coloured_noise",))
+@register("coloured_area_rate", "Coloured noise: E[XX^ε_{0,T}]/T → ΣA⁻ᵀ, Lévy perturbation N = Alt(ΣA⁻ᵀ)")
 def check_coloured_area_rate(ctx) -> CheckResult:
-    from roughpaths.coloured_noise import coloured_noise_limit, paper_coloured_noise_matrices, sample_coloured_noise
-
-    A, D = paper_coloured_noise_matrices(1.0)   # k = 1: fast mixing, same structure as the paper's
-    lim = coloured_noise_limit(A, D)
+    A, D = roughpaths.paper_coloured_noise_matrices(1.0)   # k = 1: fast mixing, same structure as the paper's
+    lim = roughpaths.coloured_noise_limit(A, D)
     P = ctx.size("coloured.paths", tiny=50, default=400, full=2_000)
     eps, T = 0.1, 5.0
     n = 500
-    smp = sample_coloured_noise(A, D, eps, np.linspace(0.0, T, n + 1), rng=ctx.rng("coloured"), batch_shape=(P,))
+    smp = roughpaths.sample_coloured_noise(A, D, eps, np.linspace(0.0, T, n + 1), rng=ctx.rng("coloured"), batch_shape=(P,))
     levy = smp.path.levy_area(0.0, T) / T
-    meas, se = levy.mean(axis=0), _sem(levy)
+    meas, se = levy.mean(axis=0), standard_error(levy)
     pred = lim.levy_perturbation
     z = np.abs(meas - pred) / np.where(se > 0, se, 1.0)
     zmax = float(np.max(z[~np.eye(3, dtype=bool)]))
+    N13_paper = roughpaths.coloured_noise_limit(*roughpaths.paper_coloured_noise_matrices(0.05)).N[0, 2]
     z2 = float(np.max(np.abs(meas - lim.unnormalised_area_rate)[~np.eye(3, dtype=bool)] /
                       se[~np.eye(3, dtype=bool)]))
     return CheckResult(
@@ -443,27 +386,22 @@ def check_coloured_area_rate(ctx) -> CheckResult:
         predicted=pred, measured=meas, tolerance="off-diagonal entries within 4 standard errors; 2N rejected",
         passed=zmax <= 4 and z2 > 4,
         details=f"{P} paths, ε = {eps:g}, T = {T:g}; max z = {zmax:.2f}; the paper's 2N is {z2:.1f} SE away; "
-                f"the paper's example (k = 0.05): N13 = {coloured_noise_limit(*paper_coloured_noise_matrices(0.05)).N[0, 2]:.4f} "
-                f"(its printed 19.95 = 2N13)")
+                f"the paper's example (k = 0.05): N13 = {N13_paper:.4f} (its printed 19.95 = 2N13)")
 
 
-@register("wong_zakai", "Wong–Zakai anomaly: coloured rigid body → limit with the Lévy torque, not without",
-          requires=("mechanics.wong_zakai", "roughpaths.coloured_noise"))
+@register("wong_zakai", "Wong–Zakai anomaly: coloured rigid body → limit with the Lévy torque, not without")
 def check_wong_zakai(ctx) -> CheckResult:
-    from mechanics.wong_zakai import simulate_wong_zakai_rigid_body
-    from roughpaths.coloured_noise import paper_coloured_noise_matrices
-
-    A, D = paper_coloured_noise_matrices(0.05)
+    A, D = roughpaths.paper_coloured_noise_matrices(0.05)
     P = ctx.size("wz.paths", tiny=600, default=1_000, full=4_000)
     eps = ctx.size("wz.eps", tiny=0.02, default=0.02, full=0.01)
     T = 2.0
-    r = simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, inertia=INERTIA, theta=THETA, Pi0=E3, T=T, n_paths=P,
-                                       rng=ctx.rng("wong_zakai"), save_every=10**9,
-                                       systems=("coloured", "limit", "no_torque"))
+    r = mechanics.simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, inertia=INERTIA, theta=THETA, Pi0=E3, T=T,
+                                                 n_paths=P, rng=ctx.rng("wong_zakai"), save_every=10**9,
+                                                 systems=("coloured", "limit", "no_torque"))
     col, lim, nt = r["final"]["coloured"], r["final"]["limit"], r["final"]["no_torque"]
     d_lim, d_nt = col - lim, col - nt
-    g_lim, se_lim = d_lim.mean(axis=0), _sem(d_lim)
-    g_nt, se_nt = d_nt.mean(axis=0), _sem(d_nt)
+    g_lim, se_lim = d_lim.mean(axis=0), standard_error(d_lim)
+    g_nt, se_nt = d_nt.mean(axis=0), standard_error(d_nt)
     z_lim = float(np.max(np.abs(g_lim) / se_lim))
     z_nt = float(np.max(np.abs(g_nt) / se_nt))
     return CheckResult(
@@ -478,13 +416,11 @@ def check_wong_zakai(ctx) -> CheckResult:
                 f"coloured − no torque: {np.round(g_nt, 5)} (max {z_nt:.1f} SE)")
 
 
-@register("planar_constant", "Planar example: δγ/(2α(α²+γ²)) = N12", requires=("roughpaths.coloured_noise",))
+@register("planar_constant", "Planar example: δγ/(2α(α²+γ²)) = N12")
 def check_planar(ctx) -> CheckResult:
-    from roughpaths.coloured_noise import coloured_noise_limit
-
     alpha, gamma, delta = 1.3, 0.7, 2.0
     J = np.array([[0.0, 1.0], [-1.0, 0.0]])
-    lim = coloured_noise_limit(alpha * np.eye(2) + gamma * J, np.sqrt(delta) * np.eye(2))
+    lim = roughpaths.coloured_noise_limit(alpha * np.eye(2) + gamma * J, np.sqrt(delta) * np.eye(2))
     pred = delta * gamma / (2 * alpha * (alpha**2 + gamma**2))
     meas = float(lim.N[0, 1])
     return CheckResult(

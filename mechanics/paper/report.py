@@ -3,28 +3,37 @@
 The main job (``python -m mechanics``) collects, for every theorem / proposition check, a
 :class:`CheckResult` (claim, predicted and measured numbers, tolerance, pass/fail) and, for every
 figure, a :class:`FigureResult` (PNG and the ``.npz`` of the data behind it). :func:`write_report`
-turns them into ``report.md`` (figures linked) and ``report.html`` (figures embedded as base64, no
-external resources), with the run's metadata (seed, convention, sizes, versions, timings).
+turns them into ``report.md`` (figures linked), ``report.html`` (figures embedded as base64, no
+external resources) and ``results.json`` (the same results, machine-readable), with the run's
+metadata (the command that reproduces it, seed, convention, sizes, versions).
+
+The three files depend only on the results and the options, never on the clock or the output
+folder's name: the same run gives the same bytes (wall times and dates are in ``manifest.json``).
 """
 
 from __future__ import annotations
 
 import base64
 import html
+import json
 import platform
 import sys
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import asdict, dataclass, field
+from importlib import metadata
 from typing import Any
 
 import numpy as np
 
+import mechanics
+import roughpaths
+
 __all__ = [
-    "CheckResult", "FigureResult", "RunMetadata", "Task", "format_value", "write_report", "versions",
+    "CheckResult", "FigureResult", "RunMetadata", "format_value", "write_report", "versions",
+    "result_to_json", "result_from_json", "PASS", "FAIL", "ERROR",
 ]
 
-#: status strings of a check
-PASS, FAIL, ERROR, SKIPPED = "pass", "FAIL", "error", "skipped"
+#: status strings of a check or figure
+PASS, FAIL, ERROR = "pass", "FAIL", "error"
 
 
 @dataclass
@@ -38,17 +47,15 @@ class CheckResult:
     statement : str
         The claim checked, in words, with the paper's reference and the convention used.
     predicted, measured : Any
-        Numbers (scalars or small arrays) compared by the check.
+        Numbers (scalars or small arrays) or short texts compared by the check.
     tolerance : str
         The acceptance rule, in words (e.g. ``"|measured - predicted| <= 4 standard errors"``).
     passed : bool or None
-        ``None`` when the check could not run (see ``status``).
+        ``None`` when the check raised (then ``status == "error"``).
     status : str
-        ``"pass"``, ``"FAIL"``, ``"error"`` (an exception; traceback in ``details``) or ``"skipped"``.
+        ``"pass"``, ``"FAIL"`` or ``"error"`` (an exception; traceback in ``details``).
     details : str
-        Free-form notes (sizes, standard errors, the failing variant's numbers, ...).
-    seconds : float
-        Wall time of the check.
+        Free-form notes (sizes, standard errors, the rejected variants' numbers, ...).
     """
 
     name: str
@@ -59,30 +66,30 @@ class CheckResult:
     passed: bool | None = None
     status: str = ""
     details: str = ""
-    seconds: float = 0.0
 
     def __post_init__(self):
         if not self.status:
-            self.status = SKIPPED if self.passed is None else (PASS if self.passed else FAIL)
+            self.status = ERROR if self.passed is None else (PASS if self.passed else FAIL)
+        if self.passed is not None:
+            self.passed = bool(self.passed)
 
 
 @dataclass
 class FigureResult:
-    """One rendered figure: PNG path, data path, caption."""
+    """One rendered figure: the names of its PNG and data files in the output folder, its caption."""
 
     name: str
     title: str
     caption: str
-    png: Path | None = None
-    npz: Path | None = None
+    png: str | None = None
+    npz: str | None = None
     status: str = PASS
     details: str = ""
-    seconds: float = 0.0
 
 
 @dataclass
 class RunMetadata:
-    """What a reader needs to reproduce the run."""
+    """What a reader needs to reproduce the run (nothing that changes from one run to the next)."""
 
     command: str
     seed: int
@@ -90,54 +97,44 @@ class RunMetadata:
     scale: str
     sizes: dict = field(default_factory=dict)
     versions: dict = field(default_factory=dict)
-    timings: dict = field(default_factory=dict)
-    started: str = ""
-    total_seconds: float = 0.0
 
 
-@dataclass
-class Task:
-    """A registry entry: a figure or a check, its title/caption, and the modules it needs.
+def _jsonable(value):
+    if isinstance(value, np.ndarray):
+        return {"array": value.tolist(), "dtype": value.dtype.str}
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
 
-    ``requires`` lists importable names, either ``"package.module"`` or ``"package.module:attribute"``;
-    a task whose requirements are missing is reported as skipped (not an error) so that the main job
-    runs while the library grows.
-    """
 
-    name: str
-    title: str
-    func: Any
-    requires: tuple = ()
-    caption: str = ""
+def _from_jsonable(value):
+    if isinstance(value, dict) and set(value) == {"array", "dtype"}:
+        return np.asarray(value["array"], dtype=np.dtype(value["dtype"]))
+    return value
 
-    def missing_modules(self) -> list[str]:
-        import importlib
 
-        missing = []
-        for req in self.requires:
-            mod, _, attr = req.partition(":")
-            try:
-                m = importlib.import_module(mod)
-            except ImportError:
-                missing.append(mod)
-                continue
-            if attr and not hasattr(m, attr):
-                missing.append(req)
-        return missing
+def result_to_json(result: CheckResult | FigureResult) -> dict:
+    """A JSON-serialisable dict of a result (arrays with their dtype, floats exactly)."""
+    kind = "check" if isinstance(result, CheckResult) else "figure"
+    return {"kind": kind, **{k: _jsonable(v) for k, v in asdict(result).items()}}
 
-    def run(self, ctx):
-        return self.func(ctx)
+
+def result_from_json(data: dict) -> CheckResult | FigureResult:
+    """Inverse of :func:`result_to_json`."""
+    data = dict(data)
+    cls = CheckResult if data.pop("kind") == "check" else FigureResult
+    return cls(**{k: _from_jsonable(v) for k, v in data.items()})
 
 
 def versions() -> dict:
     """Versions of Python, the platform and the packages the run depends on."""
     out = {"python": sys.version.split()[0], "platform": platform.platform()}
-    for mod in ("numpy", "scipy", "matplotlib", "numba", "roughpaths", "mechanics"):
+    for dist in ("numpy", "scipy", "matplotlib", "numba"):   # without importing matplotlib (start-up time)
         try:
-            m = __import__(mod)
-            out[mod] = getattr(m, "__version__", "?")
-        except Exception:  # pragma: no cover - reported, not fatal
-            out[mod] = "not importable"
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:  # pragma: no cover - a core dependency
+            out[dist] = "not installed"
+    out["roughpaths"], out["mechanics"] = roughpaths.__version__, mechanics.__version__
     return out
 
 
@@ -177,7 +174,7 @@ def _md_escape(text: str) -> str:
 
 
 def _summary(checks: list[CheckResult]) -> dict:
-    counts = {PASS: 0, FAIL: 0, ERROR: 0, SKIPPED: 0}
+    counts = {PASS: 0, FAIL: 0, ERROR: 0}
     for c in checks:
         counts[c.status] = counts.get(c.status, 0) + 1
     return counts
@@ -188,35 +185,35 @@ _CONVENTION_NOTE = (
     "says so, the paper's printed variant is shown to fail. The convention option changes the figures only "
     "(the Lévy torque's sign in Figures 2 and surf2..surf5)."
 )
+_CONVENTION_TEXT = {
+    "rp": "rough-path-correct signs and factors, see the project's docs/conventions.md",
+    "paper": "the paper's printed equations, slips included",
+}
+_TIMING_NOTE = "Wall times and dates are in manifest.json (the report depends only on the results)."
 
 
-def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult],
-                    out_dir: Path) -> str:
-    """The Markdown report (figures referenced by relative path)."""
+def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult]) -> str:
+    """The Markdown report (figures referenced by file name, relative to the output folder)."""
     counts = _summary(checks)
     lines = [
         "# Verification report: *Variational Principles on Geometric Rough Paths and the Lévy Area Correction*",
         "",
-        f"Convention: **{meta.convention}**"
-        + (" (rough-path-correct, see CONVENTIONS.md)" if meta.convention == "rp"
-           else " (the paper's printed equations, slips included)")
-        + f" · seed **{meta.seed}** · sizes **{meta.scale}** · total time **{meta.total_seconds:.1f} s**",
+        f"Convention: **{meta.convention}** ({_CONVENTION_TEXT.get(meta.convention, meta.convention)})"
+        f" · seed **{meta.seed}** · sizes **{meta.scale}**",
         "",
-        f"Checks: **{counts[PASS]} passed**, {counts[FAIL]} failed, {counts[ERROR]} errors, "
-        f"{counts[SKIPPED]} skipped.",
+        f"Checks: **{counts[PASS]} passed**, {counts[FAIL]} failed, {counts[ERROR]} errors.",
         "",
         _CONVENTION_NOTE,
         "",
         "## Theorem and proposition checks",
         "",
-        "| check | claim | predicted | measured | tolerance | result | time (s) |",
-        "|---|---|---|---|---|---|---|",
+        "| check | claim | predicted | measured | tolerance | result |",
+        "|---|---|---|---|---|---|",
     ]
     for c in checks:
         lines.append(
             f"| `{c.name}` | {_md_escape(c.statement)} | {_md_escape(format_value(c.predicted))} | "
-            f"{_md_escape(format_value(c.measured))} | {_md_escape(c.tolerance)} | "
-            f"**{c.status}** | {c.seconds:.1f} |"
+            f"{_md_escape(format_value(c.measured))} | {_md_escape(c.tolerance)} | **{c.status}** |"
         )
     notes = [c for c in checks if c.details]
     if notes:
@@ -231,16 +228,14 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
     for f in figures:
         lines += [f"### {f.title} (`{f.name}`)", ""]
         if f.png is not None and f.status == PASS:
-            rel = Path(f.png).relative_to(out_dir) if Path(f.png).is_relative_to(out_dir) else f.png
-            lines += [f"![{f.title}]({rel})", ""]
+            lines += [f"![{f.title}]({f.png})", ""]
             if f.npz is not None:
-                rel_npz = Path(f.npz).relative_to(out_dir) if Path(f.npz).is_relative_to(out_dir) else f.npz
-                lines += [f"Data: `{rel_npz}`", ""]
+                lines += [f"Data: `{f.npz}`", ""]
         else:
             lines += [f"*{f.status}*: {_md_escape(f.details.strip().splitlines()[-1] if f.details else '')}", ""]
         lines += [f.caption, ""]
-    lines += ["## Run metadata", "", f"- command: `{meta.command}`", f"- started: {meta.started}",
-              f"- seed: {meta.seed}", f"- convention: {meta.convention}", f"- sizes: {meta.scale}", ""]
+    lines += ["## Run metadata", "", f"- command: `{meta.command}`", f"- seed: {meta.seed}",
+              f"- convention: {meta.convention}", f"- sizes: {meta.scale}", f"- {_TIMING_NOTE}", ""]
     if meta.sizes:
         lines += ["| size parameter | value |", "|---|---|"]
         lines += [f"| {k} | {format_value(v)} |" for k, v in meta.sizes.items()]
@@ -248,10 +243,6 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
     lines += ["| package | version |", "|---|---|"]
     lines += [f"| {k} | {v} |" for k, v in meta.versions.items()]
     lines.append("")
-    if meta.timings:
-        lines += ["| task | wall time (s) |", "|---|---|"]
-        lines += [f"| {k} | {v:.2f} |" for k, v in meta.timings.items()]
-        lines.append("")
     return "\n".join(lines) + "\n"
 
 
@@ -260,40 +251,37 @@ body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max
 padding:0 1em;color:#222;line-height:1.45}
 table{border-collapse:collapse;margin:1em 0;font-size:0.92em}th,td{border:1px solid #ccc;padding:4px 8px;
 vertical-align:top}th{background:#f2f2f2}td.pass{background:#e3f6e3;font-weight:bold}
-td.FAIL{background:#fbe0e0;font-weight:bold}td.error{background:#fbe0e0}td.skipped{background:#f4f4f4}
+td.FAIL{background:#fbe0e0;font-weight:bold}td.error{background:#fbe0e0}
 figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}figcaption{font-size:0.92em;color:#444}
 code,pre{background:#f6f6f6;padding:1px 3px}pre{padding:6px;overflow-x:auto;font-size:0.85em}
 .summary{font-size:1.1em}
 """
 
 
-def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult]) -> str:
-    """A self-contained HTML page (figures embedded as base64 PNG)."""
+def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult], read_file) -> str:
+    """A self-contained HTML page (figures embedded as base64 PNG; ``read_file(name) -> bytes``)."""
     e = html.escape
     counts = _summary(checks)
-    conv = ("rough-path-correct (see CONVENTIONS.md)" if meta.convention == "rp"
-            else "the paper's printed equations, slips included")
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         "<title>Verification report: Lévy area correction</title>",
         f"<style>{_CSS}</style></head><body>",
         "<h1>Verification report: <i>Variational Principles on Geometric Rough Paths and the Lévy Area "
         "Correction</i></h1>",
-        f"<p>Convention: <b>{e(meta.convention)}</b> ({e(conv)}) · seed <b>{meta.seed}</b> · sizes "
-        f"<b>{e(meta.scale)}</b> · total time <b>{meta.total_seconds:.1f} s</b></p>",
+        f"<p>Convention: <b>{e(meta.convention)}</b> ({e(_CONVENTION_TEXT.get(meta.convention, ''))}) · seed "
+        f"<b>{meta.seed}</b> · sizes <b>{e(meta.scale)}</b></p>",
         f"<p class='summary'>Checks: <b>{counts[PASS]} passed</b>, {counts[FAIL]} failed, "
-        f"{counts[ERROR]} errors, {counts[SKIPPED]} skipped.</p>",
+        f"{counts[ERROR]} errors.</p>",
         f"<p>{e(_CONVENTION_NOTE)}</p>",
         "<h2>Theorem and proposition checks</h2>",
         "<table><tr><th>check</th><th>claim</th><th>predicted</th><th>measured</th><th>tolerance</th>"
-        "<th>result</th><th>time (s)</th></tr>",
+        "<th>result</th></tr>",
     ]
     for c in checks:
         parts.append(
             f"<tr><td><code>{e(c.name)}</code></td><td>{e(c.statement)}</td>"
             f"<td>{e(format_value(c.predicted))}</td><td>{e(format_value(c.measured))}</td>"
-            f"<td>{e(c.tolerance)}</td><td class='{e(c.status)}'>{e(c.status)}</td>"
-            f"<td>{c.seconds:.1f}</td></tr>"
+            f"<td>{e(c.tolerance)}</td><td class='{e(c.status)}'>{e(c.status)}</td></tr>"
         )
     parts.append("</table>")
     notes = [c for c in checks if c.details]
@@ -305,18 +293,18 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
     parts.append("<h2>Figures</h2>")
     for f in figures:
         parts.append(f"<figure id='{e(f.name)}'><h3>{e(f.title)} (<code>{e(f.name)}</code>)</h3>")
-        if f.png is not None and f.status == PASS and Path(f.png).exists():
-            data = base64.b64encode(Path(f.png).read_bytes()).decode("ascii")
+        if f.png is not None and f.status == PASS:
+            data = base64.b64encode(read_file(f.png)).decode("ascii")
             parts.append(f"<img alt='{e(f.title)}' src='data:image/png;base64,{data}'>")
         else:
             parts.append(f"<p><b>{e(f.status)}</b></p><pre>{e(f.details.strip())}</pre>")
         parts.append(f"<figcaption>{e(f.caption)}</figcaption></figure>")
     parts += ["<h2>Run metadata</h2><table>",
               f"<tr><th>command</th><td><code>{e(meta.command)}</code></td></tr>",
-              f"<tr><th>started</th><td>{e(meta.started)}</td></tr>",
               f"<tr><th>seed</th><td>{meta.seed}</td></tr>",
               f"<tr><th>convention</th><td>{e(meta.convention)}</td></tr>",
-              f"<tr><th>sizes</th><td>{e(meta.scale)}</td></tr></table>"]
+              f"<tr><th>sizes</th><td>{e(meta.scale)}</td></tr></table>",
+              f"<p>{e(_TIMING_NOTE)}</p>"]
     if meta.sizes:
         parts.append("<table><tr><th>size parameter</th><th>value</th></tr>")
         parts += [f"<tr><td>{e(k)}</td><td>{e(format_value(v))}</td></tr>" for k, v in meta.sizes.items()]
@@ -324,20 +312,23 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
     parts.append("<table><tr><th>package</th><th>version</th></tr>")
     parts += [f"<tr><td>{e(k)}</td><td>{e(str(v))}</td></tr>" for k, v in meta.versions.items()]
     parts.append("</table>")
-    if meta.timings:
-        parts.append("<table><tr><th>task</th><th>wall time (s)</th></tr>")
-        parts += [f"<tr><td>{e(k)}</td><td>{v:.2f}</td></tr>" for k, v in meta.timings.items()]
-        parts.append("</table>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
 
 
-def write_report(out_dir, meta: RunMetadata, checks: list[CheckResult],
-                 figures: list[FigureResult]) -> tuple[Path, Path]:
-    """Write ``report.md`` and ``report.html`` into ``out_dir``; return their paths."""
-    out = Path(out_dir)
-    md = out / "report.md"
-    page = out / "report.html"
-    md.write_text(render_markdown(meta, checks, figures, out), encoding="utf-8")
-    page.write_text(render_html(meta, checks, figures), encoding="utf-8")
-    return md, page
+def write_report(folder, meta: RunMetadata, checks: list[CheckResult],
+                 figures: list[FigureResult]) -> list[str]:
+    """Write ``results.json``, ``report.md`` and ``report.html`` through ``folder`` (a ``RunFolder``).
+
+    Returns the names of the files written.
+    """
+    results = {"metadata": asdict(meta), "checks": [result_to_json(c) for c in checks],
+               "figures": [result_to_json(f) for f in figures]}
+    pages = {
+        "results.json": json.dumps(results, indent=1, ensure_ascii=False, allow_nan=True).encode(),
+        "report.md": render_markdown(meta, checks, figures).encode(),
+        "report.html": render_html(meta, checks, figures, lambda name: (folder.staging / name).read_bytes()).encode(),
+    }
+    for name, data in pages.items():
+        folder.write_bytes(name, data)
+    return list(pages)

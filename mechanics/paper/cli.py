@@ -1,0 +1,349 @@
+"""Command line of the main job: reproduce the paper's figures and theorem checks.
+
+``python -m mechanics`` (or the console script ``levy-area-paper``) runs every figure of the paper
+and every theorem / proposition check, and writes PNGs, the ``.npz`` data behind them,
+``report.md``, a self-contained ``report.html``, ``results.json`` and, last, ``manifest.json``
+(every file with its size and SHA-256, the options, versions and timings) into an output folder.
+
+The folder appears under its name only when complete (see :mod:`mechanics.paper.output`): the run
+works in ``OUT.incomplete`` and renames it at the end, a lock keeps two runs out of one folder,
+an interrupted run (SIGTERM, SIGINT, a kill, a full disk) can be continued with ``--resume`` and
+gives the same bytes as an uninterrupted run.
+
+Every user error (bad option value, an existing non-empty output folder, an unwritable folder, a
+full disk) is one line on stderr and exit code 2, never a traceback. An exception inside one
+figure or check is recorded in the report (with its traceback) and the run goes on; the exit code
+is then 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+import threading
+import time
+import traceback
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+
+import importlib
+
+import mechanics
+
+from .output import OutputError, RunFolder
+from .report import (
+    ERROR,
+    FAIL,
+    PASS,
+    CheckResult,
+    FigureResult,
+    RunMetadata,
+    format_value,
+    result_from_json,
+    result_to_json,
+    versions,
+    write_report,
+)
+from .tasks import Context, Progress
+
+__all__ = ["main", "build_parser", "parse_options", "Options", "UsageError", "run", "registries"]
+
+PROG = "levy-area-paper"
+SCALES = ("tiny", "default", "full")
+CONVENTIONS = ("rp", "paper")
+DEFAULT_OUTPUT = "paper-output"
+#: environment variable overriding the default size scale (used by the tests: ``tiny``)
+SCALE_ENV = "LEVY_AREA_PAPER_SCALE"
+
+
+def registries() -> tuple[dict, dict]:
+    """The registries ``(FIGURES, CHECKS)`` of :mod:`mechanics.paper.figures` and :mod:`~.checks`.
+
+    Loaded on first use rather than when this module is imported: they bring in matplotlib and
+    scipy's integrators (about a second), which ``--help`` and a mistyped option do not need.
+    """
+    return (importlib.import_module("mechanics.paper.figures").FIGURES,
+            importlib.import_module("mechanics.paper.checks").CHECKS)
+
+
+class UsageError(Exception):
+    """A user error: reported as one line on stderr, exit code 2."""
+
+
+class Terminated(KeyboardInterrupt):
+    """Raised by the SIGTERM handler: the run stops like on Ctrl-C (exit code 143)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # argparse would print usage + message and exit: we want one line
+        raise UsageError(f"{message} (see --help)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``python -m mechanics`` / ``levy-area-paper``."""
+    p = _Parser(
+        prog=PROG,
+        description="Reproduce the figures and theorem checks of 'Variational Principles on Geometric Rough "
+        "Paths and the Lévy Area Correction': PNG figures with their .npz data, report.md, a self-contained "
+        "report.html, results.json and manifest.json (checksums). The folder appears under its name only when "
+        "complete; an interrupted run stays in DIR.incomplete and continues with --resume.",
+        epilog="Example: levy-area-paper --output my-run --seed 1 --only fig1,gibbs_mean. Conventions: "
+        "docs/conventions.md of the project.",
+    )
+    p.add_argument("--output", "-o", default=DEFAULT_OUTPUT, metavar="DIR",
+                   help=f"output folder (default: {DEFAULT_OUTPUT}/); an existing non-empty folder is "
+                   "refused unless --overwrite is given")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an existing output folder of an earlier run as a whole, when this run completes "
+                   "(or discard an unfinished DIR.incomplete and start over)")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the interrupted run in DIR.incomplete (same options): finished figures and "
+                   "checks are verified against their checksums and reused")
+    p.add_argument("--convention", default="rp", metavar="{rp,paper}",
+                   help="'rp' (default): rough-path-correct signs and factors (docs/conventions.md); 'paper': "
+                   "the paper's printed equations, slips included, to reproduce its figures literally")
+    p.add_argument("--seed", default="0", metavar="INT", help="seed of every random stream (default 0)")
+    size = p.add_mutually_exclusive_group()
+    size.add_argument("--full", action="store_true",
+                      help="paper-scale sizes (see docs/main-job.md for the measured cost; epsilon = 0.005 over "
+                      "T = 500 for Figures 4-5)")
+    size.add_argument("--tiny", action="store_true",
+                      help="smoke-test sizes (seconds; numbers not meaningful, checks may fail)")
+    p.add_argument("--only", action="append", default=None, metavar="NAMES",
+                   help="comma-separated subset of figures/checks to run (names from --list; 'figures' "
+                   "and 'checks' select a whole group); may be repeated")
+    p.add_argument("--list", action="store_true", help="list the figures and checks and exit")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress output (errors still shown)")
+    return p
+
+
+@dataclass
+class Options:
+    """Validated command-line options."""
+
+    output: str
+    overwrite: bool = False
+    resume: bool = False
+    convention: str = "rp"
+    seed: int = 0
+    scale: str = "default"
+    only: list[str] | None = None
+    list_only: bool = False
+    quiet: bool = False
+    argv: list[str] = field(default_factory=list)
+
+    def command(self) -> str:
+        """The command that reproduces the results (without the output folder)."""
+        parts = [PROG, "--convention", self.convention, "--seed", str(self.seed)]
+        if self.scale != "default":
+            parts.append(f"--{self.scale}")
+        if self.only:
+            parts += ["--only", ",".join(self.only)]
+        return " ".join(parts)
+
+
+def parse_options(argv: list[str] | None) -> Options:
+    """Parse and validate ``argv``; raise :class:`UsageError` (one line) on a bad value."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    ns = build_parser().parse_args(argv)
+    conv = ns.convention.strip().lower()
+    if conv not in CONVENTIONS:
+        raise UsageError(f"--convention must be 'rp' or 'paper', got {ns.convention!r}")
+    try:
+        seed = int(ns.seed)
+    except ValueError:
+        raise UsageError(f"--seed must be a non-negative integer, got {ns.seed!r}") from None
+    if seed < 0:
+        raise UsageError(f"--seed must be a non-negative integer, got {seed}")
+    scale = "full" if ns.full else "tiny" if ns.tiny else None
+    if scale is None:
+        env = os.environ.get(SCALE_ENV, "").strip().lower()
+        if env and env not in SCALES:
+            raise UsageError(f"environment variable {SCALE_ENV} must be one of {', '.join(SCALES)}, "
+                             f"got {env!r}")
+        scale = env or "default"
+    if not ns.output or not str(ns.output).strip():
+        raise UsageError("--output must be a folder name, got an empty string")
+    only = None
+    if ns.only is not None:
+        figs, chks = (list(r) for r in registries())
+        known = figs + chks
+        only = []
+        for chunk in ns.only:
+            for name in (n.strip() for n in chunk.split(",")):
+                if not name:
+                    continue
+                if name == "figures":
+                    only += figs
+                elif name == "checks":
+                    only += chks
+                elif name in known:
+                    only.append(name)
+                else:
+                    raise UsageError(f"--only: unknown name {name!r}; valid names: "
+                                     f"{', '.join(known)} (or 'figures', 'checks')")
+        if not only:
+            raise UsageError("--only needs at least one name (see --list)")
+        only = [n for n in known if n in set(only)]   # report order, whatever the order given
+    if ns.resume and ns.list:
+        raise UsageError("--resume and --list do not go together")
+    return Options(output=str(ns.output), overwrite=ns.overwrite, resume=ns.resume, convention=conv, seed=seed,
+                   scale=scale, only=only, list_only=ns.list, quiet=ns.quiet, argv=argv)
+
+
+def _run_tasks(opts: Options, folder: RunFolder, prog: Progress):
+    """Run (or reuse, when resuming) the selected figures and checks, recording each as it finishes."""
+    selected = set(opts.only) if opts.only else None
+    figures, checks, sizes, timings, reused = [], [], {}, {}, []
+    cache: dict = {}
+    figure_registry, check_registry = registries()
+    for kind, registry in (("figure", figure_registry), ("check", check_registry)):
+        for name, task in registry.items():
+            if selected is not None and name not in selected:
+                continue
+            key = f"{kind} {name}"
+            entry = folder.reused.get(key)
+            if entry is not None and entry["result"].get("status") != ERROR:
+                res = result_from_json(entry["result"])
+                task_sizes, seconds = entry["sizes"], entry["seconds"]
+                reused.append(key)
+                prog.message(f"[{key}] finished before the interruption: reused ({res.status})")
+            else:
+                ctx = Context(folder=folder, convention=opts.convention, seed=opts.seed, scale=opts.scale,
+                              progress=prog, cache=cache)
+                prog.message(f"[{key}] {task.title}")
+                t0 = time.perf_counter()
+                try:
+                    res = task.run(ctx)
+                except OutputError:
+                    raise
+                except Exception:
+                    tb = traceback.format_exc()
+                    prog.message(f"[{key}] error: {tb.strip().splitlines()[-1]}")
+                    res = (FigureResult(name, task.title, task.caption, status=ERROR, details=tb)
+                           if kind == "figure" else CheckResult(name, task.title, status=ERROR, details=tb))
+                seconds = time.perf_counter() - t0
+                task_sizes = ctx.sizes
+                # the record makes the result and its files reusable by --resume; it is the task's last step
+                res = result_from_json(result_to_json(res))   # the report is rendered from what is recorded
+                folder.record(key, {"files": ctx.files, "result": result_to_json(res), "sizes": task_sizes,
+                                    "seconds": seconds})
+                if kind == "check" and res.status != ERROR:
+                    prog.message(f"[{key}] {res.status}: predicted {_short(res.predicted)}, "
+                                 f"measured {_short(res.measured)}")
+            sizes.update(task_sizes)
+            timings[key] = seconds
+            (figures if kind == "figure" else checks).append(res)
+    return figures, checks, sizes, timings, reused
+
+
+def _short(v):
+    s = format_value(v, 3)
+    return s if len(s) < 60 else s[:57] + "..."
+
+
+def _list() -> int:
+    figure_registry, check_registry = registries()
+    print("figures:")
+    for name, t in figure_registry.items():
+        print(f"  {name:<14} {t.title}")
+    print("checks:")
+    for name, t in check_registry.items():
+        print(f"  {name:<14} {t.title}")
+    return 0
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
+def run(opts: Options) -> int:
+    """Run the selected figures and checks and write the report; return the exit code.
+
+    Raises :class:`~mechanics.paper.output.OutputError` when the output folder cannot be used or
+    written, and ``KeyboardInterrupt`` (:class:`Terminated` for SIGTERM) when interrupted; the
+    unfinished run is then left in ``OUT.incomplete``, marked so, for ``--resume``.
+    """
+    prog = Progress(enabled=not opts.quiet)
+    folder = RunFolder(opts.output)
+    run_info = {"seed": opts.seed, "convention": opts.convention, "scale": opts.scale, "only": opts.only,
+                "versions": versions()}
+    in_main_thread = threading.current_thread() is threading.main_thread()   # signals: main thread only
+    previous = signal.signal(signal.SIGTERM, _on_sigterm) if in_main_thread else None
+    try:
+        with folder:
+            folder.open(run_info, overwrite=opts.overwrite, resume=opts.resume, notify=prog.message)
+            if folder.already_complete:
+                prog.message(f"{PROG}: '{folder.shown}' is complete (manifest.json verified); nothing to resume")
+                return 0
+            started = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
+            prog.message(f"{PROG}: convention={opts.convention} seed={opts.seed} sizes={opts.scale} -> "
+                         f"{folder.show(folder.staging)}/ (renamed to {folder.shown}/ when complete)")
+            t0 = time.perf_counter()
+            figures, checks, sizes, timings, reused = _run_tasks(opts, folder, prog)
+            meta = RunMetadata(command=opts.command(), seed=opts.seed, convention=opts.convention,
+                               scale=opts.scale, sizes=sizes, versions=run_info["versions"])
+            write_report(folder, meta, checks, figures)
+            manifest = {
+                "package": "roughpaths-mechanics", "version": mechanics.__version__, "seed": opts.seed,
+                "convention": opts.convention, "scale": opts.scale, "only": opts.only, "command": opts.command(),
+                "argv": opts.argv, "versions": run_info["versions"], "sizes": sizes, "started": started,
+                "finished": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
+                "seconds_this_process": time.perf_counter() - t0, "task_seconds": timings,
+                "resumed": bool(opts.resume and reused), "reused": reused,
+            }
+            # no signal between the manifest and the rename (a kill -9 there is handled by --resume)
+            blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+            try:
+                final = folder.finish(manifest)
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+    except KeyboardInterrupt:
+        if folder.staging.exists():
+            prog.enabled = True
+            prog.message(f"{PROG}: interrupted; the unfinished run is in '{folder.show(folder.staging)}' (marked "
+                         "INCOMPLETE): continue it with the same options and --resume")
+        raise
+    finally:
+        if in_main_thread:
+            signal.signal(signal.SIGTERM, previous)
+    bad = [r for r in checks + figures if r.status in (FAIL, ERROR)]
+    n_pass = sum(c.status == PASS for c in checks)
+    prog.message(f"{PROG}: {len(figures)} figures, checks {n_pass}/{len(checks)} passed"
+                 + (f", {len(bad)} failed or errored: {', '.join(r.name for r in bad)}" if bad else "")
+                 + (f", {len(reused)} reused from the interrupted run" if reused else "")
+                 + f" in {time.perf_counter() - t0:.1f}s")
+    prog.message(f"{PROG}: report: {final / 'report.md'} and {final / 'report.html'}")
+    return 1 if bad else 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``python -m mechanics`` and ``levy-area-paper``; returns the exit code."""
+    try:
+        opts = parse_options(argv)
+        if opts.list_only:
+            return _list()
+        return run(opts)
+    except (UsageError, OutputError) as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except Terminated:
+        print(f"{PROG}: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. `levy-area-paper --list | head`: not an error of the user's
+        try:
+            sys.stdout = open(os.devnull, "w")
+        except OSError:
+            pass
+        return 0
+    except SystemExit as exc:  # --help / --version from argparse
+        return int(exc.code or 0)
+    except OSError as exc:  # an OS error outside the writes (those name their file already)
+        print(f"{PROG}: error: {exc.strerror or exc}"
+              + (f": '{exc.filename}'" if getattr(exc, "filename", None) else ""), file=sys.stderr)
+        return 2

@@ -1,0 +1,176 @@
+"""What the figures and checks of the main job are made of: tasks, their context, a progress printer.
+
+A :class:`Task` is a named function ``task(ctx) -> FigureResult | CheckResult``; the figures and the
+checks register themselves in :data:`mechanics.paper.figures.FIGURES` and
+:data:`mechanics.paper.checks.CHECKS` with :func:`registry_decorator`. Each task receives a
+:class:`Context`: the options of the run, sizes for the chosen scale, a random stream of its own
+(seeded by the run's seed and the task's name, so a task's numbers do not depend on which tasks ran
+before it, or whether the run was resumed), and a way to save its files into the output folder.
+"""
+
+from __future__ import annotations
+
+import io
+import sys
+import time
+import zlib
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from .output import npz_bytes
+
+__all__ = ["Task", "registry_decorator", "Context", "Progress", "DPI"]
+
+#: resolution of the saved figures
+DPI = 130
+
+
+@dataclass
+class Task:
+    """A registry entry: a figure or a check, its title and caption."""
+
+    name: str
+    title: str
+    func: Callable
+    caption: str = ""
+
+    def run(self, ctx):
+        return self.func(ctx)
+
+
+def registry_decorator(registry: dict):
+    """A decorator ``register(name, title, caption="")`` adding functions to ``registry`` (in order)."""
+
+    def register(name: str, title: str, caption: str = ""):
+        def deco(func):
+            registry[name] = Task(name=name, title=title, func=func, caption=caption)
+            return func
+
+        return deco
+
+    return register
+
+
+class Progress:
+    """A dependency-free progress printer on stderr.
+
+    On a terminal it redraws one line (``\\r``) at most every 0.1 s; otherwise it prints one line
+    at the start and one at the end of each bar (logs stay readable). ``enabled=False`` silences it.
+    """
+
+    def __init__(self, enabled: bool = True, stream=None):
+        self.enabled = enabled
+        self.stream = sys.stderr if stream is None else stream
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+
+    def bar(self, label: str, total: int | float):
+        """A context manager with ``update(n=1)``: one bar of ``total`` units."""
+        return _Bar(self, label, total)
+
+    def message(self, text: str) -> None:
+        if self.enabled:
+            print(text, file=self.stream, flush=True)
+
+
+class _Bar:
+    def __init__(self, owner: Progress, label: str, total):
+        self.owner, self.label, self.total = owner, label, max(float(total), 1e-300)
+        self.done = 0.0
+        self.t0 = time.perf_counter()
+        self._last = 0.0
+        if owner.enabled and not owner.tty:
+            print(f"  {label} ...", file=owner.stream, flush=True)
+
+    def update(self, n: float = 1) -> None:
+        self.done = min(self.done + n, self.total)
+        if not (self.owner.enabled and self.owner.tty):
+            return
+        now = time.perf_counter()
+        if now - self._last < 0.1 and self.done < self.total:
+            return
+        self._last = now
+        frac = self.done / self.total
+        width = 24
+        fill = int(round(frac * width))
+        elapsed = now - self.t0
+        eta = elapsed * (1 - frac) / frac if frac > 0 else float("nan")
+        line = (f"\r  {self.label:<34.34} [{'#' * fill}{'.' * (width - fill)}] {100 * frac:5.1f}% "
+                f"{elapsed:6.1f}s" + (f"  eta {eta:5.0f}s" if 0 < frac < 1 else "          "))
+        print(line, end="", file=self.owner.stream, flush=True)
+
+    def close(self) -> None:
+        if not self.owner.enabled:
+            return
+        elapsed = time.perf_counter() - self.t0
+        if self.owner.tty:
+            print(f"\r  {self.label:<34.34} done in {elapsed:.1f}s" + " " * 40, file=self.owner.stream,
+                  flush=True)
+        else:
+            print(f"  {self.label} done in {elapsed:.1f}s", file=self.owner.stream, flush=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+
+@dataclass
+class Context:
+    """What a figure or check receives.
+
+    Attributes
+    ----------
+    folder : RunFolder or None
+        Where :meth:`save_figure` writes (None: nothing is saved, e.g. in tests of a single check).
+    convention, seed, scale : str, int, str
+        The run's options.
+    progress : Progress
+    sizes : dict
+        The sizes the current task picked (``size``), recorded for the report.
+    files : dict
+        ``{file name: {"size", "sha256"}}`` written by the current task.
+    cache : dict
+        Results shared between tasks (e.g. one coloured-noise run behind Figures 4 and 5); a cached
+        value must be a deterministic function of the seed and the sizes.
+    """
+
+    folder: Any = None
+    convention: str = "rp"
+    seed: int = 0
+    scale: str = "default"
+    progress: Progress = field(default_factory=lambda: Progress(enabled=False))
+    sizes: dict = field(default_factory=dict)
+    files: dict = field(default_factory=dict)
+    cache: dict = field(default_factory=dict)
+
+    def rng(self, name: str) -> np.random.Generator:
+        """Generator seeded by ``(seed, name)``: a task's numbers do not depend on which others ran."""
+        return np.random.default_rng([self.seed, zlib.crc32(name.encode())])
+
+    def seed_for(self, name: str) -> int:
+        """A non-negative integer seed derived from ``(seed, name)`` (for APIs taking a seed)."""
+        return int(np.random.SeedSequence([self.seed, zlib.crc32(name.encode())]).generate_state(1, np.uint64)[0])
+
+    def size(self, key: str, *, tiny, default, full):
+        """Pick a size for the current scale and record it for the report's metadata."""
+        value = {"tiny": tiny, "default": default, "full": full}[self.scale]
+        self.sizes[key] = value
+        return value
+
+    def save_figure(self, name: str, fig, data: dict) -> tuple[str, str]:
+        """Save ``fig`` as ``<name>.png`` and ``data`` as ``<name>.npz``; return the two file names.
+
+        Both files are byte-for-byte reproducible (no time stamps), and written atomically.
+        """
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
+        png, npz = f"{name}.png", f"{name}.npz"
+        blobs = {png: buf.getvalue(), npz: npz_bytes({k: np.asarray(v) for k, v in data.items()})}
+        for fname, blob in blobs.items():
+            self.files[fname] = self.folder.write_bytes(fname, blob) if self.folder is not None else \
+                {"size": len(blob), "sha256": None}
+        return png, npz
