@@ -175,9 +175,9 @@ def check_prop21(ctx) -> CheckResult:
     X = roughpaths.brownian_rough_path(np.linspace(0.0, 10.0, n + 1), 3, ctx.rng("prop21"), batch_shape=(P,))
     # θ = 0: Proposition 2.1 is about the Euler–Poincaré / Lie–Poisson equation; the perturbation of the
     # driver does not touch the dissipation (which Theorem 3.1 builds from h̃), see mechanics.wong_zakai
-    _, a = mechanics.simulate(paper_body(s, theta=0.0), E3, X, mechanics.LieHeun())
-    _, b = mechanics.simulate(paper_body(None, theta=0.0), E3, X.perturb(s), mechanics.LieHeun())
-    _, c = mechanics.simulate(paper_body(s, theta=0.0, convention="paper"), E3, X, mechanics.LieHeun())
+    a = roughpaths.solve(paper_body(s, theta=0.0), X, E3, mechanics.LieHeun()).states
+    b = roughpaths.solve(paper_body(None, theta=0.0), X.perturb(s), E3, mechanics.LieHeun()).states
+    c = roughpaths.solve(paper_body(s, theta=0.0, convention="paper"), X, E3, mechanics.LieHeun()).states
     gap = float(np.max(np.abs(a - b)))
     wrong = float(np.max(np.abs(c - b)))
     tol = 1e-10
@@ -198,7 +198,8 @@ def check_casimir(ctx) -> CheckResult:
     n = ctx.size("casimir.steps", tiny=1_000, default=10_000, full=100_000)
     P = ctx.size("casimir.paths", tiny=16, default=64, full=1_000)
     body = paper_body(s_matrix(s13=25.0), sigma=0.5)
-    _, out = mechanics.simulate_brownian(body, E3, 0.01, n, ctx.rng("casimir"), n_paths=P, save_every=n)
+    driver = roughpaths.BrownianDriver(3, seed=ctx.seed_for("casimir"), dt=0.01, n_steps=n, batch_shape=(P,))
+    out = roughpaths.solve(body, driver, E3, mechanics.LieHeun(), save_at="end").states
     err = float(np.max(np.abs(np.linalg.norm(out, axis=-1) - 1.0)))
     tol = 1e-12
     return CheckResult(
@@ -298,7 +299,8 @@ def check_uniform(ctx) -> CheckResult:
     T, dt = 30.0, 0.02
     body = paper_body(s_matrix(s12=-2.0, s13=1.0, s23=1.0), sigma=0.5, theta=0.0)
     n = int(T / dt)
-    _, out = mechanics.simulate_brownian(body, E3, dt, n, ctx.rng("uniform"), n_paths=P, save_every=n)
+    driver = roughpaths.BrownianDriver(3, seed=ctx.seed_for("uniform"), dt=dt, n_steps=n, batch_shape=(P,))
+    out = roughpaths.solve(body, driver, E3, mechanics.LieHeun(), save_at="end").states
     Pi = out[:, -1]
     second = np.einsum("pi,pj->pij", Pi, Pi)
     m2 = second.mean(axis=0)

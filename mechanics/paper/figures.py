@@ -55,14 +55,19 @@ def _simulate_long(ctx, body, rng, T, dt, label, save_every):
     per = n_steps // n_chunks
     per -= per % save_every
     mu = PI0.copy()
-    states, done = [PI0[None, :]], 0
+    states, done, chunk = [PI0[None, :]], 0, 0
+    root = int(rng.integers(2**63))
     with ctx.progress.bar(label, n_steps) as bar:
         while done < n_steps:
             k = min(per, n_steps - done) if done + per < n_steps else n_steps - done
-            _, out = mechanics.simulate_brownian(body, mu, dt, k, rng, n_paths=1, save_every=save_every)
-            states.append(out[0, 1:])
-            mu = out[0, -1]
+            driver = roughpaths.BrownianDriver(3, seed=np.random.SeedSequence(root, spawn_key=(chunk,)), dt=dt,
+                                               n_steps=k)
+            keep = driver.times[save_every::save_every]
+            sol = roughpaths.solve(body, driver, mu, mechanics.LieHeun(), save_at=np.append(keep, driver.times[-1]))
+            states.append(sol.states[:keep.size])
+            mu = sol.final
             done += k
+            chunk += 1
             bar.update(k)
     traj = np.concatenate(states, axis=0)
     times = np.arange(len(traj)) * dt * save_every
