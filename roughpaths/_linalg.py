@@ -122,9 +122,7 @@ def expm_batched(A) -> np.ndarray:
     return out.reshape(shape)
 
 
-@numba.guvectorize(["void(float64[:, :], float64[:], float64[:])"], "(a,b),(b)->(a)", nopython=True, cache=True)
-def matvec(A, x, out):  # pragma: no cover - compiled
-    """``out[..., a] = Σ_b A[..., a, b] x[..., b]`` (broadcast over leading axes), one summation order."""
+def _matvec_kernel(A, x, out):  # pragma: no cover - compiled
     for a in range(A.shape[0]):
         acc = 0.0
         for b in range(A.shape[1]):
@@ -132,12 +130,33 @@ def matvec(A, x, out):  # pragma: no cover - compiled
         out[a] = acc
 
 
-@numba.guvectorize(["void(float64[:], float64[:, :], float64[:])"], "(b),(b,c)->(c)", nopython=True, cache=True)
-def vecmat(x, M, out):  # pragma: no cover - compiled
-    """``out[..., c] = Σ_b x[..., b] M[..., b, c]`` (broadcast over leading axes), one summation order."""
+def _vecmat_kernel(x, M, out):  # pragma: no cover - compiled
     for c in range(M.shape[1]):
         out[c] = 0.0
     for b in range(M.shape[0]):
         xb = x[b]
         for c in range(M.shape[1]):
             out[c] += xb * M[b, c]
+
+
+_GUFUNCS: dict = {}
+
+
+def _gufunc(name):
+    """Compile (or load from numba's cache) a gufunc on first use, so that importing stays cheap."""
+    g = _GUFUNCS.get(name)
+    if g is None:
+        kernel, sig, layout = {"matvec": (_matvec_kernel, "void(float64[:, :], float64[:], float64[:])", "(a,b),(b)->(a)"),
+                               "vecmat": (_vecmat_kernel, "void(float64[:], float64[:, :], float64[:])", "(b),(b,c)->(c)")}[name]
+        g = _GUFUNCS[name] = numba.guvectorize([sig], layout, nopython=True, cache=True)(kernel)
+    return g
+
+
+def matvec(A, x):
+    """``out[..., a] = Σ_b A[..., a, b] x[..., b]`` (broadcast over leading axes), one summation order."""
+    return _gufunc("matvec")(np.asarray(A, dtype=np.float64), np.asarray(x, dtype=np.float64))
+
+
+def vecmat(x, M):
+    """``out[..., c] = Σ_b x[..., b] M[..., b, c]`` (broadcast over leading axes), one summation order."""
+    return _gufunc("vecmat")(np.asarray(x, dtype=np.float64), np.asarray(M, dtype=np.float64))

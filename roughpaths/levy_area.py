@@ -55,7 +55,6 @@ import math
 import numbers
 
 import numpy as np
-from scipy.special import polygamma
 
 from .validation import as_float_array, check_positive_int, check_rng
 
@@ -66,6 +65,13 @@ __all__ = ["LEVY_AREA_METHODS", "levy_area_terms", "levy_area_normals", "choose_
 LEVY_AREA_METHODS = ("fourier", "mrongowius-rossler", "wiktorsson")
 _ORDER = {"fourier": 0.5, "mrongowius-rossler": 1.0, "wiktorsson": 1.0}
 _MAX_TERMS = 10**7
+
+
+def _tail_zeta2(n: int) -> float:
+    """``Σ_{k>n} 1/k² = ψ'(n + 1)`` (scipy's trigamma, imported on first use: keeps ``import roughpaths`` light)."""
+    from scipy.special import polygamma
+
+    return float(polygamma(1, n + 1))
 
 
 def _coefficient(method: str, dim: int, h: float) -> float:
@@ -188,7 +194,7 @@ def levy_areas_from_normals(increments, h: float, normals, method: str, n: int) 
     inv_k = 1.0 / np.arange(1, n + 1)
     # P[i, j] = Σ_k ξ_ik (η_jk + √2 w_j) / k  (stacked mat-mat product: one order per member)
     P = (xi * inv_k) @ np.swapaxes(eta + math.sqrt(2.0) * w[..., :, None], -1, -2)
-    s_n = float(polygamma(1, n + 1))                                      # Σ_{k>n} 1/k²
+    s_n = _tail_zeta2(n)                                                  # Σ_{k>n} 1/k²
     a = math.sqrt(2.0 * s_n)
     if method in ("fourier", "mrongowius-rossler"):
         psi = z[..., pos:pos + d]
