@@ -27,12 +27,11 @@ def chord_solve(system, mu, dt, eta, tol, max_iter):
     alg = system.algebra
     w0 = system.drift_velocity(mu)
     jac = np.eye(n) - 0.5 * dt * (system.drift_velocity_jacobian(mu) @ alg.coadjoint_orbit_tangent(mu))
-    with np.errstate(all="ignore"):
-        jinv = np.linalg.inv(jac)
+    jinv = _member_inverses(jac)
     sigma = w0 * dt + eta
     done = np.zeros(mu.shape[0], dtype=bool)
     ok = np.zeros(mu.shape[0], dtype=bool)
-    active = np.arange(mu.shape[0])
+    active = np.flatnonzero(np.all(np.isfinite(jinv), axis=(-2, -1)))     # a singular Jacobian fails alone
     for _ in range(max_iter):
         if active.size == 0:
             break
@@ -59,3 +58,26 @@ def chord_solve(system, mu, dt, eta, tol, max_iter):
         active = active[~stop]
     sigma[~ok] = np.nan
     return sigma.reshape(shape), ok.reshape(shape[:-1])
+
+
+def _member_inverses(jac):
+    """Inverses of a stack ``(B, n, n)``; a non-finite or singular member gets NaN, alone.
+
+    ``numpy.linalg.inv`` raises for the whole stack when one member is singular; then the members
+    are inverted one by one (each as a stack of one, the same LAPACK call a solo solve makes).
+    """
+    out = np.full(jac.shape, np.nan)
+    good = np.flatnonzero(np.all(np.isfinite(jac), axis=(-2, -1)))
+    if good.size == 0:
+        return out
+    try:
+        with np.errstate(all="ignore"):
+            out[good] = np.linalg.inv(jac[good])
+    except np.linalg.LinAlgError:
+        for i in good:
+            try:
+                with np.errstate(all="ignore"):
+                    out[i] = np.linalg.inv(jac[i:i + 1])[0]
+            except np.linalg.LinAlgError:
+                pass
+    return out
