@@ -85,8 +85,24 @@ def _so3_chord(m0, m1, m2, e0, e1, e2, s0, s1, s2, dt, q, lin, minv, theta, tol,
         A[1, 0], A[1, 1], A[1, 2] = -g2, 0.0, g0
         A[2, 0], A[2, 1], A[2, 2] = g1, -g0, 0.0
         Dw = Dw + theta * (minv @ (A + L @ q))
-    Ji = np.linalg.inv(np.eye(3) - 0.5 * dt * (Dw @ L))
+    J = np.eye(3) - 0.5 * dt * (Dw @ L)
+    # 3x3 inverse by cofactors: a singular or non-finite Jacobian fails this member alone (LAPACK's
+    # inv would raise and abort the whole block)
+    c00 = J[1, 1] * J[2, 2] - J[1, 2] * J[2, 1]
+    c01 = J[1, 2] * J[2, 0] - J[1, 0] * J[2, 2]
+    c02 = J[1, 0] * J[2, 1] - J[1, 1] * J[2, 0]
+    det = J[0, 0] * c00 + J[0, 1] * c01 + J[0, 2] * c02
     ok = False
+    if not (det != 0.0 and abs(det) < np.inf):
+        return s0, s1, s2, ok
+    Ji = np.empty((3, 3))
+    Ji[0, 0], Ji[1, 0], Ji[2, 0] = c00 / det, c01 / det, c02 / det
+    Ji[0, 1] = (J[0, 2] * J[2, 1] - J[0, 1] * J[2, 2]) / det
+    Ji[1, 1] = (J[0, 0] * J[2, 2] - J[0, 2] * J[2, 0]) / det
+    Ji[2, 1] = (J[0, 1] * J[2, 0] - J[0, 0] * J[2, 1]) / det
+    Ji[0, 2] = (J[0, 1] * J[1, 2] - J[0, 2] * J[1, 1]) / det
+    Ji[1, 2] = (J[0, 2] * J[1, 0] - J[0, 0] * J[1, 2]) / det
+    Ji[2, 2] = (J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]) / det
     for it in range(max_iter):
         n0, n1, n2 = _rod(s0, s1, s2, m0, m1, m2)
         u0, u1, u2 = _w3(q, lin, minv, theta, 0.5 * (m0 + n0), 0.5 * (m1 + n1), 0.5 * (m2 + n2))
