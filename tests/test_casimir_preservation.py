@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from mechanics.heavy_top import heavy_top
-from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate_brownian
+from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
 from mechanics.lie_algebra import sl2r
 from mechanics.lie_poisson import LiePoissonSystem
 from mechanics.rigid_body import rigid_body
-from roughpaths import RoughPath, solve
+from roughpaths import BrownianDriver, RoughPath, solve
 
 S = np.array([[0.0, 10.0, 25.0], [-10.0, 0.0, -5.0], [-25.0, 5.0, 0.0]])
 N_STEPS = 10_000
@@ -25,7 +25,8 @@ def test_rigid_body_norm_preserved(method, rng):
     rb = rigid_body([1.0, 2.0, 3.0], sigma=0.3, s=S, theta=1.0)
     mu0 = rng.standard_normal((16, 3))
     mu0 /= np.linalg.norm(mu0, axis=-1, keepdims=True)
-    _, Pi = simulate_brownian(rb, mu0, 1e-2, N_STEPS, rng, method=method, save_every=100)
+    X = BrownianDriver(3, seed=1, dt=1e-2, n_steps=N_STEPS, batch_shape=(16,))
+    Pi = solve(rb, X, mu0, method, save_at=X.times[::100]).states
     err = np.max(np.abs(np.linalg.norm(Pi, axis=-1) - 1.0))
     assert err <= 1e-12, err
     assert np.ptp(Pi[..., 2]) > 0.1         # the state really moved
@@ -47,7 +48,8 @@ def test_rigid_body_naive_heun_drifts(rng):
 def test_heavy_top_casimirs_preserved(rng):
     top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.2, s=S, theta=0.5)
     mu0 = rng.standard_normal((8, 6))
-    _, mu = simulate_brownian(top, mu0, 1e-2, N_STEPS, rng, method=LieEuler(), save_every=500)
+    X = BrownianDriver(3, seed=2, dt=1e-2, n_steps=N_STEPS, batch_shape=(8,))
+    mu = solve(top, X, mu0, LieEuler(), save_at=X.times[::500]).states
     c0 = top.casimirs(mu0)
     err = np.max(np.abs(top.casimirs(mu) - c0[:, None, :]) / np.maximum(1.0, np.abs(c0[:, None, :])))
     assert err <= 1e-12, err

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from mechanics.heavy_top import heavy_top
-from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate_brownian
-from roughpaths import RoughPath, solve
+from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
+from roughpaths import BrownianDriver, RoughPath, solve
 
 I3 = np.array([1.0, 2.0, 3.0])
 CHI = np.array([0.2, -0.1, 1.0])
@@ -43,7 +43,8 @@ def test_vector_field_independent_formula(rng):
 def test_casimirs_exact(method, rng):
     top = heavy_top(I3, CHI, sigma=0.3, s=S, theta=0.2)
     mu0 = np.stack([MU0, rng.standard_normal(6)])
-    _, mu = simulate_brownian(top, mu0, 1e-2, 1000, rng, method=method, save_every=100)
+    X = BrownianDriver(3, seed=3, dt=1e-2, n_steps=1000, batch_shape=(2,))
+    mu = solve(top, X, mu0, method, save_at=X.times[::100]).states
     c0 = top.casimirs(mu0)[:, None, :]
     assert np.max(np.abs(top.casimirs(mu) - c0)) <= 1e-12 * np.max(np.abs(c0))
 

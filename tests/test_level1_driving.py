@@ -1,19 +1,19 @@
 """Level-1 driving of the coadjoint schemes means zero step Lévy area, and it is never implicit.
 
-Claim: ``simulate(system, mu0, X1, method, levy_area=False)`` on a level-1 path equals the run on the
-level-2 path with the same increments and zero step Lévy areas (the piecewise-linear lift), and
-differs from the run with the true (non-zero) areas; a level-1 path without ``levy_area=False``, or a
-level-2 path with it, is refused (no silent drop of areas).
+Claim: ``solve(system, X1, mu0, Method(levy_area=False))`` on a level-1 path equals the run of
+``Method()`` on the level-2 path with the same increments and zero step Lévy areas (the piecewise-linear
+lift), and differs from the run with the true (non-zero) areas; a level-1 path with a level-2 solver
+(``levy_area=True``), or a level-2 path with ``levy_area=False``, is refused (no silent drop of areas).
 """
 
 import numpy as np
 import pytest
 
-from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun, simulate
+from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
 from mechanics.lie_algebra import sl2r
 from mechanics.lie_poisson import LiePoissonSystem
 from mechanics.rigid_body import rigid_body
-from roughpaths import RoughPath
+from roughpaths import RoughPath, solve
 from roughpaths.level2 import outer
 
 SYSTEMS = {
@@ -34,9 +34,9 @@ def test_level1_equals_zero_area_lift(name, method, rng):
     lam = rng.standard_normal((3, n, 3, 3)) * 0.05 ** 2
     true = RoughPath.from_increments(dw, 0.5 * outer(dw, dw) + (lam - np.swapaxes(lam, -1, -2)), times=times)
     mu0 = [0.0, 0.6, 0.8]
-    _, a = simulate(system, mu0, x1, method, levy_area=False)
-    _, b = simulate(system, mu0, lift, method)
-    _, c = simulate(system, mu0, true, method)
+    a = solve(system, x1, mu0, type(method)(levy_area=False)).states
+    b = solve(system, lift, mu0, method).states
+    c = solve(system, true, mu0, method).states
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-14)
     assert np.max(np.abs(a - c)) > 1e-4                   # the areas do enter when given
 
@@ -46,11 +46,11 @@ def test_level1_without_flag_and_level2_with_flag_are_refused(rng):
     dw = rng.standard_normal((10, 3)) * 0.1
     x1 = RoughPath.from_increments(dw, times=np.linspace(0, 1, 11))
     with pytest.raises(ValueError, match="levy_area=False"):
-        simulate(rb, [0.0, 0.0, 1.0], x1)
+        solve(rb, x1, [0.0, 0.0, 1.0], LieHeun())
     x2 = RoughPath.from_path(np.cumsum(np.vstack([np.zeros(3), dw]), axis=0), times=np.linspace(0, 1, 11))
     with pytest.raises(ValueError, match="to_level1"):
-        simulate(rb, [0.0, 0.0, 1.0], x2, levy_area=False)
+        solve(rb, x2, [0.0, 0.0, 1.0], LieHeun(levy_area=False))
     with pytest.raises(TypeError, match="levy_area"):
-        simulate(rb, [0.0, 0.0, 1.0], x2, levy_area="yes")
-    _, a = simulate(rb, [0.0, 0.0, 1.0], x2.to_level1(), levy_area=False)     # the deliberate drop works
+        LieHeun(levy_area="yes")
+    a = solve(rb, x2.to_level1(), [0.0, 0.0, 1.0], LieHeun(levy_area=False)).states  # the deliberate drop works
     assert a.shape == (11, 3)

@@ -2,20 +2,21 @@
 
 Covers: non-symmetric / non-positive inertia, wrong ξ shapes, s not antisymmetric or of the wrong size,
 θ < 0 (and non-finite, non-numeric), unknown convention, states off the orbit for a Casimir-preserving
-run, a chord iteration that fails to converge (the message names the step), level-1 or non-geometric
-drivers, dimension mismatches, bad rng / dt / n_steps / save_every.
+run (``check_on_orbit``), a chord iteration that fails to converge (the message names the step), level-1
+or non-geometric drivers, dimension mismatches, bad seed / dt / n_steps / save_at. (The validation of the
+deprecated wrappers ``simulate`` / ``simulate_brownian`` / ``coadjoint_step`` is in
+``test_deprecated_wrappers.py``.)
 """
 
 import numpy as np
 import pytest
 
 from mechanics.heavy_top import heavy_top
-from mechanics.integrators import (ChordConvergenceError, ImplicitMidpoint, LieHeun, coadjoint_step,
-                                   simulate, simulate_brownian)
+from mechanics.integrators import ChordConvergenceError, ImplicitMidpoint, LieHeun, check_on_orbit
 from mechanics.lie_algebra import so3
 from mechanics.lie_poisson import LiePoissonSystem
 from mechanics.rigid_body import rigid_body
-from roughpaths import RoughPath
+from roughpaths import BrownianDriver, RoughPath, solve
 
 I3 = [1.0, 2.0, 3.0]
 
@@ -87,27 +88,32 @@ def test_off_orbit_states_rejected(rng):
     rb = rigid_body(I3, sigma=0.1, theta=1.0)
     X = RoughPath.from_path(np.zeros((11, 3)))
     with pytest.raises(ValueError, match=r"off the coadjoint orbit: \|mu\|\^2 = 4.0"):
-        simulate(rb, [0.0, 0.0, 2.0], X, orbit=[1.0])
+        check_on_orbit(rb, [0.0, 0.0, 2.0], [1.0])
     with pytest.raises(ValueError, match="batch index \\(1,\\)"):
-        simulate_brownian(rb, [[0.0, 0.0, 1.0], [0.0, 0.0, 1.1]], 0.01, 10, rng, orbit=1.0)
+        check_on_orbit(rb, [[0.0, 0.0, 1.0], [0.0, 0.0, 1.1]], 1.0)
     top = heavy_top(I3, [0, 0, 1.0], sigma=0.1)
     with pytest.raises(ValueError, match="Pi.Gamma"):
-        simulate(top, [1.0, 0, 0, 1.0, 0, 0], X, orbit=[1.0, 0.0])
-    simulate(top, [0.0, 1.0, 0, 1.0, 0, 0], X, orbit=[1.0, 0.0])      # on the orbit: accepted
+        check_on_orbit(top, [1.0, 0, 0, 1.0, 0, 0], [1.0, 0.0])
+    check_on_orbit(top, [0.0, 1.0, 0, 1.0, 0, 0], [1.0, 0.0])        # on the orbit: accepted
+    assert solve(top, X, [0.0, 1.0, 0, 1.0, 0, 0], LieHeun()).states.shape == (11, 6)
 
 
 def test_chord_non_convergence_names_the_step(rng):
     rb = rigid_body(I3, sigma=0.5, theta=50.0)
     with pytest.raises(ChordConvergenceError, match=r"did not converge at step 0 .*max_iter = 1"):
-        simulate_brownian(rb, [0.0, 0.6, 0.8], 0.05, 5, rng, method=ImplicitMidpoint(tol=1e-15, max_iter=1))
+        solve(rb, BrownianDriver(3, seed=5, dt=0.05, n_steps=5), [0.0, 0.6, 0.8],
+              ImplicitMidpoint(tol=1e-15, max_iter=1))
     X = RoughPath.from_path(np.cumsum(rng.standard_normal((3, 21, 3)) * 0.1, axis=1), times=np.linspace(0, 1, 21))
     with pytest.raises(ChordConvergenceError, match="step 0"):
-        simulate(rb, [0.0, 0.6, 0.8], X, ImplicitMidpoint(tol=1e-15, max_iter=1))
+        solve(rb, X, [0.0, 0.6, 0.8], ImplicitMidpoint(tol=1e-15, max_iter=1))
+    # the numpy path (a generic system): at rest on the equilibrium e3 until the first kick at step 7
     generic = LiePoissonSystem(so3(), lambda m: 0.5 * np.sum(m * m / I3, -1), 0.5 * np.eye(3), theta=50.0,
                                hamiltonian_gradient=lambda m: m / np.asarray(I3))
-    with pytest.raises(ChordConvergenceError, match=r"step 7 \(t = 0.35"):
-        coadjoint_step(generic, np.array([0.0, 0.6, 0.8]), 0.05, np.zeros(3), ImplicitMidpoint(tol=1e-15, max_iter=1),
-                       step_index=7, t=0.35)
+    kick = np.zeros((11, 3))
+    kick[8:] = [0.1, -0.2, 0.05]
+    with pytest.raises(ChordConvergenceError, match=r"step 7 of the block from t = 0 \(step from t = 0.35"):
+        solve(generic, RoughPath.from_path(kick, times=np.linspace(0.0, 0.5, 11)), [0.0, 0.0, 1.0],
+              ImplicitMidpoint(tol=1e-15, max_iter=1))
     with pytest.raises(ValueError, match="tol"):
         ImplicitMidpoint(tol=-1.0)
     with pytest.raises(ValueError, match="max_iter"):
@@ -119,32 +125,32 @@ def test_bad_drivers_and_shapes(rng):
     vals = np.cumsum(rng.standard_normal((11, 3)), axis=0)
     X = RoughPath.from_path(vals)
     with pytest.raises(ValueError, match="level-1"):
-        simulate(rb, [0, 0, 1.0], X.to_level1())
+        solve(rb, X.to_level1(), [0, 0, 1.0], LieHeun())
     ito = RoughPath(X.increments, X.areas - 0.05 * np.eye(3), times=X.times, kind="ito")
     with pytest.raises(ValueError, match="geometric"):
-        simulate(rb, [0, 0, 1.0], ito)
+        solve(rb, ito, [0, 0, 1.0], LieHeun())
     with pytest.raises(ValueError, match="dimension d=2"):
-        simulate(rb, [0, 0, 1.0], RoughPath.from_path(vals[:, :2]))
-    with pytest.raises(ValueError, match="mu0 must have trailing shape"):
-        simulate(rb, [0, 1.0], X)
+        solve(rb, RoughPath.from_path(vals[:, :2]), [0, 0, 1.0], LieHeun())
+    with pytest.raises(ValueError, match=r"y0 must have shape \(\.\.\., 3\)"):
+        solve(rb, X, [0, 1.0], LieHeun())
     with pytest.raises(TypeError, match="RoughPath"):
-        simulate(rb, [0, 0, 1.0], vals)
-    with pytest.raises(TypeError, match="method"):
-        simulate(rb, [0, 0, 1.0], X, method="heun")
-    with pytest.raises(ValueError, match="save_every"):
-        simulate(rb, [0, 0, 1.0], X, save_every=0)
+        solve(rb, vals, [0, 0, 1.0], LieHeun())
+    with pytest.raises(TypeError, match="coadjoint solver"):
+        solve(rb, X, [0, 0, 1.0], "heun")
+    with pytest.raises(ValueError, match="save_at"):
+        solve(rb, X, [0, 0, 1.0], LieHeun(), save_at=X.times[:2] + 0.05)
     with pytest.raises(TypeError, match="Generator"):
-        simulate_brownian(rb, [0, 0, 1.0], 0.01, 10, 42)
+        BrownianDriver(3, seed=rng, dt=0.01, n_steps=10)
     with pytest.raises(ValueError, match="dt"):
-        simulate_brownian(rb, [0, 0, 1.0], -0.01, 10, rng)
+        BrownianDriver(3, seed=0, dt=-0.01, n_steps=10)
     with pytest.raises(ValueError, match="n_steps"):
-        simulate_brownian(rb, [0, 0, 1.0], 0.01, 0, rng)
+        BrownianDriver(3, seed=0, dt=0.01, n_steps=0)
     with pytest.raises(ValueError, match="levy_area"):
-        simulate_brownian(rb, [0, 0, 1.0], 0.01, 10, rng, levy_area="exact")
+        BrownianDriver(3, seed=0, dt=0.01, n_steps=10, levy_area="exact")
     with pytest.raises(ValueError, match="non-finite"):
-        simulate_brownian(rb, [0, np.nan, 1.0], 0.01, 10, rng)
+        solve(rb, BrownianDriver(3, seed=0, dt=0.01, n_steps=10), [0, np.nan, 1.0], LieHeun())
     with pytest.raises(ValueError, match="broadcast"):
-        simulate(rb, np.ones((4, 3)), RoughPath.from_path(np.stack([vals, vals, vals])))
+        solve(rb, RoughPath.from_path(np.stack([vals, vals, vals])), np.ones((4, 3)), LieHeun())
 
 
 def test_solver_contract_of_the_coadjoint_schemes():
@@ -167,8 +173,6 @@ def test_solver_contract_of_the_coadjoint_schemes():
         solve(rb, X, [0, 0, 1.0], LieHeun)
     with pytest.raises(TypeError, match=r"did you mean LieHeun\(\)"):
         run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=5, n_paths=2, seed=0, method=LieHeun)
-    with pytest.raises(TypeError, match=r"did you mean LieHeun\(\)"):
-        simulate(rb, [0, 0, 1.0], X.rough_path(), LieHeun)
     with pytest.raises(TypeError, match="LiePoissonSystem"):
         solve(LinearVectorFields(np.zeros((3, 3, 3))), X, np.ones(3), LieHeun())
     with pytest.raises(TypeError, match="coadjoint solver"):

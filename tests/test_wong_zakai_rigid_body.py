@@ -17,10 +17,12 @@ diagonal), so there E[Π1] = 0; the torque breaks it.
 import numpy as np
 import pytest
 
+from roughpaths import solve
 from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_coloured_noise
+from mechanics.integrators import LieHeun
 from mechanics.lie_poisson import levy_velocity
-from mechanics.wong_zakai import (integrate_rigid_body, rigid_body_wong_zakai_limit,
-                                  simulate_wong_zakai_rigid_body)
+from mechanics.rigid_body import rigid_body
+from mechanics.wong_zakai import rigid_body_wong_zakai_limit, simulate_wong_zakai_rigid_body
 
 A, D = paper_coloured_noise_matrices(k=0.5)
 SIGMA = 0.5
@@ -47,9 +49,12 @@ def test_limit_in_both_coordinates_agree(rng):
     """Friz–Oberhauser: ξ = σe_i driven by (MB, M BB Mᵀ + N dt) == ξ' = σM[:, k] driven by B plus Π×c."""
     wz = rigid_body_wong_zakai_limit(A, D, SIGMA)
     s = sample_coloured_noise(A, D, 0.05, np.linspace(0, 1, 2001), rng=rng, batch_shape=(20,))
-    _, P1 = integrate_rigid_body(s.limit_path(), [0.0, 0.0, 1.0], [1, 2, 3], wz.coloured_xi, 1.0)
-    _, P2 = integrate_rigid_body(s.brownian, [0.0, 0.0, 1.0], [1, 2, 3], wz.limit_xi, 1.0, torque=wz.torque)
-    _, P0 = integrate_rigid_body(s.brownian, [0.0, 0.0, 1.0], [1, 2, 3], wz.limit_xi, 1.0)
+    e3 = [0.0, 0.0, 1.0]
+    torque_body = rigid_body([1, 2, 3], xi=wz.limit_xi, s=wz.perturbation_B, theta=1.0, levy_in_dissipation=False)
+    assert np.allclose(torque_body.levy_velocity, wz.torque)                 # Π×c in the conservative term only
+    P1 = solve(rigid_body([1, 2, 3], xi=wz.coloured_xi, theta=1.0), s.limit_path(), e3, LieHeun()).states
+    P2 = solve(torque_body, s.brownian, e3, LieHeun()).states
+    P0 = solve(rigid_body([1, 2, 3], xi=wz.limit_xi, theta=1.0), s.brownian, e3, LieHeun()).states
     d = np.max(np.abs(P1 - P2))
     assert d < 1e-3 and np.max(np.abs(P1 - P0)) > 100 * d
     assert np.max(np.abs(np.linalg.norm(P1, axis=-1) - 1)) < 1e-12
@@ -80,13 +85,18 @@ def _strang_naive(X, Pi0, inertia, xi, theta, c, cd):
 
 
 def test_shared_integrator_agrees_with_a_naive_strang_splitting(rng):
-    """integrate_rigid_body (the shared coadjoint Lie–Heun) vs an independent Strang scheme on coloured paths,
-    for the exact limit's torque placement (c in the conservative term only) and for (srblevy)."""
+    """The shared coadjoint Lie–Heun (``roughpaths.solve`` on ``rigid_body(..., s)``) vs an independent Strang
+    scheme on coloured paths, for the exact limit's torque placement (c in the conservative term only:
+    ``levy_in_dissipation=False``) and for (srblevy) (c in the dissipation too: ``levy_in_dissipation=True``)."""
     s = sample_coloured_noise(A, D, 0.1, np.linspace(0, 0.5, 1001), rng=rng, batch_shape=(5,))
     c = np.array([0.1, -0.2, 0.05])
+    sc = np.zeros((3, 3))                             # c = σ² (s23, −s13, s12) for ξ_i = σ e_i
+    sc[1, 2], sc[0, 2], sc[0, 1] = c[0] / SIGMA ** 2, -c[1] / SIGMA ** 2, c[2] / SIGMA ** 2
+    sc -= sc.T
     for cd in (np.zeros(3), c):
-        _, ours = integrate_rigid_body(s.path, [0.0, 0.6, 0.8], [1, 2, 3], SIGMA * np.eye(3), 1.0, torque=c,
-                                       dissipation_shift=cd, save_every=1000)
+        body = rigid_body([1, 2, 3], xi=SIGMA * np.eye(3), s=sc, theta=1.0, levy_in_dissipation=bool(np.any(cd)))
+        assert np.allclose(body.levy_velocity, c)
+        ours = solve(body, s.path, [0.0, 0.6, 0.8], LieHeun(), save_at=s.path.times[::1000]).states
         ref = _strang_naive(s.path, [0.0, 0.6, 0.8], np.array([1.0, 2.0, 3.0]), SIGMA * np.eye(3), 1.0, c, cd)
         assert np.max(np.abs(ours[:, -1] - ref)) < 1e-4
         other = _strang_naive(s.path, [0.0, 0.6, 0.8], np.array([1.0, 2.0, 3.0]), SIGMA * np.eye(3), 1.0, c,

@@ -57,7 +57,8 @@ assert X3.level == 3 and np.all(np.isfinite(X3.p_variation(3.5)))
 
 # %% [markdown]
 # ## 3. The rigid body driven by fBM (H = 0.4, level 2), with and without the Lévy-area perturbation
-# `mechanics.simulate` takes any geometric level-2 rough path; the coadjoint scheme keeps `|Π|` exactly.
+# `roughpaths.solve` with a coadjoint solver (`mechanics.LieHeun()`) takes any geometric level-2 rough path;
+# the coadjoint scheme keeps `|Π|` exactly.
 # Perturbing the area by `s (t − s)` (`X.perturb(s)`) is, by Friz–Oberhauser, the same as adding the Lévy
 # torque `c = ½ Σ s^{ij} ξ_i × ξ_j` to the body (`rigid_body(..., s=s, levy_in_dissipation=False)`). The
 # coadjoint scheme sees the step Lévy area and the torque in the same Lie-algebra element, so on an fBM
@@ -71,9 +72,9 @@ body_torque = mechanics.rigid_body([1.0, 2.0, 3.0], sigma=0.5, s=s, theta=0.2, l
 mu0 = np.array([0.0, 0.6, 0.8])
 n_paths = 8 if SMALL else 64
 X = fbm_rough_path(512, 0.4, rng=4, substeps=8, T=4.0, dim=3, batch_shape=(n_paths,))
-_, Pi_plain = mechanics.simulate(body, mu0, X, mechanics.LieHeun())
-_, Pi_pert = mechanics.simulate(body, mu0, X.perturb(s), mechanics.LieHeun())
-_, Pi_torque = mechanics.simulate(body_torque, mu0, X, mechanics.LieHeun())
+Pi_plain = solve(body, X, mu0, mechanics.LieHeun()).states
+Pi_pert = solve(body, X.perturb(s), mu0, mechanics.LieHeun()).states
+Pi_torque = solve(body_torque, X, mu0, mechanics.LieHeun()).states
 casimir = max(np.abs(np.linalg.norm(P, axis=-1) - 1.0).max() for P in (Pi_plain, Pi_pert, Pi_torque))
 gap = np.abs(Pi_pert - Pi_torque).max()
 effect = np.sqrt(np.mean(np.sum((Pi_pert[..., -1, :] - Pi_plain[..., -1, :]) ** 2, -1)))
