@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 import mechanics
+import roughpaths
 from mechanics.paper.plotting import new_figure, plot_density, plot_sphere_portrait, plot_trajectory_3d
 
 small = os.environ.get("TUTORIAL_SMALL") == "1"
@@ -27,9 +28,9 @@ print("Lévy torque c =", np.round(body.levy_velocity, 4))                 # σ�
 
 # 1. one long trajectory from e3, saved every 10 steps
 dt, n = 0.005, (20_000 if small else 200_000)
-times, states = mechanics.simulate_brownian(body, [0.0, 0.0, 1.0], dt, n, np.random.default_rng(1),
-                                            n_paths=1, save_every=10)
-traj = states[0]
+driver = roughpaths.BrownianDriver(3, seed=1, dt=dt, n_steps=n)                # lazy, seeded, block-wise
+sol = roughpaths.solve(body, driver, [0.0, 0.0, 1.0], mechanics.LieHeun(), save_at=driver.times[::10])
+times, traj = sol.times, sol.states
 assert np.allclose(np.linalg.norm(traj, axis=-1), 1.0, atol=1e-12)      # on the sphere
 
 fig = new_figure(figsize=(5, 5))
