@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 from .driver import Driver
-from .validation import as_float_array, check_positive_int, check_times
+from .validation import as_float_array, check_batch_shape, check_positive_int, check_times
 
 
 def check_seed(seed) -> np.random.SeedSequence:
@@ -29,20 +29,6 @@ def check_seed(seed) -> np.random.SeedSequence:
         raise TypeError("seed must be an int or a numpy.random.SeedSequence, got a Generator: a Generator's "
                         "state would make the paths depend on what was drawn before. Pass seed=<int>.")
     raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
-
-
-def check_batch_shape(batch_shape) -> tuple:
-    if isinstance(batch_shape, numbers.Integral) and not isinstance(batch_shape, bool):
-        batch_shape = (batch_shape,)
-    try:
-        shape = tuple(batch_shape)
-    except TypeError:
-        raise TypeError(f"batch_shape must be a tuple of integers, got {batch_shape!r}; "
-                        f"pass e.g. batch_shape=(1000,).") from None
-    for n in shape:
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
-            raise ValueError(f"batch_shape must hold non-negative integers, got {shape!r}.")
-    return tuple(int(n) for n in shape)
 
 
 def grid(times, dt, n_steps, t0):

@@ -52,7 +52,7 @@ import scipy.linalg
 from .rough_path import RoughPath
 from .rough_path_n import RoughPathN
 from .signature import signature
-from .validation import as_float_array, check_positive_int, check_times
+from .validation import as_float_array, check_memory, check_positive_int, check_times
 
 __all__ = ["fbm", "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift"]
 
@@ -93,6 +93,7 @@ def fgn_autocovariance(hurst, n: int) -> np.ndarray:
     """
     H = _check_hurst(hurst)
     n = check_positive_int(n, "n")
+    check_memory(8.0 * 4 * n, f"the autocovariance of {n} lags", "ask for fewer lags")
     k = np.arange(n, dtype=np.float64)
     return 0.5 * (np.abs(k + 1) ** (2 * H) - 2 * k ** (2 * H) + np.abs(k - 1) ** (2 * H))
 
