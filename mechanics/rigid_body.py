@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from roughpaths.validation import as_float_array, check_positive_int, check_positive_real
+from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real
 
 from .lie_algebra import so3
 from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
@@ -34,6 +34,7 @@ def isotropic_xi(sigma, dim: int = 3) -> np.ndarray:
     r"""Isotropic SALT noise :math:`\xi_i = \sigma e_i`, shape ``(dim, dim)``."""
     sigma = check_positive_real(sigma, "sigma", allow_zero=True)
     dim = check_positive_int(dim, "dim")
+    check_memory(8.0 * dim * dim, f"the noise vectors (dim={dim} x dim)", "use a smaller dim")
     return sigma * np.eye(dim)
 
 

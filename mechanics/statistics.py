@@ -12,7 +12,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from roughpaths.validation import as_float_array, check_positive_int
+from roughpaths.validation import as_float_array, check_memory, check_positive_int
 
 __all__ = ["RunningMoments", "moment_observable", "split_moment_features", "LeafReducer", "LEAF"]
 
@@ -41,6 +41,8 @@ class RunningMoments:
 
     def __init__(self, dim: int):
         self.dim = check_positive_int(dim, "dim")
+        check_memory(8.0 * self.dim * (self.dim + 1), f"the mean and scatter matrix (dim={self.dim})",
+                     "use fewer observables")
         self.count = 0
         self.mean = np.zeros(self.dim)
         self.scatter = np.zeros((self.dim, self.dim))

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_rng,
+from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_real, check_rng,
                                    check_work)
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
@@ -435,10 +435,7 @@ def planar_example(alpha=1.0, gamma=1.0, delta=1.0, lam=0.0, mu=0.0) -> PlanarEx
     """
     vals = []
     for name, v in (("alpha", alpha), ("gamma", gamma), ("delta", delta), ("lam", lam), ("mu", mu)):
-        f = float(v)
-        if not math.isfinite(f):
-            raise ValueError(f"{name} must be finite, got {v!r}.")
-        vals.append(f)
+        vals.append(check_real(v, name))
     alpha, gamma, delta, lam, mu = vals
     if alpha <= 0 or delta <= 0:
         raise ValueError(f"alpha and delta must be > 0 (alpha is the OU damping, delta the noise variance), "
@@ -456,6 +453,11 @@ def planar_example(alpha=1.0, gamma=1.0, delta=1.0, lam=0.0, mu=0.0) -> PlanarEx
                          drift=np.diag([lam, mu]) + N12 * S, noise_matrices=E)
 
 
+def _check_example(ex):
+    if not isinstance(ex, PlanarExample):
+        raise TypeError(f"ex must be a PlanarExample (from planar_example(...)), got {type(ex).__name__}.")
+
+
 def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
     r"""Exact ``E[X_T]`` and ``E[X_T X_Tᵀ]`` of the limit ``dX = (Q + N12 S)X dt + Σ_k G_k X∘dB^k``.
 
@@ -463,6 +465,7 @@ def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
     ``E[X_T] = e^{BT}x0``; ``vec E[XXᵀ]`` solves ``d/dt vec P = (I⊗B + B⊗I + Σ_k G_k⊗G_k) vec P``.
     ``torque=False`` drops ``N12 S`` (the plain Stratonovich guess).
     """
+    _check_example(ex)
     x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
     T = check_positive_real(T, "T", allow_zero=True)
     M = ex.limit.scaling
@@ -496,6 +499,7 @@ def simulate_planar_coloured(ex: PlanarExample, eps, x0, T, *, n_paths, rng, h=N
     ``exp(...)`` is the exact log-ODE step of the linear fields on the step's level-2 data of ``B^ε``
     (increment ``X``, Lévy area ``L``). Default grid step ``h = ε²/(2‖A‖)``.
     """
+    _check_example(ex)
     rng = check_rng(rng)
     x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
     nrm = float(np.linalg.norm(ex.A, 2))

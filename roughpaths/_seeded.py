@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 from .driver import Driver
-from .validation import as_float_array, check_batch_shape, check_positive_int, check_times
+from .validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_times
 
 
 def check_seed(seed) -> np.random.SeedSequence:
@@ -41,6 +41,7 @@ def grid(times, dt, n_steps, t0):
     if dt is None or n_steps is None:
         raise ValueError("the grid is missing: pass times=<increasing array> or dt=<step> and n_steps=<int>.")
     n = check_positive_int(n_steps, "n_steps")
+    check_memory(8.0 * 2 * (n + 1), f"the time grid (n_steps={n})", "use fewer steps")
     if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
         raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
                          f"non-uniform grid.")
@@ -63,6 +64,8 @@ class SeededDriver(Driver):
         self.times, self._h = grid(times, dt, n_steps, t0)
         self.times.setflags(write=False)
         self.batch_shape = check_batch_shape(batch_shape)
+        check_memory(8.0 * 4 * (self.dim + self.dim * self.dim), f"one step of one path in dim={self.dim}",
+                     "use a smaller dim")
         self.block_bytes = check_positive_int(block_bytes, "block_bytes")
         self._paths = None                   # None: all paths 0..n-1 (nothing allocated before blocks())
 

@@ -243,7 +243,7 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     dim = check_positive_int(dim, "dim")
     batch_shape = _check_batch_shape(batch_shape)
     check_memory(8.0 * 3 * float(np.prod(batch_shape, dtype=float)) * n_steps * (dim + dim * dim),
-                 f"the increments and areas ({batch_shape} paths x {n_steps} steps x d={dim})",
+                 f"the increments and areas ({batch_shape} paths x n_steps={n_steps} x dim={dim})",
                  "sample fewer steps or paths at a time (BrownianDriver(...).blocks() streams them)")
     h = _check_dt(dt, n_steps)
     drv = BrownianDriver(dim, seed=seed, times=np.concatenate([[0.0], np.cumsum(h)]), batch_shape=batch_shape,

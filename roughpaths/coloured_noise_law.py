@@ -335,7 +335,7 @@ def lift_area_rate(A, D, substep, *, hermite: bool = True):
     ndarray, shape ``(n, n)``
     """
     A, D = _check_AD(A, D)
-    delta = float(substep)
+    delta = check_positive_real(substep, "substep")
     if not math.isfinite(delta) or delta <= 0:
         raise ValueError(f"substep must be > 0 (fast time units, sub-step / eps**2), got {substep!r}.")
     n = A.shape[0]

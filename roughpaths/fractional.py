@@ -52,7 +52,8 @@ import scipy.linalg
 from .rough_path import RoughPath
 from .rough_path_n import RoughPathN
 from .signature import signature
-from .validation import as_float_array, check_memory, check_positive_int, check_times
+from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
+                         check_times)
 
 __all__ = ["fbm", "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift"]
 
@@ -173,12 +174,8 @@ def fbm(n_steps: int, hurst, *, rng, T: float = 1.0, dim: int = 1, batch_shape=(
     H = _check_hurst(hurst)
     K = check_positive_int(n_steps, "n_steps")
     d = check_positive_int(dim, "dim")
-    T = float(T)
-    if not np.isfinite(T) or T <= 0:
-        raise ValueError(f"T must be a positive finite number, got {T!r}.")
-    if isinstance(batch_shape, numbers.Integral):
-        batch_shape = (int(batch_shape),)
-    batch_shape = tuple(check_positive_int(b, "batch_shape entry") for b in batch_shape)
+    T = check_positive_real(T, "T")
+    batch_shape = check_batch_shape(batch_shape)
     if method not in ("auto", "davies-harte", "cholesky"):
         raise ValueError(f"method must be 'auto', 'davies-harte' or 'cholesky', got {method!r}.")
     rng = _rng(rng)

@@ -20,6 +20,7 @@ __all__ = [
     "check_rng",
     "check_positive_int",
     "check_positive_real",
+    "check_real",
     "check_batch_shape",
     "check_same_batch",
     "check_memory",
@@ -154,6 +155,19 @@ def check_positive_real(value, name: str, *, allow_zero: bool = False) -> float:
     bound = ">= 0" if allow_zero else "> 0"
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         raise ValueError(f"{name} must be a finite number {bound}, got {value!r}.")
+    return v
+
+
+def check_real(value, name: str) -> float:
+    """Check a finite real scalar of any sign (bools, strings, complex and arrays rejected)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+            value = value.item()
+        else:
+            raise TypeError(f"{name} must be a real number, got {_describe(value)}; pass a float.")
+    v = float(value)
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}.")
     return v
 
 
