@@ -379,9 +379,9 @@ def _coloured_grid(eps, T, h, nrm, n_paths):
     eps = check_positive_real(eps, "eps")
     T = check_positive_real(T, "T")
     h = eps ** 2 / (2.0 * nrm) if h is None else check_positive_real(h, "h")
-    steps = T / h
+    steps = max(1.0, T / h)
     check_work(steps * n_paths, f"T={T:.3g} with step h={h:.3g} (eps={eps:.3g}) is {steps:.3g} steps for "
-               f"{n_paths} path(s)", "use a larger eps, a larger h or a shorter T")
+               f"n_paths={n_paths}", "use fewer paths, a larger eps, a larger h or a shorter T")
     n_steps = max(1, int(round(steps)))
     return n_steps, T / n_steps
 
@@ -505,6 +505,7 @@ def simulate_planar_coloured(ex: PlanarExample, eps, x0, T, *, n_paths, rng, h=N
     nrm = float(np.linalg.norm(ex.A, 2))
     n_paths = check_positive_int(n_paths, "n_paths")
     n_steps, h = _coloured_grid(eps, T, h, nrm, n_paths)
+    check_memory(8.0 * 16 * n_paths, f"the states of n_paths={n_paths} paths", "use fewer paths")
     x = np.tile(x0, (n_paths, 1))
     eq = np.exp(np.array([ex.lam, ex.mu]) * h / 2)
     for inc, area, _, _, _ in iter_coloured_noise(ex.A, ex.D, eps, h, n_steps, rng=rng, n_paths=n_paths,

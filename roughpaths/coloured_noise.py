@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
-                         check_rng, check_times)
+                         check_rng, check_times, check_work)
 from .rough_path import RoughPath
 from ._random import PathStreams
 from ._seeded import SeededDriver
@@ -125,6 +125,9 @@ def _resolve_substeps(A, eps, h, substeps, max_substep, *, n_paths=1, n_steps=1)
                      "area is then biased, see lift_area_rate)")
         return max(1, int(math.ceil(want)))
     m = check_positive_int(substeps, "substeps")
+    n = A.shape[0]
+    check_memory(8.0 * n * (n + 2) * m * n_paths, f"substeps={m} sub-steps per step for {n_paths} path(s)",
+                 "pass fewer substeps (substeps=None resolves eps**2 with the fewest)")
     ratio = h / (m * eps ** 2)
     if ratio * nrm > max_substep * (1 + 1e-12):
         warnings.warn(
@@ -302,6 +305,7 @@ def iter_coloured_noise(A, D, eps, h, n_steps, *, rng, n_paths=1, y0="stationary
     P = check_positive_int(n_paths, "n_paths")
     lim = coloured_noise_limit(A, D)
     n, m = D.shape
+    check_memory(8.0 * 4 * P * (n + m) * (n + m), f"the state of n_paths={P} paths", "use fewer paths")
     if isinstance(y0, str):
         if y0 != "stationary":
             raise ValueError(f"y0 must be 'stationary' or an array of shape (n_paths, {n}), got {y0!r}.")
@@ -309,6 +313,8 @@ def iter_coloured_noise(A, D, eps, h, n_steps, *, rng, n_paths=1, y0="stationary
     else:
         y = np.array(np.broadcast_to(as_float_array(y0, "y0", last_dims=(n,)), (P, n)))
     msub = _resolve_substeps(A, eps, h, substeps, max_substep, n_paths=P)
+    check_work(float(P) * n_steps * msub, f"n_paths={P} x n_steps={n_steps} x {msub} sub-steps",
+               "use fewer paths or steps (or a larger eps)")
     Phi, L = _substep_factor(A, D, h / (msub * eps ** 2))
     delta = h / (msub * eps ** 2)
     Ainv = np.linalg.inv(A)

@@ -11,7 +11,8 @@ process pool) either
 
 and never another exception type, a NaN result, or a hang: anything sized by user input is
 estimated and refused before work starts (the test runs every call under ``ROUGHPATHS_MAX_BYTES``
-= 1 GiB and a 20 s alarm).
+= 1 GiB, ``ROUGHPATHS_MAX_WORK`` = 1e8 path-steps and a 20 s alarm, so a request that is refused only
+after it starts shows up as a MemoryError or a hang).
 
 Inputs tried in one default run (``-s`` prints the table; ``@slow`` runs ten times as many):
 see ``test_zz_summary_of_inputs_tried``, which asserts at least 200 bad inputs were tried and
@@ -399,6 +400,7 @@ def bad_calls(draw, targets):
 @pytest.fixture(autouse=True)
 def _memory_budget(monkeypatch):
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(2 ** 30))
+    monkeypatch.setenv("ROUGHPATHS_MAX_WORK", "1e8")
 
 
 _FAST = settings(max_examples=300, deadline=None, derandomize=True, database=None,

@@ -122,8 +122,8 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
         n_paths = mu0.shape[0] if mu0.ndim == 2 else 1
     n_paths = check_positive_int(n_paths, "n_paths")
     n_saved = n_steps // save_every + 1
-    check_memory(8.0 * n_paths * (n_saved + 2) * system.dim, f"the saved states ({n_paths} paths x {n_saved} "
-                 f"times x {system.dim})", "save fewer times (a larger save_every) or use fewer paths")
+    check_memory(8.0 * n_paths * (n_saved + 2) * system.dim, f"the saved states (n_paths={n_paths} x (n_steps/save_every + 1) "
+                 f"= {n_saved} times x {system.dim})", "save fewer times (a larger save_every) or use fewer paths")
     check_work(float(n_paths) * n_steps * area_substeps, f"simulate_brownian with n_paths={n_paths}, "
                f"n_steps={n_steps} and area_substeps={area_substeps}", "use fewer paths, steps or sub-steps")
     mu0 = np.array(np.broadcast_to(mu0, (n_paths, system.dim)))
