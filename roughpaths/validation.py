@@ -44,7 +44,8 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     Parameters
     ----------
     x : array_like
-        Real numbers (bool, integer or float); complex and object arrays are rejected.
+        Real numbers (integer or float; bool arrays count as 0/1, a lone bool is rejected); complex and
+        object arrays are rejected.
     name : str
         The argument's name, used in error messages.
     min_ndim, ndim : int, optional
@@ -57,6 +58,9 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     if isinstance(x, (str, bytes)) or x is None:
         raise TypeError(f"{name} must be an array of real numbers, got {_describe(x)}; "
                         f"pass a numpy array (or nested lists) of floats.")
+    if isinstance(x, (bool, np.bool_)):          # a lone True/False is a flag passed in the wrong place
+        raise TypeError(f"{name} must be a real number or an array of them, got the bool {x!r}; "
+                        f"pass a float.")
     try:
         arr = np.asarray(x)
     except Exception as exc:  # pragma: no cover - exotic inputs
