@@ -41,7 +41,9 @@ def grid(times, dt, n_steps, t0):
     if dt is None or n_steps is None:
         raise ValueError("the grid is missing: pass times=<increasing array> or dt=<step> and n_steps=<int>.")
     n = check_positive_int(n_steps, "n_steps")
-    check_memory(8.0 * 2 * (n + 1), f"the time grid (n_steps={n})", "use fewer steps")
+    # the grid is built eagerly; refuse what can never fit (physical memory, or ROUGHPATHS_MAX_BYTES if set)
+    check_memory(8.0 * 2 * (n + 1), f"the time grid (n_steps={n})", "use fewer steps",
+                 max_bytes=None if os.environ.get("ROUGHPATHS_MAX_BYTES") else phys_bytes())
     if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
         raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
                          f"non-uniform grid.")

@@ -414,9 +414,9 @@ class BrownianDriver(SeededDriver):
         self.kind = _check_kind(kind)
         self.level = 1 if self.levy_area is None else 2
         self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
-        check_memory(4.0 * self.n_paths * self._bytes_per_path_step(),
-                     f"one step of {self.n_paths} path(s) with dim={self.dim}, substeps={self.substeps} and "
-                     f"levy_area={self.levy_area!r}", "use fewer substeps or paths")
+        check_memory(4.0 * self._bytes_per_path_step(),        # paths are selected lazily: one path's step
+                     f"one step of one path with dim={self.dim}, substeps={self.substeps} and "
+                     f"levy_area={self.levy_area!r}", "use fewer substeps")
 
     def _starts(self) -> dict:
         return {"_x0": self.dim}

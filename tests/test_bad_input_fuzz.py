@@ -14,9 +14,14 @@ estimated and refused before work starts (the test runs every call under ``ROUGH
 = 1 GiB, ``ROUGHPATHS_MAX_WORK`` = 1e8 path-steps and a 20 s alarm, so a request that is refused only
 after it starts shows up as a MemoryError or a hang).
 
-Inputs tried in one default run (``-s`` prints the table; ``@slow`` runs ten times as many):
-see ``test_zz_summary_of_inputs_tried``, which asserts at least 200 bad inputs were tried and
-reports the counts by kind (e.g. non-integer count, NaN, string, wrong shape, huge size, ...).
+Inputs tried in one default run (``-s`` prints the table in ``test_zz_summary_of_inputs_tried``,
+which asserts at least 200): 619 = 600 drawn (300 per package, 61 targets) + the issue's 19 examples.
+By kind: string 114, complex 61, wrong shape 60, inf 58, foreign object 53, None 51, NaN 37, object
+array 33, negative 25, huge size 24, empty 21, bool 20, non-integer float 19, zero 17, a class or
+another wrong type 11, a plain number where an object is expected 6, callables returning scalars /
+wrong shapes / NaN 6, lambdas sent to a process pool 2, an option given as a number 1. Outcome: 614
+refused with a ValueError/TypeError naming the argument, 5 accepted as valid odd input (finite
+results). The ``slow`` run draws 3000 more (3388 in all when measured).
 """
 
 from __future__ import annotations
