@@ -40,7 +40,7 @@ from typing import Callable
 import numpy as np
 
 from roughpaths import BrownianDriver, register_format, solve
-from roughpaths.validation import as_float_array, check_positive_int
+from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real, check_work
 
 from .statistics import (
     LeafReducer,
@@ -64,7 +64,9 @@ def path_generator(seed: int, index: int) -> np.random.Generator:
     warnings.warn("path_generator is deprecated: run_ensemble draws its paths from roughpaths.BrownianDriver "
                   "(path i is BrownianDriver(..., seed=seed, batch_shape=(n_paths,)).select([i])).",
                   DeprecationWarning, stacklevel=2)
-    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(int(index),))))
+    seed = check_positive_int(seed, "seed", minimum=0)
+    index = check_positive_int(index, "index", minimum=0)
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(index,))))
 
 
 # ------------------------------------------------------------------------------ results
@@ -172,6 +174,61 @@ class _Spec:
 
 def _observe(observable, x):
     return np.asarray(observable(x), dtype=np.float64)
+
+
+def _check_observable(observable, mu0, n):
+    """Evaluate ``observable`` on the initial state (shapes ``(1, n)`` and ``(1, 1, n)``) before any
+    work starts: it must return finite arrays of shape ``(1, p)`` and ``(1, 1, p)``; returns ``p``."""
+    x = np.array(np.broadcast_to(mu0, (1, n)), dtype=np.float64)
+    outs = []
+    for probe in (x, x[:, None]):
+        try:
+            v = np.asarray(observable(probe.copy()))
+        except Exception as exc:
+            raise ValueError(f"observable raised {type(exc).__name__}: {exc} when called on the initial state "
+                             f"of shape {probe.shape}; it must map (..., {n}) -> (..., p).") from exc
+        if v.dtype.kind not in "biuf":
+            raise TypeError(f"observable must return real numbers, got an array of dtype {v.dtype} for input "
+                            f"of shape {probe.shape}.")
+        if v.ndim != probe.ndim or v.shape[:-1] != probe.shape[:-1] or v.shape[-1] < 1:
+            raise ValueError(f"observable must map (..., {n}) -> (..., p) keeping the leading axes, but for "
+                             f"input of shape {probe.shape} it returned shape {v.shape}; e.g. return "
+                             f"x[..., :1] rather than a scalar.")
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"observable returned non-finite values on the initial state {x[0]!r}.")
+        outs.append(v.shape[-1])
+    if outs[0] != outs[1]:
+        raise ValueError(f"observable returned {outs[0]} values per state for input (1, {n}) but {outs[1]} for "
+                         f"(1, 1, {n}); it must act on the last axis only.")
+    return outs[0]
+
+
+def _check_picklable(spec, executor):
+    """A process or cluster executor pickles each task: refuse an unpicklable one (e.g. a lambda
+    observable with a ProcessPoolExecutor) before any work is submitted."""
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+
+    if isinstance(executor, ThreadPoolExecutor):
+        return
+    try:
+        pickle.dumps(spec)
+        return
+    except Exception as exc:
+        error = exc
+    if not isinstance(executor, ProcessPoolExecutor):
+        try:                                   # cluster executors (dask) pickle with cloudpickle
+            import cloudpickle
+
+            cloudpickle.dumps(spec)
+            return
+        except ImportError:
+            pass
+        except Exception as exc:
+            error = exc
+    raise TypeError(f"executor {type(executor).__name__} must pickle each task, but the system or observable "
+                    f"cannot be pickled ({type(error).__name__}: {error}); use a module-level function "
+                    f"(not a lambda or a local function) as observable, or executor=None / a ThreadPoolExecutor.")
 
 
 def _run_chunk(spec: _Spec, first: int, last: int):
@@ -284,10 +341,11 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
                                              else "."))
     n = system.dim
     mu0 = as_float_array(mu0, "mu0", last_dims=(n,))
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating)) or not np.isfinite(dt) or dt <= 0:
-        raise ValueError(f"dt must be a positive finite number, got {dt!r}.")
+    dt = check_positive_real(dt, "dt")
     n_steps = check_positive_int(n_steps, "n_steps")
     n_paths = check_positive_int(n_paths, "n_paths")
+    check_work(float(n_paths) * float(n_steps), f"run_ensemble with n_paths={n_paths} and n_steps={n_steps}",
+               "use fewer paths or steps (or raise ROUGHPATHS_MAX_WORK)")
     if mu0.ndim not in (1, 2) or (mu0.ndim == 2 and mu0.shape[0] != n_paths):
         raise ValueError(f"mu0 must have shape ({n},) or (n_paths, {n}) = ({n_paths}, {n}), got {mu0.shape}.")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
@@ -307,6 +365,14 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         block_steps = check_positive_int(block_steps, "block_steps")
     if executor is not None and not hasattr(executor, "submit"):
         raise TypeError(f"executor must be a concurrent.futures.Executor (with .submit), got {executor!r}.")
+    p = _check_observable(observable, mu0[:1] if mu0.ndim == 2 else mu0, n)
+    if record_every is not None:
+        n_snap = n_steps // record_every + 1
+        check_memory(8.0 * n_snap * (p + p * p) * 3, f"the snapshot statistics ({n_snap} snapshots of {p} "
+                     f"observables)", "record fewer snapshots (a larger record_every)")
+    if keep_final:
+        check_memory(8.0 * n_paths * n, f"the final states ({n_paths} paths x {n})",
+                     "use keep_final=False or fewer paths")
     if method.levy_area != (levy_area is not None):                 # the driving level follows levy_area
         method = copy.copy(method)
         method.levy_area = levy_area is not None
@@ -316,6 +382,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     spec = _Spec(system=system, mu0=mu0, driver=driver, method=method, block_steps=block_steps, burn_in=burn_in,
                  average_every=average_every, record_every=record_every, observable=observable,
                  keep_final=bool(keep_final))
+    if executor is not None:
+        _check_picklable(spec, executor)
     bounds = [(a, min(a + chunk_size, n_paths)) for a in range(0, n_paths, chunk_size)]
     if executor is None:
         parts = (_run_chunk(spec, a, b) for a, b in bounds)

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from roughpaths.validation import as_float_array, check_antisymmetric
+from roughpaths.validation import as_float_array, check_antisymmetric, check_positive_real, check_real
 
 from .lie_poisson import check_inertia, levy_velocity
 
@@ -418,12 +418,13 @@ def lagrange_top_sleeping_stability(I1, I3, omega3, mgl):
     >>> lagrange_top_sleeping_stability(1.0, 2.0, 2.0, 1.0)["stable"]
     True
     """
-    I1 = float(I1)
-    I3 = float(I3)
-    if not (I1 > 0 and I3 > 0):
-        raise ValueError(f"I1 and I3 must be > 0, got I1={I1!r}, I3={I3!r}.")
-    p3 = I3 * float(omega3)
-    margin = p3 * p3 - 4.0 * I1 * float(mgl)
+    I1 = check_positive_real(I1, "I1")
+    I3 = check_positive_real(I3, "I3")
+    p3 = I3 * check_real(omega3, "omega3")
+    margin = p3 * p3 - 4.0 * I1 * check_real(mgl, "mgl")
+    if not np.isfinite(margin):
+        raise ValueError(f"the margin (I3*omega3)**2 - 4*I1*mgl overflows for I1={I1!r}, I3={I3!r}, "
+                         f"omega3={omega3!r}, mgl={mgl!r}; rescale the units.")
     lam = np.sqrt(complex(-margin)) / (2.0 * I1)
     return {"stable": bool(margin > 0), "margin": margin,
             "eigenvalues": np.array([lam, lam, -lam, -lam, 0.0, 0.0], dtype=complex)}

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from roughpaths.validation import as_float_array, check_positive_int, check_rng
+from roughpaths.validation import as_float_array, check_positive_int, check_positive_real, check_rng
 
 from .equilibria import _modified_hamiltonian, _as_c, _check_radius, _tangent_basis, as_inverse_inertia, rigid_body_equilibria
 
@@ -130,9 +130,7 @@ class GibbsMeasure:
             if b < 0:
                 raise ValueError(f"beta must be >= 0 (beta = 2*theta/sigma**2), got {b!r}.")
             self.beta = b
-        self.rtol = float(rtol)
-        if not self.rtol > 0:
-            raise ValueError(f"rtol must be > 0, got {rtol!r}.")
+        self.rtol = check_positive_real(rtol, "rtol")
         self.max_nodes = check_positive_int(max_nodes, "max_nodes")
         self.equilibria = rigid_body_equilibria(np.linalg.inv(self._A), self._c, radius=self.radius)
         mins = [e for e in self.equilibria if e.kind in ("minimum", "degenerate")]

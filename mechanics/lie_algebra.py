@@ -36,7 +36,7 @@ __all__ = ["LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r"
 
 def hat(x) -> np.ndarray:
     """Skew matrix of ``x`` (shape ``(..., 3)`` → ``(..., 3, 3)``): ``hat(x) @ y == cross(x, y)``."""
-    x = np.asarray(x, dtype=np.float64)
+    x = as_float_array(x, "x", last_dims=(3,))
     z = np.zeros(x.shape[:-1])
     return np.stack([np.stack([z, -x[..., 2], x[..., 1]], -1),
                      np.stack([x[..., 2], z, -x[..., 0]], -1),
@@ -45,7 +45,7 @@ def hat(x) -> np.ndarray:
 
 def vee(m) -> np.ndarray:
     """Inverse of :func:`hat` (reads the antisymmetric part), shape ``(..., 3, 3)`` → ``(..., 3)``."""
-    m = np.asarray(m, dtype=np.float64)
+    m = as_float_array(m, "m", last_dims=(3, 3))
     return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
                            m[..., 1, 0] - m[..., 0, 1]], -1)
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from roughpaths.validation import as_float_array
+from roughpaths.validation import as_float_array, check_memory, check_positive_int
 
 from .equilibria import _as_c, _check_radius, as_inverse_inertia, rigid_body_equilibria
 
@@ -76,6 +76,19 @@ def _join_polylines(lines, tol):
     return out
 
 
+#: At most this many levels per call: each level is a contour pass over the whole grid (10⁶ levels
+#: took about 20 minutes), and a phase portrait with more curves is unreadable anyway.
+MAX_LEVELS = 10_000
+
+
+def _check_level_count(n: int) -> int:
+    if n > MAX_LEVELS:
+        raise ValueError(f"levels asks for {n} level curves, more than MAX_LEVELS = {MAX_LEVELS} (each is a "
+                         f"contour pass over the n_theta x n_phi grid; 10**6 levels take ~20 minutes); "
+                         f"ask for fewer levels.")
+    return n
+
+
 def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_separatrices=True,
                           n_theta=181, n_phi=361, theta=0.0, project=True):
     r"""Level curves of ``h̃ = ½Π·𝕀⁻¹Π + c·Π`` on the sphere ``|Π| = r``, with the equilibria.
@@ -123,13 +136,12 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
     r = _check_radius(radius)
     eqs = rigid_body_equilibria(np.linalg.inv(A), c, radius=r, theta=theta)
     emin, emax = eqs[0].energy, eqs[-1].energy
-    if np.ndim(levels) == 0:
-        n = int(levels)
-        if n < 1:
-            raise ValueError(f"levels must be a positive number of levels or an array of values, got {levels!r}.")
-        lv = list(np.linspace(emin, emax, n + 2)[1:-1])
+    if np.ndim(levels) == 0 and not isinstance(levels, (str, bytes)):
+        n = check_positive_int(levels, "levels")
+        lv = list(np.linspace(emin, emax, _check_level_count(n) + 2)[1:-1])
     else:
         lv = list(as_float_array(levels, "levels", ndim=1))
+        _check_level_count(len(lv))
     sep = [False] * len(lv)
     if include_separatrices:
         for e in eqs:
@@ -140,6 +152,10 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
     lv = np.array(lv)[order]
     sep = np.array(sep)[order]
 
+    n_theta = check_positive_int(n_theta, "n_theta", minimum=3)
+    n_phi = check_positive_int(n_phi, "n_phi", minimum=3)
+    check_memory(8.0 * 12 * n_theta * n_phi, f"the contour grid (n_theta={n_theta} x n_phi={n_phi})",
+                 "use a coarser grid (the defaults 181 x 361 resolve curves to ~1e-5 after projection)")
     th = np.linspace(0.0, np.pi, n_theta)
     ph = np.linspace(-np.pi, np.pi, n_phi)
     TH, PH = np.meshgrid(th, ph, indexing="ij")

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from roughpaths.validation import as_float_array
+from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real
 
 from .lie_algebra import so3
 from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
@@ -32,12 +32,10 @@ __all__ = ["RigidBody", "rigid_body", "isotropic_xi"]
 
 def isotropic_xi(sigma, dim: int = 3) -> np.ndarray:
     r"""Isotropic SALT noise :math:`\xi_i = \sigma e_i`, shape ``(dim, dim)``."""
-    if isinstance(sigma, bool) or not np.isscalar(sigma) or not np.isfinite(sigma):
-        raise ValueError(f"sigma must be a finite real number (the noise amplitude), got {sigma!r}.")
-    if sigma < 0:
-        raise ValueError(f"sigma must be >= 0 (the noise amplitude; the sign of xi_i = sigma e_i is "
-                         f"irrelevant in law), got {sigma!r}.")
-    return float(sigma) * np.eye(dim)
+    sigma = check_positive_real(sigma, "sigma", allow_zero=True)
+    dim = check_positive_int(dim, "dim")
+    check_memory(8.0 * dim * dim, f"the noise vectors (dim={dim} x dim)", "use a smaller dim")
+    return sigma * np.eye(dim)
 
 
 def _noise_vectors(xi, sigma, dim):

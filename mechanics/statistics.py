@@ -12,7 +12,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from roughpaths.validation import check_positive_int
+from roughpaths.validation import as_float_array, check_memory, check_positive_int
 
 __all__ = ["RunningMoments", "moment_observable", "split_moment_features", "LeafReducer", "LEAF"]
 
@@ -41,13 +41,15 @@ class RunningMoments:
 
     def __init__(self, dim: int):
         self.dim = check_positive_int(dim, "dim")
+        check_memory(8.0 * self.dim * (self.dim + 1), f"the mean and scatter matrix (dim={self.dim})",
+                     "use fewer observables")
         self.count = 0
         self.mean = np.zeros(self.dim)
         self.scatter = np.zeros((self.dim, self.dim))
 
     def update(self, x) -> "RunningMoments":
         """Add the rows of ``x`` (shape ``(k, p)`` or ``(p,)``); returns ``self``."""
-        x = np.asarray(x, dtype=np.float64)
+        x = as_float_array(x, "x")
         if x.ndim == 1:
             x = x[None]
         if x.ndim != 2 or x.shape[1] != self.dim:
@@ -64,8 +66,11 @@ class RunningMoments:
 
     def merge(self, other: "RunningMoments") -> "RunningMoments":
         """Merge ``other`` into ``self`` (Chan et al.); returns ``self``."""
-        if not isinstance(other, RunningMoments) or other.dim != self.dim:
-            raise ValueError(f"can only merge a RunningMoments of dimension {self.dim}.")
+        if not isinstance(other, RunningMoments):
+            raise TypeError(f"other must be a RunningMoments, got {type(other).__name__}.")
+        if other.dim != self.dim:
+            raise ValueError(f"other has dimension {other.dim}; can only merge a RunningMoments of "
+                             f"dimension {self.dim}.")
         if other.count == 0:
             return self
         if self.count == 0:

@@ -53,7 +53,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from roughpaths.validation import as_float_array, check_positive_int, check_rng
+from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_real, check_rng,
+                                   check_work)
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
 
@@ -138,9 +139,7 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
     if lim.A.shape[0] != 3:
         raise ValueError(f"the rigid body needs 3-dimensional coloured noise (A of shape (3, 3)), got "
                          f"A of shape {lim.A.shape}.")
-    sg = float(sigma)
-    if not math.isfinite(sg) or sg < 0:
-        raise ValueError(f"sigma must be a finite number >= 0, got {sigma!r}.")
+    sg = check_positive_real(sigma, "sigma", allow_zero=True)
     cxi = sg * np.eye(3)
     lxi = (sg * lim.scaling).T.copy()
     c = levy_velocity(lim.levy_perturbation, cxi)
@@ -309,16 +308,23 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     wz = rigid_body_wong_zakai_limit(A, D, sigma)
     rng = check_rng(rng)
     known = ("coloured", "limit", "no_torque", "srblevy")
+    if isinstance(systems, str):
+        raise TypeError(f"systems must be a tuple of system names, got the string {systems!r}; pass "
+                        f"systems=({systems!r},).")
+    try:
+        systems = tuple(systems)
+    except TypeError:
+        raise TypeError(f"systems must be a tuple of names from {known}, got {systems!r}.") from None
     for name in systems:
         if name not in known:
-            raise ValueError(f"unknown system {name!r}; choose from {known}.")
+            raise ValueError(f"systems: unknown system {name!r}; choose from {known}.")
     nrm = float(np.linalg.norm(wz.limit.A, 2))
-    if h is None:
-        h = eps ** 2 / (2.0 * nrm)
-    n_steps = max(1, int(round(T / h)))
-    h = T / n_steps
-    save_every = check_positive_int(save_every, "save_every")
     n_paths = check_positive_int(n_paths, "n_paths")
+    n_steps, h = _coloured_grid(eps, T, h, nrm, n_paths)
+    save_every = check_positive_int(save_every, "save_every")
+    check_memory(8.0 * 3 * n_paths * (n_steps // save_every + 1) * (len(systems) + 1),
+                 f"the saved states ({len(systems)} system(s) x {n_paths} paths x {n_steps // save_every + 1} "
+                 f"times x 3)", "save fewer times (a larger save_every) or use fewer paths")
     method = _check_method(method)
     inertia = _check_inertia3(inertia)
     P0 = as_float_array(Pi0, "Pi0", ndim=1, last_dims=(3,))
@@ -365,6 +371,19 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     res.update(out)
     res["final"] = state
     return res
+
+
+def _coloured_grid(eps, T, h, nrm, n_paths):
+    """Check ``eps``, ``T``, ``h`` and return ``(n_steps, h)``, refusing an ε-driven step count
+    (``T/h`` with the default ``h = ε²/(2‖A‖)``) that would run for ever."""
+    eps = check_positive_real(eps, "eps")
+    T = check_positive_real(T, "T")
+    h = eps ** 2 / (2.0 * nrm) if h is None else check_positive_real(h, "h")
+    steps = max(1.0, T / h)
+    check_work(steps * n_paths, f"T={T:.3g} with step h={h:.3g} (eps={eps:.3g}) is {steps:.3g} steps for "
+               f"n_paths={n_paths}", "use fewer paths, a larger eps, a larger h or a shorter T")
+    n_steps = max(1, int(round(steps)))
+    return n_steps, T / n_steps
 
 
 # -------------------------------------------------------------------------------- planar example
@@ -416,10 +435,7 @@ def planar_example(alpha=1.0, gamma=1.0, delta=1.0, lam=0.0, mu=0.0) -> PlanarEx
     """
     vals = []
     for name, v in (("alpha", alpha), ("gamma", gamma), ("delta", delta), ("lam", lam), ("mu", mu)):
-        f = float(v)
-        if not math.isfinite(f):
-            raise ValueError(f"{name} must be finite, got {v!r}.")
-        vals.append(f)
+        vals.append(check_real(v, name))
     alpha, gamma, delta, lam, mu = vals
     if alpha <= 0 or delta <= 0:
         raise ValueError(f"alpha and delta must be > 0 (alpha is the OU damping, delta the noise variance), "
@@ -437,6 +453,11 @@ def planar_example(alpha=1.0, gamma=1.0, delta=1.0, lam=0.0, mu=0.0) -> PlanarEx
                          drift=np.diag([lam, mu]) + N12 * S, noise_matrices=E)
 
 
+def _check_example(ex):
+    if not isinstance(ex, PlanarExample):
+        raise TypeError(f"ex must be a PlanarExample (from planar_example(...)), got {type(ex).__name__}.")
+
+
 def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
     r"""Exact ``E[X_T]`` and ``E[X_T X_Tᵀ]`` of the limit ``dX = (Q + N12 S)X dt + Σ_k G_k X∘dB^k``.
 
@@ -444,7 +465,9 @@ def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
     ``E[X_T] = e^{BT}x0``; ``vec E[XXᵀ]`` solves ``d/dt vec P = (I⊗B + B⊗I + Σ_k G_k⊗G_k) vec P``.
     ``torque=False`` drops ``N12 S`` (the plain Stratonovich guess).
     """
+    _check_example(ex)
     x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
+    T = check_positive_real(T, "T", allow_zero=True)
     M = ex.limit.scaling
     G = np.einsum("ik,iab->kab", M, ex.noise_matrices)
     B = (ex.drift if torque else np.diag([ex.lam, ex.mu])) + 0.5 * np.einsum("kab,kbc->ac", G, G)
@@ -476,14 +499,13 @@ def simulate_planar_coloured(ex: PlanarExample, eps, x0, T, *, n_paths, rng, h=N
     ``exp(...)`` is the exact log-ODE step of the linear fields on the step's level-2 data of ``B^ε``
     (increment ``X``, Lévy area ``L``). Default grid step ``h = ε²/(2‖A‖)``.
     """
+    _check_example(ex)
     rng = check_rng(rng)
     x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
     nrm = float(np.linalg.norm(ex.A, 2))
-    if h is None:
-        h = eps ** 2 / (2.0 * nrm)
-    n_steps = max(1, int(round(T / h)))
-    h = T / n_steps
     n_paths = check_positive_int(n_paths, "n_paths")
+    n_steps, h = _coloured_grid(eps, T, h, nrm, n_paths)
+    check_memory(8.0 * 16 * n_paths, f"the states of n_paths={n_paths} paths", "use fewer paths")
     x = np.tile(x0, (n_paths, 1))
     eq = np.exp(np.array([ex.lam, ex.mu]) * h / 2)
     for inc, area, _, _, _ in iter_coloured_noise(ex.A, ex.D, eps, h, n_steps, rng=rng, n_paths=n_paths,

@@ -20,6 +20,8 @@ from math import factorial
 import numba
 import numpy as np
 
+from .validation import as_float_array
+
 __all__ = ["expm_batched", "matvec", "vecmat"]
 
 # (degree m, largest 1-norm for which the degree-m diagonal Padé approximant has backward error
@@ -90,14 +92,14 @@ def expm_batched(A) -> np.ndarray:
     >>> bool(np.array_equal(pair[0], expm_batched(B))), bool(np.isnan(pair[1]).all())
     (True, True)
     """
-    A = np.asarray(A, dtype=np.float64)
+    A = as_float_array(A, "A", allow_nonfinite=True)     # NaN members: documented NaN result, see above
     if A.ndim < 2 or A.shape[-1] != A.shape[-2]:
         raise ValueError(f"A must have shape (..., n, n) (a batch of square matrices), got shape {A.shape}.")
     shape, n = A.shape, A.shape[-1]
+    if A.size == 0:                          # no members, or 0 x 0 matrices: nothing to exponentiate
+        return np.broadcast_to(np.eye(n), shape).copy()
     flat = A.reshape(-1, n, n)
     out = np.full(flat.shape, np.nan)
-    if flat.shape[0] == 0 or n == 0:
-        return np.broadcast_to(np.eye(n), shape).copy()
     with np.errstate(over="ignore", invalid="ignore"):
         norms = np.max(np.sum(np.abs(flat), axis=-2), axis=-1)
     finite = np.isfinite(norms)

@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 from .driver import Driver
-from .validation import as_float_array, check_positive_int, check_times
+from .validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_times
 
 
 def check_seed(seed) -> np.random.SeedSequence:
@@ -31,20 +31,6 @@ def check_seed(seed) -> np.random.SeedSequence:
     raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
 
 
-def check_batch_shape(batch_shape) -> tuple:
-    if isinstance(batch_shape, numbers.Integral) and not isinstance(batch_shape, bool):
-        batch_shape = (batch_shape,)
-    try:
-        shape = tuple(batch_shape)
-    except TypeError:
-        raise TypeError(f"batch_shape must be a tuple of integers, got {batch_shape!r}; "
-                        f"pass e.g. batch_shape=(1000,).") from None
-    for n in shape:
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
-            raise ValueError(f"batch_shape must hold non-negative integers, got {shape!r}.")
-    return tuple(int(n) for n in shape)
-
-
 def grid(times, dt, n_steps, t0):
     """``(times, h)``: the grid and its step sizes (exactly ``dt`` on a uniform grid)."""
     if times is not None:
@@ -55,6 +41,9 @@ def grid(times, dt, n_steps, t0):
     if dt is None or n_steps is None:
         raise ValueError("the grid is missing: pass times=<increasing array> or dt=<step> and n_steps=<int>.")
     n = check_positive_int(n_steps, "n_steps")
+    # the grid is built eagerly; refuse what can never fit (physical memory, or ROUGHPATHS_MAX_BYTES if set)
+    check_memory(8.0 * 2 * (n + 1), f"the time grid (n_steps={n})", "use fewer steps",
+                 max_bytes=None if os.environ.get("ROUGHPATHS_MAX_BYTES") else phys_bytes())
     if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
         raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
                          f"non-uniform grid.")
@@ -77,6 +66,8 @@ class SeededDriver(Driver):
         self.times, self._h = grid(times, dt, n_steps, t0)
         self.times.setflags(write=False)
         self.batch_shape = check_batch_shape(batch_shape)
+        check_memory(8.0 * 4 * (self.dim + self.dim * self.dim), f"one step of one path in dim={self.dim}",
+                     "use a smaller dim")
         self.block_bytes = check_positive_int(block_bytes, "block_bytes")
         self._paths = None                   # None: all paths 0..n-1 (nothing allocated before blocks())
 

@@ -95,7 +95,7 @@ import numbers
 
 import numpy as np
 
-from .validation import as_float_array, check_positive_int
+from .validation import as_float_array, check_memory, check_positive_int
 from ._brownian_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
 from .levy_area import LEVY_AREA_METHODS, block_areas, step_plan
@@ -242,6 +242,9 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     n_steps = check_positive_int(n_steps, "n_steps")
     dim = check_positive_int(dim, "dim")
     batch_shape = _check_batch_shape(batch_shape)
+    check_memory(8.0 * 3 * float(np.prod(batch_shape, dtype=float)) * n_steps * (dim + dim * dim),
+                 f"the increments and areas ({batch_shape} paths x n_steps={n_steps} x dim={dim})",
+                 "sample fewer steps or paths at a time (BrownianDriver(...).blocks() streams them)")
     h = _check_dt(dt, n_steps)
     drv = BrownianDriver(dim, seed=seed, times=np.concatenate([[0.0], np.cumsum(h)]), batch_shape=batch_shape,
                          levy_area=levy_area, substeps=substeps, kind=kind)
@@ -411,6 +414,9 @@ class BrownianDriver(SeededDriver):
         self.kind = _check_kind(kind)
         self.level = 1 if self.levy_area is None else 2
         self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
+        check_memory(4.0 * self._bytes_per_path_step(),        # paths are selected lazily: one path's step
+                     f"one step of one path with dim={self.dim}, substeps={self.substeps} and "
+                     f"levy_area={self.levy_area!r}", "use fewer substeps")
 
     def _starts(self) -> dict:
         return {"_x0": self.dim}

@@ -11,7 +11,7 @@ import numpy as np
 
 from .level2 import outer
 from .rough_path import RoughPath
-from .validation import check_positive_int, check_rng
+from .validation import check_memory, check_positive_int, check_rng
 
 __all__ = ["refine"]
 
@@ -145,6 +145,10 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     if X.level == 2 and X.kind not in ("geometric", "ito"):
         raise ValueError(f"X.kind must be 'geometric' (Stratonovich) or 'ito' to refine as Brownian "
                          f"motion, got {X.kind!r}; build X with brownian_rough_path.")
+    d = X.increments.shape[-1]
+    check_memory(8.0 * 4 * X.increments.size * m * (1 + d), f"refining {X.increments.shape[:-1]} steps by "
+                 f"factor={m} (the refined increments and areas, with temporaries)",
+                 "use a smaller factor, or refine a shorter or smaller batch of paths")
     if m == 1:
         return X
     t, h = X.times, X.dt

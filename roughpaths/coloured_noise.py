@@ -41,7 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .validation import as_float_array, check_positive_int, check_rng, check_times
+from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
+                         check_rng, check_times, check_work)
 from .rough_path import RoughPath
 from ._random import PathStreams
 from ._seeded import SeededDriver
@@ -106,12 +107,27 @@ class ColouredNoiseSample:
         return coloured_noise_limit_path(self.limit, self.brownian)
 
 
-def _resolve_substeps(A, eps, h, substeps, max_substep):
-    """Sub-steps per grid step; warn if the sub-step exceeds ``max_substep · ε²/‖A‖``."""
+def _resolve_substeps(A, eps, h, substeps, max_substep, *, n_paths=1, n_steps=1):
+    """Sub-steps per grid step; warn if the sub-step exceeds ``max_substep · ε²/‖A‖``.
+
+    The automatic count grows like ``h/ε²``: it is estimated first and refused (with the estimate)
+    when one sub-stepped block of ``n_paths`` paths would not fit the memory budget.
+    """
+    max_substep = check_positive_real(max_substep, "max_substep")
     nrm = float(np.linalg.norm(A, 2))
     if substeps is None:
-        return max(1, int(math.ceil(h * nrm / (eps ** 2 * max_substep))))
+        want = h * nrm / (eps ** 2 * max_substep)
+        n = A.shape[0]
+        check_memory(8.0 * n * (n + 2) * max(want, 1.0) * n_paths,
+                     f"resolving eps={eps:.3g} at step h={h:.3g} needs about {want:.3g} sub-steps per step "
+                     f"(h*||A||/(eps**2*max_substep)); one step of {n_paths} path(s)",
+                     "use a larger eps or a smaller step h, or pass substeps=<int> explicitly (the Lévy "
+                     "area is then biased, see lift_area_rate)")
+        return max(1, int(math.ceil(want)))
     m = check_positive_int(substeps, "substeps")
+    n = A.shape[0]
+    check_memory(8.0 * n * (n + 2) * m * n_paths, f"substeps={m} sub-steps per step for {n_paths} path(s)",
+                 "pass fewer substeps (substeps=None resolves eps**2 with the fewest)")
     ratio = h / (m * eps ** 2)
     if ratio * nrm > max_substep * (1 + 1e-12):
         warnings.warn(
@@ -170,7 +186,7 @@ def sample_coloured_noise(A, D, eps, times, *, rng, batch_shape=(), y0="stationa
     t = check_times(times)
     lim = coloured_noise_limit(A, D)
     n, m = D.shape
-    batch_shape = tuple(int(b) for b in np.atleast_1d(np.asarray(batch_shape, dtype=int))) if batch_shape != () else ()
+    batch_shape = check_batch_shape(batch_shape)
     P = int(np.prod(batch_shape)) if batch_shape else 1
     N = t.size - 1
     dts = np.diff(t)
@@ -188,7 +204,7 @@ def sample_coloured_noise(A, D, eps, times, *, rng, batch_shape=(), y0="stationa
             raise ValueError(f"y0 of shape {yv.shape} does not broadcast to batch_shape + (n,) = "
                              f"{batch_shape + (n,)}.") from None
     hmax = float(np.max(dts))
-    msub = _resolve_substeps(A, eps, hmax, substeps, max_substep)
+    msub = _resolve_substeps(A, eps, hmax, substeps, max_substep, n_paths=P)
     Ainv = np.linalg.inv(A)
     inc = np.empty((P, N, n))
     area = np.empty((P, N, n, n))
@@ -284,20 +300,21 @@ def iter_coloured_noise(A, D, eps, h, n_steps, *, rng, n_paths=1, y0="stationary
     A, D = _check_AD(A, D)
     eps = _check_eps(eps)
     rng = check_rng(rng)
-    h = float(h)
-    if not math.isfinite(h) or h <= 0:
-        raise ValueError(f"h must be a finite step > 0, got {h!r}.")
+    h = check_positive_real(h, "h")
     n_steps = check_positive_int(n_steps, "n_steps")
     P = check_positive_int(n_paths, "n_paths")
     lim = coloured_noise_limit(A, D)
     n, m = D.shape
+    check_memory(8.0 * 4 * P * (n + m) * (n + m), f"the state of n_paths={P} paths", "use fewer paths")
     if isinstance(y0, str):
         if y0 != "stationary":
             raise ValueError(f"y0 must be 'stationary' or an array of shape (n_paths, {n}), got {y0!r}.")
         y = rng.standard_normal((P, n)) @ np.linalg.cholesky(lim.Sigma).T
     else:
         y = np.array(np.broadcast_to(as_float_array(y0, "y0", last_dims=(n,)), (P, n)))
-    msub = _resolve_substeps(A, eps, h, substeps, max_substep)
+    msub = _resolve_substeps(A, eps, h, substeps, max_substep, n_paths=P)
+    check_work(float(P) * n_steps * msub, f"n_paths={P} x n_steps={n_steps} x {msub} sub-steps",
+               "use fewer paths or steps (or a larger eps)")
     Phi, L = _substep_factor(A, D, h / (msub * eps ** 2))
     delta = h / (msub * eps ** 2)
     Ainv = np.linalg.inv(A)
@@ -375,7 +392,8 @@ class ColouredNoiseDriver(SeededDriver):
         self.limit = coloured_noise_limit(A, D)
         self.level = 2
         self.noise_dim = D.shape[1]
-        self.substeps = _resolve_substeps(A, self.eps, float(self._h.max()), substeps, max_substep)
+        self.substeps = _resolve_substeps(A, self.eps, float(self._h.max()), substeps, max_substep,
+                                          n_paths=max(1, int(np.prod(self.batch_shape))))
         if isinstance(y0, str):
             if y0 != "stationary":
                 raise ValueError(f"y0 must be 'stationary' or an array of shape (..., {self.dim}), got {y0!r}.")

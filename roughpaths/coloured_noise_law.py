@@ -47,12 +47,13 @@ interpolant has Lévy area ``−x∧u/10 + x∧v/10 − u∧v/60``.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 
-from .validation import as_float_array
+from .validation import as_float_array, check_positive_real
 
 __all__ = [
     "ColouredNoiseLimit",
@@ -69,7 +70,7 @@ _K_XU, _K_XV, _K_UV = -0.1, 0.1, -1.0 / 60.0
 
 # ---------------------------------------------------------------------------------------- checks
 def _check_eps(eps) -> float:
-    if isinstance(eps, bool) or not np.isscalar(eps) or not np.isreal(eps):
+    if isinstance(eps, (bool, np.bool_)) or not isinstance(eps, numbers.Real):
         raise TypeError(f"eps must be a positive real number, got {eps!r}.")
     e = float(eps)
     if not math.isfinite(e) or e <= 0.0:
@@ -265,9 +266,7 @@ def ou_step_law(A, D, eps, h):
     """
     A, D = _check_AD(A, D)
     eps = _check_eps(eps)
-    h = float(h)
-    if not math.isfinite(h) or h <= 0:
-        raise ValueError(f"h must be a finite step > 0, got {h!r}.")
+    h = check_positive_real(h, "h")
     n, m = D.shape
     delta = h / eps ** 2
     Tm, Qf = _fast_law(A, D, delta)
@@ -313,7 +312,7 @@ def expected_area_rate(A, D, eps, window):
     eps = _check_eps(eps)
     Sigma = _lyapunov(A, D)
     AiT = np.linalg.inv(A).T
-    w = float(window)
+    w = check_positive_real(window, "window")
     return Sigma @ AiT - (eps ** 2 / w) * Sigma @ AiT @ AiT @ (np.eye(A.shape[0]) - sla.expm(-A.T * w / eps ** 2))
 
 
@@ -336,7 +335,7 @@ def lift_area_rate(A, D, substep, *, hermite: bool = True):
     ndarray, shape ``(n, n)``
     """
     A, D = _check_AD(A, D)
-    delta = float(substep)
+    delta = check_positive_real(substep, "substep")
     if not math.isfinite(delta) or delta <= 0:
         raise ValueError(f"substep must be > 0 (fast time units, sub-step / eps**2), got {substep!r}.")
     n = A.shape[0]

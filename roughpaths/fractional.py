@@ -52,7 +52,8 @@ import scipy.linalg
 from .rough_path import RoughPath
 from .rough_path_n import RoughPathN
 from .signature import signature
-from .validation import as_float_array, check_positive_int, check_times
+from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
+                         check_times)
 
 __all__ = ["fbm", "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift"]
 
@@ -93,6 +94,7 @@ def fgn_autocovariance(hurst, n: int) -> np.ndarray:
     """
     H = _check_hurst(hurst)
     n = check_positive_int(n, "n")
+    check_memory(8.0 * 4 * n, f"the autocovariance of {n} lags", "ask for fewer lags")
     k = np.arange(n, dtype=np.float64)
     return 0.5 * (np.abs(k + 1) ** (2 * H) - 2 * k ** (2 * H) + np.abs(k - 1) ** (2 * H))
 
@@ -172,12 +174,8 @@ def fbm(n_steps: int, hurst, *, rng, T: float = 1.0, dim: int = 1, batch_shape=(
     H = _check_hurst(hurst)
     K = check_positive_int(n_steps, "n_steps")
     d = check_positive_int(dim, "dim")
-    T = float(T)
-    if not np.isfinite(T) or T <= 0:
-        raise ValueError(f"T must be a positive finite number, got {T!r}.")
-    if isinstance(batch_shape, numbers.Integral):
-        batch_shape = (int(batch_shape),)
-    batch_shape = tuple(check_positive_int(b, "batch_shape entry") for b in batch_shape)
+    T = check_positive_real(T, "T")
+    batch_shape = check_batch_shape(batch_shape)
     if method not in ("auto", "davies-harte", "cholesky"):
         raise ValueError(f"method must be 'auto', 'davies-harte' or 'cholesky', got {method!r}.")
     rng = _rng(rng)
@@ -186,7 +184,7 @@ def fbm(n_steps: int, hurst, *, rng, T: float = 1.0, dim: int = 1, batch_shape=(
         method = "cholesky" if K <= _AUTO_CHOLESKY else "davies-harte"
     need = 8 * n_series * (K + 1) + (8 * K * K if method == "cholesky" else 8 * (n_series + 1) * 2 * K * 3)
     if need > max_bytes:
-        raise ValueError(f"fbm would need about {need / 2**20:.0f} MiB for {n_series} series of {K} steps "
+        raise ValueError(f"fbm would need about {need / 2**20:.0f} MiB for {n_series} series (dim={d} x batch_shape={batch_shape}) of n_steps={K} steps "
                          f"(method={method!r}) > max_bytes={max_bytes / 2**20:.0f} MiB; sample in smaller "
                          f"batches (a loop over seeds) or pass a larger max_bytes.")
     gamma = fgn_autocovariance(H, K + 1)
@@ -241,6 +239,16 @@ def piecewise_linear_lift(values, substeps: int, *, level: int = 2, times=None):
                          f"multiple of substeps={m}; give K*m + 1 samples.")
     t = np.linspace(0.0, 1.0, nf + 1) if times is None else check_times(times, "times", n=nf + 1)
     K, d = nf // m, v.shape[-1]
+    if level > 2:
+        from .tensor_algebra import sigdim
+
+        try:
+            size = sigdim(d, level)
+        except ValueError as exc:
+            raise ValueError(f"level={level} is too deep: {exc}") from None
+        check_memory(8.0 * 2 * size * K * max(1, v.size // max(1, v.shape[-1] * v.shape[-2])),
+                     f"the level-{level} step signatures (sigdim({d}, {level}) = {size} per step, {K} steps)",
+                     "ask for a lower level")
     tc = t[::m]
     if level == 1:
         return RoughPath(np.diff(v[..., ::m, :], axis=-2), None, times=tc, x0=v[..., 0, :], check=False)
@@ -303,5 +311,10 @@ def fbm_rough_path(n_steps: int, hurst, *, rng, substeps: int = 16, level: int =
                          f"for 1/4 < H <= 1/3.")
     K = check_positive_int(n_steps, "n_steps")
     m = check_positive_int(substeps, "substeps")
-    values = fbm(K * m, H, rng=rng, T=T, dim=dim, batch_shape=batch_shape, method=method, max_bytes=max_bytes)
+    try:
+        values = fbm(K * m, H, rng=rng, T=T, dim=dim, batch_shape=batch_shape, method=method, max_bytes=max_bytes)
+    except ValueError as exc:
+        if "would need" not in str(exc):
+            raise
+        raise ValueError(f"n_steps={K} x substeps={m} fine steps: {exc}") from None
     return piecewise_linear_lift(values, m, level=level, times=np.linspace(0.0, float(T), K * m + 1))

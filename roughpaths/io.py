@@ -212,7 +212,7 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
     payload = {name: np.asarray(a, order="C") for name, a in arrays.items()}   # keeps 0-d arrays 0-d
     payload[_META_KEY] = np.array(json.dumps(meta, ensure_ascii=False))
 
-    target = Path(os.fspath(path))
+    target = Path(_fspath(path))
     if target.suffix != ".npz":
         target = target.with_name(target.name + ".npz")
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
@@ -231,8 +231,14 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
     return target
 
 
+def _fspath(path):
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a str or os.PathLike naming a .npz file, got {type(path).__name__}.")
+    return os.fspath(path)
+
+
 def _open(path):
-    p = Path(os.fspath(path))
+    p = Path(_fspath(path))
     if not p.exists():
         raise FileNotFoundError(f"no such file: {p}")
     try:

@@ -250,6 +250,9 @@ def sample_levy_areas(increments, h: float, rng, *, method: str = "auto", error:
     w = as_float_array(increments, "increments", min_ndim=1)
     rng = check_rng(rng)
     d = w.shape[-1]
+    if d == 0:
+        raise ValueError(f"increments must have at least one component (shape (..., d) with d >= 1), got "
+                         f"shape {w.shape}.")
     if method == "auto" or (isinstance(method, str) and method.lower() == "auto"):
         method, n = choose_levy_area_method(d, h, error)
     else:

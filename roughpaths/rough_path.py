@@ -82,7 +82,10 @@ class RoughPath:
             t = check_times(times, "times", n=n + 1) if check else np.asarray(times, dtype=np.float64)
         if areas is not None:
             if check:
-                a = as_float_array(areas, "areas", last_dims=(n, d, d))
+                a = as_float_array(areas, "areas")
+                if a.ndim < 3 or a.shape[-3:] != (n, d, d):
+                    raise ValueError(f"areas must have shape (..., n, d, d) = (..., {n}, {d}, {d}) to match "
+                                     f"increments of shape {inc.shape}, got shape {a.shape}.")
                 if a.shape[:-3] != inc.shape[:-2]:
                     raise ValueError(f"areas has batch shape {a.shape[:-3]} but increments has "
                                      f"{inc.shape[:-2]}; both need the same leading axes.")

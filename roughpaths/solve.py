@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .validation import as_float_array, check_memory, check_same_batch
+from .validation import as_float_array, check_memory, check_positive_int, check_same_batch
 from .driver import Driver
 from .rough_path import RoughPath
 from .rough_path_n import RoughPathN
@@ -198,6 +198,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     """
     solver = _resolve_solver(solver)
     fields = solver.check_fields(fields)
+    if block_steps is not None:
+        block_steps = check_positive_int(block_steps, "block_steps")
     if executor is not None:
         return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
                             on_failure=on_failure, block_steps=block_steps)

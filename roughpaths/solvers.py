@@ -81,7 +81,7 @@ class Solver:
         from .vector_fields import VectorFields
 
         if not isinstance(fields, VectorFields):
-            raise TypeError(f"{self!r} integrates VectorFields objects (LinearVectorFields(M) or "
+            raise TypeError(f"fields: {self!r} integrates VectorFields objects (LinearVectorFields(M) or "
                             f"VectorFields(callables, ...)), got {type(fields).__name__}; a Lie–Poisson "
                             f"system needs a coadjoint solver (mechanics.LieEuler(), LieHeun(), "
                             f"ImplicitMidpoint()).")

@@ -43,7 +43,7 @@ from . import _signature_kernels as _k
 from . import _signature_threads as _threads
 from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix, lyndon_projection,
                       lyndon_words)
-from .validation import as_float_array, check_positive_int, check_same_batch
+from .validation import as_float_array, check_memory, check_positive_int, check_same_batch
 
 __all__ = [
     "sigdim",
@@ -60,6 +60,27 @@ __all__ = [
 ]
 
 
+#: The largest size counted exactly by :func:`sigdim` / :func:`logsigdim`: ``dim**depth`` of at most
+#: this many decimal digits (far beyond any signature that could be stored; larger counts would
+#: only spend minutes on big-integer arithmetic).
+_MAX_COUNT_DIGITS = 10_000
+_MAX_COUNT_DEPTH = 1_000
+
+
+def _check_count_size(dim: int, depth: int) -> int:
+    import math
+
+    digits = depth * math.log10(dim) if dim > 1 else 0.0
+    if digits > _MAX_COUNT_DIGITS:
+        raise ValueError(f"depth={depth} with dim={dim}: dim**depth has about {digits:.3g} decimal digits, no "
+                         f"signature of that size can be stored (the count is refused above "
+                         f"{_MAX_COUNT_DIGITS} digits); ask for a smaller depth.")
+    if depth > _MAX_COUNT_DEPTH:
+        raise ValueError(f"depth={depth} is more than {_MAX_COUNT_DEPTH} levels (Witt's formula costs "
+                         f"depth**2 steps and no signature that deep can be stored); ask for a smaller depth.")
+    return depth
+
+
 def sigdim(dim: int, depth: int) -> int:
     """Length ``dim + dim**2 + ... + dim**depth`` of a flat element (no scalar level).
 
@@ -67,8 +88,8 @@ def sigdim(dim: int, depth: int) -> int:
     120
     """
     dim = check_positive_int(dim, "dim")
-    depth = check_positive_int(depth, "depth")
-    return sum(dim ** k for k in range(1, depth + 1))
+    depth = _check_count_size(dim, check_positive_int(depth, "depth"))
+    return depth if dim == 1 else (dim ** (depth + 1) - dim) // (dim - 1)
 
 
 def logsigdim(dim: int, depth: int) -> int:
@@ -83,7 +104,7 @@ def logsigdim(dim: int, depth: int) -> int:
     True
     """
     dim = check_positive_int(dim, "dim")
-    depth = check_positive_int(depth, "depth")
+    depth = _check_count_size(dim, check_positive_int(depth, "depth"))
     return sum(count_lyndon_words(dim, k) for k in range(1, depth + 1))
 
 
@@ -310,6 +331,10 @@ def lyndon_basis(dim: int, depth: int) -> list:
     """
     dim = check_positive_int(dim, "dim")
     depth = check_positive_int(depth, "depth")
+    n = logsigdim(dim, depth)
+    check_memory(float(n) * (120.0 + 8 * depth), f"the Lyndon basis ({n} words up to length {depth} over "
+                 f"{dim} letters)", "ask for a smaller depth or dimension (logsigdim(dim, depth) counts the "
+                 "words without listing them)")
     return [bracket_string(w) for w in lyndon_words(dim, depth)]
 
 

@@ -19,9 +19,14 @@ __all__ = [
     "check_antisymmetric",
     "check_rng",
     "check_positive_int",
+    "check_positive_real",
+    "check_real",
+    "check_batch_shape",
     "check_same_batch",
     "check_memory",
     "memory_budget",
+    "check_work",
+    "work_budget",
 ]
 
 
@@ -39,7 +44,8 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     Parameters
     ----------
     x : array_like
-        Real numbers (bool, integer or float); complex and object arrays are rejected.
+        Real numbers (integer or float; bool arrays count as 0/1, a lone bool is rejected); complex and
+        object arrays are rejected.
     name : str
         The argument's name, used in error messages.
     min_ndim, ndim : int, optional
@@ -52,6 +58,9 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     if isinstance(x, (str, bytes)) or x is None:
         raise TypeError(f"{name} must be an array of real numbers, got {_describe(x)}; "
                         f"pass a numpy array (or nested lists) of floats.")
+    if isinstance(x, (bool, np.bool_)):          # a lone True/False is a flag passed in the wrong place
+        raise TypeError(f"{name} must be a real number or an array of them, got the bool {x!r}; "
+                        f"pass a float.")
     try:
         arr = np.asarray(x)
     except Exception as exc:  # pragma: no cover - exotic inputs
@@ -135,6 +144,56 @@ def check_positive_int(value, name: str, *, minimum: int = 1) -> int:
     return int(value)
 
 
+def check_positive_real(value, name: str, *, allow_zero: bool = False) -> float:
+    """Check a finite real scalar ``> 0`` (``>= 0`` with ``allow_zero``); bools, strings, complex rejected.
+
+    A wrong kind of object raises ``TypeError``; NaN, inf or a value out of range ``ValueError``.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.ndarray)):
+        raise TypeError(f"{name} must be a real number, got {_describe(value)}; pass a float.")
+    if isinstance(value, np.ndarray):
+        if value.ndim != 0 or value.dtype.kind not in "iuf":
+            raise TypeError(f"{name} must be a real scalar, got {_describe(value)}; pass a float.")
+        value = value.item()
+    v = float(value)
+    bound = ">= 0" if allow_zero else "> 0"
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise ValueError(f"{name} must be a finite number {bound}, got {value!r}.")
+    return v
+
+
+def check_real(value, name: str) -> float:
+    """Check a finite real scalar of any sign (bools, strings, complex and arrays rejected)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+            value = value.item()
+        else:
+            raise TypeError(f"{name} must be a real number, got {_describe(value)}; pass a float.")
+    v = float(value)
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}.")
+    return v
+
+
+def check_batch_shape(batch_shape, name: str = "batch_shape") -> tuple:
+    """Check a batch shape: an integer or a tuple of non-negative integers (``2.5`` or ``(2.5,)`` rejected)."""
+    if isinstance(batch_shape, numbers.Integral) and not isinstance(batch_shape, (bool, np.bool_)):
+        batch_shape = (batch_shape,)
+    if isinstance(batch_shape, (str, bytes)):
+        raise TypeError(f"{name} must be a tuple of integers, got {batch_shape!r}; pass e.g. {name}=(1000,).")
+    try:
+        shape = tuple(batch_shape)
+    except TypeError:
+        raise TypeError(f"{name} must be a tuple of integers, got {_describe(batch_shape)}; "
+                        f"pass e.g. {name}=(1000,).") from None
+    for n in shape:
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral):
+            raise TypeError(f"{name} must be a tuple of integers, got {shape!r}; pass e.g. {name}=(1000,).")
+        if n < 0:
+            raise ValueError(f"{name} must hold non-negative integers, got {shape!r}.")
+    return tuple(int(n) for n in shape)
+
+
 def check_same_batch(shape_a: tuple, shape_b: tuple, name_a: str, name_b: str) -> tuple:
     """Broadcast two batch shapes, or raise naming both arguments."""
     try:
@@ -205,3 +264,36 @@ def check_memory(nbytes, what: str, fix: str, *, max_bytes=None) -> None:
         raise ValueError(f"{what} would take {_human(float(nbytes))}, more than the memory budget of "
                          f"{_human(budget)} (three quarters of the available memory, or "
                          f"ROUGHPATHS_MAX_BYTES); {fix}.")
+
+
+def work_budget() -> float:
+    """The number of path-steps (or comparable units of work) one call may do before it is refused.
+
+    ``ROUGHPATHS_MAX_WORK`` if set; otherwise ``1e12`` (about a day of single-core work at the
+    fastest kernels). Streamed computations use constant memory, so :func:`check_memory` cannot
+    catch a request that would merely run for ever (e.g. ``T / eps**2`` steps with a tiny ``eps``).
+    """
+    import os
+
+    env = os.environ.get("ROUGHPATHS_MAX_WORK")
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            raise ValueError(f"ROUGHPATHS_MAX_WORK must be a number, got {env!r}.") from None
+        if not value > 0:
+            raise ValueError(f"ROUGHPATHS_MAX_WORK must be positive, got {env!r}.")
+        return value
+    return 1e12
+
+
+def check_work(units, what: str, fix: str, *, max_units=None) -> None:
+    """Refuse, before starting, a computation of ``units`` path-steps above :func:`work_budget`.
+
+    ``units`` is an estimate computed in floating point (so it cannot overflow); the message
+    states it, ``what`` says what it counts and ``fix`` how to reduce it.
+    """
+    budget = work_budget() if max_units is None else float(max_units)
+    if not float(units) <= budget:
+        raise ValueError(f"{what}: about {float(units):.3g} path-steps, more than the work budget of "
+                         f"{budget:.3g} (ROUGHPATHS_MAX_WORK); {fix}.")

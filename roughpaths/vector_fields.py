@@ -156,6 +156,10 @@ class VectorFields:
             raise TypeError(f"time_dependent must be True or False, got {time_dependent!r}.")
         self.dim_state = check_positive_int(dim_state, "dim_state")
         self.dim_noise = check_positive_int(dim_noise, "dim_noise")
+        from .validation import check_memory
+        check_memory(8.0 * 64 * self.dim_state * self.dim_state * self.dim_noise,
+                     f"probing fields with dim_state={self.dim_state} and dim_noise={self.dim_noise} (Jacobians "
+                     f"of shape (dim_noise, dim_state, dim_state) on a small batch)", "check dim_state and dim_noise")
         self.time_dependent = bool(time_dependent)
         wrap = (lambda f: f) if self.time_dependent else _Autonomous
         d = self.dim_noise
@@ -188,6 +192,9 @@ class VectorFields:
         except TypeError as exc:
             raise TypeError(f"calling {name} on y of shape {y.shape} failed: {exc}."
                             f"{_signature_hint(raw, name) if not self.time_dependent else ''}") from None
+        except Exception as exc:             # the user's callable failed on a valid probe point
+            raise ValueError(f"calling {name} on the probe point y of shape {y.shape} raised "
+                             f"{type(exc).__name__}: {exc}; {name} must be defined on (..., e) arrays.") from exc
 
     def _check_shapes(self):
         e, d = self.dim_state, self.dim_noise
@@ -416,8 +423,8 @@ class LinearVectorFields(VectorFields):
 
     def __init__(self, matrices, drift=None, *, drift_jacobian=None):
         M = as_float_array(matrices, "matrices", ndim=3)
-        if M.shape[1] != M.shape[2]:
-            raise ValueError(f"matrices must have shape (d, e, e), got {M.shape}; each M_i is square.")
+        if M.shape[1] != M.shape[2] or M.size == 0:
+            raise ValueError(f"matrices must have shape (d, e, e) with d, e >= 1, got {M.shape}; each M_i is square.")
         self.matrices = M
         self.dim_noise, self.dim_state = M.shape[0], M.shape[1]
         self._Mt = np.ascontiguousarray(np.transpose(M, (2, 0, 1)).reshape(M.shape[2], -1))  # (e, d*e)

@@ -18,7 +18,7 @@ import warnings
 import numpy as np
 
 from roughpaths import BrownianDriver, NonFiniteStateError, RoughPath, solve
-from roughpaths.validation import as_float_array, check_positive_int, check_rng
+from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_rng, check_work
 
 from ..lie_poisson import LiePoissonSystem
 from .base import ChordConvergenceError, CoadjointSolver, LieHeun, check_on_orbit
@@ -121,6 +121,11 @@ def simulate_brownian(system: LiePoissonSystem, mu0, dt: float, n_steps: int, rn
     if n_paths is None:
         n_paths = mu0.shape[0] if mu0.ndim == 2 else 1
     n_paths = check_positive_int(n_paths, "n_paths")
+    n_saved = n_steps // save_every + 1
+    check_memory(8.0 * n_paths * (n_saved + 2) * system.dim, f"the saved states (n_paths={n_paths} x (n_steps/save_every + 1) "
+                 f"= {n_saved} times x {system.dim})", "save fewer times (a larger save_every) or use fewer paths")
+    check_work(float(n_paths) * n_steps * area_substeps, f"simulate_brownian with n_paths={n_paths}, "
+               f"n_steps={n_steps} and area_substeps={area_substeps}", "use fewer paths, steps or sub-steps")
     mu0 = np.array(np.broadcast_to(mu0, (n_paths, system.dim)))
     if orbit is not None:
         check_on_orbit(system, mu0, orbit)
@@ -143,7 +148,9 @@ def coadjoint_step(system: LiePoissonSystem, mu, dt: float, eta, method=LieHeun(
     _warn("coadjoint_step", "solver.step(system, mu, t, dt, dX, dXX)")
     solver = _solver(method, method.levy_area if isinstance(method, CoadjointSolver) else True)
     mu = _prepare(system, mu, None)
-    new, ok, conv = solver._advance(system, mu, float(dt), np.asarray(eta, dtype=np.float64))
+    dt = float(as_float_array(dt, "dt", ndim=0))
+    eta = as_float_array(eta, "eta", last_dims=(system.dim,))
+    new, ok, conv = solver._advance(system, mu, dt, eta)
     if conv is not None and not np.all(conv):
         raise ChordConvergenceError(
             f"implicit midpoint: the chord iteration did not converge at step {step_index} (t = {t:.6g}, "
