@@ -271,7 +271,8 @@ def _run_chunk(spec: _Spec, first: int, last: int):
 
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
-                 chunk_size=256, block_steps=None, executor=None, keep_final=False) -> EnsembleResult:
+                 chunk_size=256, block_steps=None, executor=None, keep_final=False,
+                 checkpoint=None) -> EnsembleResult:
     r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
 
     Parameters
@@ -310,6 +311,12 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         ``client.get_executor()``. Never changes the numbers.
     keep_final : bool
         Also return every path's final state.
+    checkpoint : str or os.PathLike, optional
+        A ``.npz`` file where the statistics merged so far are saved, atomically, after every chunk
+        (with a fingerprint of the run's arguments). If the file exists when the run starts, the
+        finished chunks are taken from it and only the rest is simulated: a run killed at any moment
+        and started again with the same arguments returns bitwise the result of an uninterrupted run.
+        A checkpoint of a different run is refused. The file is left in place at the end.
 
     Returns
     -------
@@ -385,16 +392,23 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     if executor is not None:
         _check_picklable(spec, executor)
     bounds = [(a, min(a + chunk_size, n_paths)) for a in range(0, n_paths, chunk_size)]
-    if executor is None:
-        parts = (_run_chunk(spec, a, b) for a, b in bounds)
-    else:
-        futures = [executor.submit(_run_chunk, spec, a, b) for a, b in bounds]
-        parts = (f.result() for f in futures)
-
     final = tavg = None
     snaps: list = []
     finals = []
-    for fin, ta, sn, fs in parts:                  # in path order: fixed leaves, bitwise reproducible
+    start = 0
+    if checkpoint is not None:
+        fingerprint = _fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn_in,
+                                   average_every, record_every, chunk_size, keep_final, observable)
+        state = _load_checkpoint(checkpoint, fingerprint)
+        if state is not None:
+            start, final, tavg, snaps, finals = state
+    todo = bounds[start:]
+    if executor is None:
+        parts = (_run_chunk(spec, a, b) for a, b in todo)
+    else:
+        futures = [executor.submit(_run_chunk, spec, a, b) for a, b in todo]
+        parts = (f.result() for f in futures)
+    for done, (fin, ta, sn, fs) in enumerate(parts, start + 1):   # in path order: fixed leaves, bitwise
         if final is None:
             p = fin.shape[-1]
             final = LeafReducer(p)
@@ -407,9 +421,108 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
             red.add(values)
         if fs is not None:
             finals.append(fs)
+        if checkpoint is not None:
+            _save_checkpoint(checkpoint, fingerprint, done, final, tavg, snaps, finals)
     snap_steps = [] if record_every is None else list(range(0, n_steps + 1, record_every))
     return EnsembleResult(final=final.result(), time_average=None if tavg is None else tavg.result(),
                           snapshot_times=np.asarray(snap_steps, dtype=np.float64) * float(dt),
                           snapshots=[r.result() for r in snaps],
                           final_states=np.concatenate(finals) if finals else None,
                           n_paths=n_paths, n_steps=n_steps, dt=float(dt), seed=int(seed), state_dim=n)
+
+
+# ------------------------------------------------------------------------------ checkpoints
+def _fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn_in, average_every,
+                 record_every, chunk_size, keep_final, observable) -> str:
+    """A digest of what determines the numbers of a run (a checkpoint of another run is refused)."""
+    import hashlib
+    import pickle
+
+    h = hashlib.sha256()
+    for part in (repr(system), repr(method), getattr(observable, "__qualname__", repr(observable)),
+                 (float(dt), int(n_steps), int(n_paths), int(seed), levy_area, int(burn_in), int(average_every),
+                  record_every, int(chunk_size), bool(keep_final))):
+        h.update(pickle.dumps(part))
+    h.update(np.ascontiguousarray(mu0).tobytes())
+    for name in ("xi", "s"):
+        value = getattr(system, name, None)
+        if value is not None:
+            h.update(np.ascontiguousarray(np.asarray(value, dtype=np.float64)).tobytes())
+    return h.hexdigest()
+
+
+def _save_checkpoint(path, fingerprint, done, final, tavg, snaps, finals) -> None:
+    """Write the merged statistics after ``done`` chunks to ``path`` atomically (temporary file + rename)."""
+    import json
+    import os
+    import tempfile
+    from pathlib import Path
+
+    arrays = {"__fingerprint__": np.array(fingerprint), "__done__": np.array(done, dtype=np.int64),
+              "__layout__": np.array(json.dumps({"tavg": tavg is not None, "snaps": len(snaps),
+                                                 "finals": len(finals)}))}
+    for name, red in [("final", final), ("tavg", tavg)] + [(f"snap{k}", r) for k, r in enumerate(snaps)]:
+        if red is None:
+            continue
+        arrays[name + "_count"] = np.array(red.moments.count, dtype=np.int64)
+        arrays[name + "_mean"] = red.moments.mean
+        arrays[name + "_scatter"] = red.moments.scatter
+        arrays[name + "_pending"] = red._pending
+    for k, fs in enumerate(finals):
+        arrays[f"finals{k}"] = fs
+    target = Path(os.fspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def _load_checkpoint(path, fingerprint):
+    """``(chunks done, final, tavg, snaps, finals)`` from ``path``, or None if it does not exist."""
+    import json
+    import os
+    import zipfile
+
+    from pathlib import Path
+
+    target = Path(os.fspath(path))
+    for stale in target.parent.glob(f".{target.name}.*.tmp"):      # left by a run killed while writing
+        try:
+            stale.unlink()
+        except OSError:
+            pass
+    if not target.exists():
+        return None
+    try:
+        with np.load(target, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"checkpoint {os.fspath(path)!r} is unreadable ({exc}); delete it to start the run "
+                         f"afresh.") from None
+    if str(arrays.get("__fingerprint__", "")) != fingerprint:
+        raise ValueError(f"checkpoint {os.fspath(path)!r} belongs to a run with other arguments (system, mu0, "
+                         f"sizes, seed, method or observable); pass another checkpoint file or delete this one.")
+    layout = json.loads(str(arrays["__layout__"]))
+
+    def reducer(name):
+        red = LeafReducer(arrays[name + "_mean"].shape[0])
+        red.moments.count = int(arrays[name + "_count"])
+        red.moments.mean = np.array(arrays[name + "_mean"])
+        red.moments.scatter = np.array(arrays[name + "_scatter"])
+        red._pending = np.array(arrays[name + "_pending"]).reshape(-1, red.moments.dim)
+        return red
+
+    final = reducer("final")
+    tavg = reducer("tavg") if layout["tavg"] else None
+    snaps = [reducer(f"snap{k}") for k in range(layout["snaps"])]
+    finals = [arrays[f"finals{k}"] for k in range(layout["finals"])]
+    return int(arrays["__done__"]), final, tavg, snaps, finals
