@@ -51,7 +51,7 @@ import numpy as np
 from .rough_path import RoughPath
 from .solve import Solution
 
-__all__ = ["save", "load", "load_metadata", "register_format", "FORMAT", "FORMAT_VERSION"]
+__all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "roughpaths-npz"
 FORMAT_VERSION = 1
@@ -215,10 +215,24 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
     target = Path(_fspath(path))
     if target.suffix != ".npz":
         target = target.with_name(target.name + ".npz")
+    return atomic_savez(target, payload)
+
+
+def _fspath(path):
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a str or os.PathLike naming a .npz file, got {type(path).__name__}.")
+    return os.fspath(path)
+
+
+def atomic_savez(target, arrays: dict) -> Path:
+    """Write ``arrays`` to the ``.npz`` file ``target`` atomically (a temporary file in the same folder,
+    flushed to disk, then renamed over ``target``): a crash or kill never leaves a partial file under
+    the name. Returns the path written."""
+    target = Path(os.fspath(target))
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **payload)
+            np.savez(fh, **arrays)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, target)
@@ -229,12 +243,6 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
             pass
         raise
     return target
-
-
-def _fspath(path):
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a str or os.PathLike naming a .npz file, got {type(path).__name__}.")
-    return os.fspath(path)
 
 
 def _open(path):
