@@ -34,6 +34,10 @@ def fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn
                   record_every, int(chunk_size), bool(keep_final))):
         h.update(pickle.dumps(part))
     h.update(np.ascontiguousarray(mu0).tobytes())
+    try:                                   # the whole system when it pickles (inertia, Hamiltonian, ...)
+        h.update(pickle.dumps(system))
+    except Exception:                      # noqa: BLE001 - user callables that do not pickle: repr and arrays
+        pass
     for name in ("xi", "s"):
         value = getattr(system, name, None)
         if value is not None:
