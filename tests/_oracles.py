@@ -27,3 +27,21 @@ def rk4_flow(f, y, t, n=40):
         k4 = f(y + h * k3)
         y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return y
+
+
+# A non-commuting pair of smooth fields on R^2 with their exact Jacobians, shared by the rough-driver
+# tests (Friz–Oberhauser on fBM, strong rates): V_1 = (sin y2, cos y1), V_2 = (cos(y1 + y2)/2, sin y1).
+def trig_fields(y):
+    y1, y2 = y[..., 0], y[..., 1]
+    V1 = np.stack([np.sin(y2), np.cos(y1)], -1)
+    V2 = np.stack([0.5 * np.cos(y1 + y2), np.sin(y1)], -1)
+    return np.stack([V1, V2], -1)
+
+
+def trig_jacobians(y):
+    y1, y2 = y[..., 0], y[..., 1]
+    z = np.zeros(y.shape[:-1])
+    J1 = np.stack([np.stack([z, np.cos(y2)], -1), np.stack([-np.sin(y1), z], -1)], -2)
+    s = -0.5 * np.sin(y1 + y2)
+    J2 = np.stack([np.stack([s, s], -1), np.stack([np.cos(y1), z], -1)], -2)
+    return np.stack([J1, J2], -3)

@@ -25,6 +25,7 @@ Three checks:
 """
 
 import numpy as np
+from _oracles import trig_fields, trig_jacobians
 import pytest
 
 from roughpaths import (Davie, Davie3, LinearVectorFields, LogODE, LogODE3, VectorFields, fbm,
@@ -34,29 +35,13 @@ SIG = 0.8                                     # s^{12}
 S = np.array([[0.0, SIG], [-SIG, 0.0]])
 
 
-def _fields(y):
-    y1, y2 = y[..., 0], y[..., 1]
-    V1 = np.stack([np.sin(y2), np.cos(y1)], -1)
-    V2 = np.stack([0.5 * np.cos(y1 + y2), np.sin(y1)], -1)
-    return np.stack([V1, V2], -1)
-
-
-def _jac(y):
-    y1, y2 = y[..., 0], y[..., 1]
-    z = np.zeros(y.shape[:-1])
-    J1 = np.stack([np.stack([z, np.cos(y2)], -1), np.stack([-np.sin(y1), z], -1)], -2)
-    s = -0.5 * np.sin(y1 + y2)
-    J2 = np.stack([np.stack([s, s], -1), np.stack([np.cos(y1), z], -1)], -2)
-    return np.stack([J1, J2], -3)
-
-
-FIELDS = VectorFields(_fields, _jac, dim_state=2, dim_noise=2)
+FIELDS = VectorFields(trig_fields, trig_jacobians, dim_state=2, dim_noise=2)
 Y0 = np.array([0.3, -0.2])
 
 
 def _bracket12(y):
     """[V_1, V_2] = DV_2·V_1 − DV_1·V_2 from the closed-form Jacobians."""
-    V, J = _fields(y), _jac(y)
+    V, J = trig_fields(y), trig_jacobians(y)
     return (J[..., 1, :, :] @ V[..., :, 0, None])[..., 0] - (J[..., 0, :, :] @ V[..., :, 1, None])[..., 0]
 
 
@@ -81,10 +66,10 @@ def _loop_solution(values, sig, T=1.0):
     dx = np.diff(values, axis=-2)
     y = np.broadcast_to(Y0, values.shape[:-2] + (2,)).copy()
     for k in range(n):
-        y = _rk4(lambda z: (_fields(z) @ dx[..., k, :, None])[..., 0], y)
+        y = _rk4(lambda z: (trig_fields(z) @ dx[..., k, :, None])[..., 0], y)
         sign = 1.0 if k % 2 == 0 else -1.0
         for i, c in legs:
-            y = _rk4(lambda z: sign * c * _fields(z)[..., :, i], y)
+            y = _rk4(lambda z: sign * c * trig_fields(z)[..., :, i], y)
     return y
 
 
@@ -95,7 +80,7 @@ def _drift_solution(values, coef, T=1.0):
     dx = np.diff(values, axis=-2)
     y = np.broadcast_to(Y0, values.shape[:-2] + (2,)).copy()
     for k in range(n):
-        y = _rk4(lambda z: (_fields(z) @ dx[..., k, :, None])[..., 0] + coef * delta * _bracket12(z), y)
+        y = _rk4(lambda z: (trig_fields(z) @ dx[..., k, :, None])[..., 0] + coef * delta * _bracket12(z), y)
     return y
 
 

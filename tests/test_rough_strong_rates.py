@@ -26,28 +26,13 @@ Its level-3 terms are right: on smooth drivers it has order 3 (``tests/test_leve
 """
 
 import numpy as np
+from _oracles import trig_fields, trig_jacobians
 import pytest
 
 from roughpaths import Davie, Davie3, LogODE, LogODE3, VectorFields, fbm, piecewise_linear_lift, solve
 
 
-def _fields(y):
-    y1, y2 = y[..., 0], y[..., 1]
-    V1 = np.stack([np.sin(y2), np.cos(y1)], -1)
-    V2 = np.stack([0.5 * np.cos(y1 + y2), np.sin(y1)], -1)
-    return np.stack([V1, V2], -1)
-
-
-def _jac(y):
-    y1, y2 = y[..., 0], y[..., 1]
-    z = np.zeros(y.shape[:-1])
-    J1 = np.stack([np.stack([z, np.cos(y2)], -1), np.stack([-np.sin(y1), z], -1)], -2)
-    s = -0.5 * np.sin(y1 + y2)
-    J2 = np.stack([np.stack([s, s], -1), np.stack([np.cos(y1), z], -1)], -2)
-    return np.stack([J1, J2], -3)
-
-
-FIELDS = VectorFields(_fields, _jac, dim_state=2, dim_noise=2)
+FIELDS = VectorFields(trig_fields, trig_jacobians, dim_state=2, dim_noise=2)
 Y0 = np.array([0.3, -0.2])
 
 
@@ -57,7 +42,7 @@ def _polygon_ode(values, y0, sub=2):
     dx = np.diff(values, axis=-2)
 
     def f(z, d):
-        return (_fields(z) @ d[..., None])[..., 0]
+        return (trig_fields(z) @ d[..., None])[..., 0]
 
     for k in range(dx.shape[-2]):
         d = dx[..., k, :] / sub
