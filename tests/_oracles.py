@@ -45,3 +45,20 @@ def trig_jacobians(y):
     s = -0.5 * np.sin(y1 + y2)
     J2 = np.stack([np.stack([s, s], -1), np.stack([np.cos(y1), z], -1)], -2)
     return np.stack([J1, J2], -3)
+
+
+# Polynomial fields on R^3 with exact Jacobians (elementwise-exact arithmetic, so a batch member's
+# values cannot depend on the batch), shared by the batch-independence tests.
+def poly_fields(y):
+    return np.stack([0.3 * y * y - y[..., ::-1], 0.2 * y[..., [1, 2, 0]] * y], axis=-1)
+
+
+def poly_jacobians(y):
+    e = y.shape[-1]
+    J = np.zeros(y.shape[:-1] + (2, e, e))
+    idx = np.arange(e)
+    J[..., 0, idx, idx] += 0.6 * y
+    J[..., 0, idx, idx[::-1]] -= 1.0
+    J[..., 1, idx, [1, 2, 0]] += 0.2 * y
+    J[..., 1, idx, idx] += 0.2 * y[..., [1, 2, 0]]
+    return J

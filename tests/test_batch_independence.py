@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import roughpaths as rp
+from _oracles import poly_fields, poly_jacobians
 
 SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -68,20 +69,7 @@ def _fields(kind, rng):
         return rp.LinearVectorFields(0.5 * rng.standard_normal((2, 3, 3)),
                                      drift=0.3 * rng.standard_normal((3, 3)))
 
-    def f(y):                                    # polynomial: elementwise-exact arithmetic
-        return np.stack([0.3 * y * y - y[..., ::-1], 0.2 * y[..., [1, 2, 0]] * y], axis=-1)
-
-    def jf(y):
-        e = y.shape[-1]
-        J = np.zeros(y.shape[:-1] + (2, e, e))
-        idx = np.arange(e)
-        J[..., 0, idx, idx] += 0.6 * y
-        J[..., 0, idx, idx[::-1]] -= 1.0
-        J[..., 1, idx, [1, 2, 0]] += 0.2 * y
-        J[..., 1, idx, idx] += 0.2 * y[..., [1, 2, 0]]
-        return J
-
-    return rp.VectorFields(f, jf, dim_state=3, dim_noise=2, drift=lambda y: -0.1 * y)
+    return rp.VectorFields(poly_fields, poly_jacobians, dim_state=3, dim_noise=2, drift=lambda y: -0.1 * y)
 
 
 @pytest.mark.parametrize("kind", ["linear", "polynomial"])

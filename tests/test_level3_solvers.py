@@ -11,6 +11,7 @@ form Hessians of the test fields.
 """
 
 import numpy as np
+from _oracles import poly_fields, poly_jacobians
 import pytest
 
 from roughpaths import (Davie, Davie3, Heun, LinearVectorFields, LogODE, LogODE3, RoughPathN, VectorFields,
@@ -112,20 +113,7 @@ def test_levels_are_checked():
 
 
 def _poly_fields():
-    def f(y):                                    # polynomial: elementwise-exact arithmetic
-        return np.stack([0.3 * y * y - y[..., ::-1], 0.2 * y[..., [1, 2, 0]] * y], axis=-1)
-
-    def jf(y):
-        e = y.shape[-1]
-        J = np.zeros(y.shape[:-1] + (2, e, e))
-        idx = np.arange(e)
-        J[..., 0, idx, idx] += 0.6 * y
-        J[..., 0, idx, idx[::-1]] -= 1.0
-        J[..., 1, idx, [1, 2, 0]] += 0.2 * y
-        J[..., 1, idx, idx] += 0.2 * y[..., [1, 2, 0]]
-        return J
-
-    return VectorFields(f, jf, dim_state=3, dim_noise=2, drift=lambda y: -0.1 * y)
+    return VectorFields(poly_fields, poly_jacobians, dim_state=3, dim_noise=2, drift=lambda y: -0.1 * y)
 
 
 @pytest.mark.parametrize("kind", ["linear", "polynomial"])
