@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._random import _pcg64_normal
+from ._random import _pcg64_fill, _pcg64_normal
 
 
 @njit(cache=True, nogil=True)
@@ -56,38 +56,31 @@ def _areas_m1(dW, h, buf, states, davie, ito, out):
     cs = h / np.sqrt(12.0)
     draw = states.shape[0] > 0
     na = buf.shape[2]
-    zero = np.uint64(0)
-    sh, sl, ih, il = zero, zero, zero, zero
+    zrow = np.empty(K * na if draw else 0)
+    words = np.empty(K * na + 64 if draw else 0, dtype=np.uint64)
+    zb = zrow.reshape((1, K, na)) if draw else buf
     for p in range(P):
-        if draw:
-            sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+        if draw:                      # the path's normals for the whole block, in stream order
+            _pcg64_fill(states, p, zrow, words)
         for r in range(K):
             hr = h[r]
             sH = sHs[r]
             c = cs[r]
-            if draw:
-                for i in range(na):
-                    buf[0, 0, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
-                bp, br = 0, 0
-            else:
-                bp, br = p, r
+            bp, br = (0, r) if draw else (p, r)
             q = 0
             for i in range(d):
                 Wi = dW[p, r, i]
-                Hi = sH * buf[bp, br, i]
+                Hi = sH * zb[bp, br, i]
                 out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
                 for j in range(i + 1, d):
                     Wj = dW[p, r, j]
-                    v = Hi * Wj - sH * buf[bp, br, j] * Wi
+                    v = Hi * Wj - sH * zb[bp, br, j] * Wi
                     if davie:
-                        v += buf[bp, br, d + q] * c
+                        v += zb[bp, br, d + q] * c
                     sym = 0.5 * Wi * Wj
                     out[p, r, i, j] = sym + v
                     out[p, r, j, i] = sym - v
                     q += 1
-        if draw:
-            states[p, 0] = sh
-            states[p, 1] = sl
 
 
 @njit(cache=True, nogil=True)
@@ -110,12 +103,12 @@ def _block_areas(dW, h, buf, states, m, davie, ito, out):
         Step sizes.
     buf : (P, K, n_area) or (1, 1, n_area) float64
         Standard normals, ``n_area = (m d if m > 1 else 0) + m d + (d(d-1)/2 if davie else 0)``;
-        with ``states``, a scratch row that receives each step's normals as they are drawn.
+        ignored (any shape ``(1, 1, n_area)``) with ``states``.
     states : (P, 4) uint64 or (0, 4)
         If not empty, the PCG64 states of the paths' area streams (:mod:`roughpaths._random`):
-        each step's ``n_area`` normals are drawn here, in order, instead of read from ``buf``
-        (same numbers as drawing the block first; saves the buffer's memory traffic). The
-        states advance in place.
+        each path's ``K n_area`` normals of the block are drawn into a scratch row of the kernel,
+        in stream order, instead of read from ``buf`` (same numbers as drawing the block first,
+        without a ``(P, K, n_area)`` buffer). The states advance in place.
     m : int
         Substeps per step.
     davie, ito : bool
@@ -137,34 +130,30 @@ def _block_areas(dW, h, buf, states, m, davie, ito, out):
     cs = h / np.sqrt(12.0 * m)                   # Davie's scale h/√(12 m)
     draw = states.shape[0] > 0
     na = buf.shape[2]
-    zero = np.uint64(0)
-    sh, sl, ih, il = zero, zero, zero, zero
+    zrow = np.empty(K * na if draw else 0)
+    words = np.empty(K * na + 64 if draw else 0, dtype=np.uint64)
+    zb = zrow.reshape((1, K, na)) if draw else buf
     for p in range(P):
-        if draw:
-            sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+        if draw:                      # the path's normals for the whole block, in stream order
+            _pcg64_fill(states, p, zrow, words)
         for r in range(K):
             hr = h[r]
             sH = sHs[r]
             c = cs[r]
-            if draw:
-                for i in range(na):
-                    buf[0, 0, i], sh, sl = _pcg64_normal(sh, sl, ih, il)
-                bp, br = 0, 0
-            else:
-                bp, br = p, r
+            bp, br = (0, r) if draw else (p, r)
             sq = np.sqrt(hr * inv_m)
             for j in range(d):
                 acc = 0.0
                 for k in range(m):
-                    acc += buf[bp, br, k * d + j]
+                    acc += zb[bp, br, k * d + j]
                 shift[j] = sq * acc * inv_m - dW[p, r, j] * inv_m
                 s[j] = 0.0
             for q in range(npair):
                 A[q] = 0.0
             for k in range(m):
                 for j in range(d):
-                    w[j] = sq * buf[bp, br, k * d + j] - shift[j]
-                    a[j] = sH * buf[bp, br, o_zeta + k * d + j] + 0.5 * s[j]
+                    w[j] = sq * zb[bp, br, k * d + j] - shift[j]
+                    a[j] = sH * zb[bp, br, o_zeta + k * d + j] + 0.5 * s[j]
                     s[j] += w[j]
                 q = 0
                 for i in range(d):         # (g - gᵀ)_{ij}, g = Σ_k a_k ⊗ w_k
@@ -176,14 +165,11 @@ def _block_areas(dW, h, buf, states, m, davie, ito, out):
                 Wi = dW[p, r, i]
                 out[p, r, i, i] = 0.5 * Wi * Wi - (0.5 * hr if ito else 0.0)
                 for j in range(i + 1, d):
-                    v = A[q] + (buf[bp, br, o_lam + q] * c if davie else 0.0)
+                    v = A[q] + (zb[bp, br, o_lam + q] * c if davie else 0.0)
                     sym = 0.5 * Wi * dW[p, r, j]
                     out[p, r, i, j] = sym + v
                     out[p, r, j, i] = sym - v
                     q += 1
-        if draw:
-            states[p, 0] = sh
-            states[p, 1] = sl
 
 
 # ----------------------------------------------------------------------------- exact d = 2 area
