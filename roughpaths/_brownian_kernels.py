@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._random import _pcg64_fill, _pcg64_normal
+from ._random import _pcg64_fill, _pcg64_fill2, _pcg64_normal
 
 
 @njit(cache=True, nogil=True)
@@ -56,12 +56,17 @@ def _areas_m1(dW, h, buf, states, davie, ito, out):
     cs = h / np.sqrt(12.0)
     draw = states.shape[0] > 0
     na = buf.shape[2]
-    zrow = np.empty(K * na if draw else 0)
-    words = np.empty(K * na + 64 if draw else 0, dtype=np.uint64)
-    zb = zrow.reshape((1, K, na)) if draw else buf
+    zrows = np.empty((2, K * na if draw else 0))
+    words = np.empty((2, K * na + 64 if draw else 0), dtype=np.uint64)
+    zb = buf
     for p in range(P):
         if draw:                      # the path's normals for the whole block, in stream order
-            _pcg64_fill(states, p, zrow, words)
+            if p % 2 == 0:            # two paths' streams at a time (see _pcg64_fill2)
+                if p + 1 < P:
+                    _pcg64_fill2(states, p, p + 1, zrows[0], zrows[1], words[0], words[1])
+                else:
+                    _pcg64_fill(states, p, zrows[0], words[0])
+            zb = zrows[p % 2].reshape((1, K, na))
         for r in range(K):
             hr = h[r]
             sH = sHs[r]
@@ -130,12 +135,17 @@ def _block_areas(dW, h, buf, states, m, davie, ito, out):
     cs = h / np.sqrt(12.0 * m)                   # Davie's scale h/√(12 m)
     draw = states.shape[0] > 0
     na = buf.shape[2]
-    zrow = np.empty(K * na if draw else 0)
-    words = np.empty(K * na + 64 if draw else 0, dtype=np.uint64)
-    zb = zrow.reshape((1, K, na)) if draw else buf
+    zrows = np.empty((2, K * na if draw else 0))
+    words = np.empty((2, K * na + 64 if draw else 0), dtype=np.uint64)
+    zb = buf
     for p in range(P):
         if draw:                      # the path's normals for the whole block, in stream order
-            _pcg64_fill(states, p, zrow, words)
+            if p % 2 == 0:            # two paths' streams at a time (see _pcg64_fill2)
+                if p + 1 < P:
+                    _pcg64_fill2(states, p, p + 1, zrows[0], zrows[1], words[0], words[1])
+                else:
+                    _pcg64_fill(states, p, zrows[0], words[0])
+            zb = zrows[p % 2].reshape((1, K, na))
         for r in range(K):
             hr = h[r]
             sH = sHs[r]

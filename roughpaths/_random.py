@@ -323,22 +323,14 @@ def _pcg64_normal(sh, sl, ih, il):
 
 
 @njit(cache=True, nogil=True)
-def _pcg64_fill(states, p, out, words):
-    """``out`` (1-D, contiguous) <- the next ``out.size`` normals of PCG64 stream ``states[p]``.
+def _pcg64_rounds(sh, sl, ih, il, out, buf, left, i):
+    """Continue filling ``out[i:]`` from PCG64 state ``(sh, sl)``; ``buf[:left]`` holds words not yet used.
 
-    Same numbers and end state as :func:`_pcg64_normal` called ``out.size`` times, but in two
-    passes: the LCG writes raw words into ``words`` (uint64 scratch, any size >= 1; a larger one
-    is allocated if needed), then :func:`_ziggurat_fill` turns them into normals. The passes are
-    tight loops without calls (one call per normal measured ~4x slower). Words are requested
-    as in :func:`_fill_normals_raw` (``n - i`` at a time, an unfinished attempt carried over),
-    which never draws a word the ziggurat does not use, so the state ends where the one-normal
-    version leaves it.
+    Words are requested as in :func:`_fill_normals_raw` (``n - i`` at a time, an unfinished
+    attempt carried over), which never draws a word the ziggurat does not use, so the state
+    ends where the one-normal version :func:`_pcg64_normal` leaves it. Returns ``(sh, sl)``.
     """
     n = out.size
-    sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
-    i = 0
-    left = 0
-    buf = words
     while i < n:
         need = n - i
         if left + need > buf.size:
@@ -352,17 +344,58 @@ def _pcg64_fill(states, p, out, words):
         left = left + need - used
         for j in range(left):
             buf[j] = buf[used + j]
+    return sh, sl
+
+
+@njit(cache=True, nogil=True)
+def _pcg64_fill(states, p, out, words):
+    """``out`` (1-D) <- the next ``out.size`` normals of PCG64 stream ``states[p]``; the state advances.
+
+    Same numbers and end state as :func:`_pcg64_normal` called ``out.size`` times, in two
+    passes: the LCG writes raw words into ``words`` (uint64 scratch; a larger one is allocated if
+    needed), then :func:`_ziggurat_fill` turns them into normals. Both passes are tight loops
+    without calls (one call per normal measured ~2x slower).
+    """
+    sh, sl = _pcg64_rounds(states[p, 0], states[p, 1], states[p, 2], states[p, 3], out, words, 0, 0)
     states[p, 0] = sh
     states[p, 1] = sl
+
+
+@njit(cache=True, nogil=True)
+def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
+    """:func:`_pcg64_fill` for two streams ``p``, ``q`` and rows of equal length, same numbers.
+
+    The first ``n`` words of both streams are generated in one loop (two independent LCG chains
+    overlap in the pipeline: ~1.3x faster word generation); the rest as in :func:`_pcg64_fill`.
+    """
+    n = out_p.size
+    ph, pl, pih, pil = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
+    qh, ql, qih, qil = states[q, 0], states[q, 1], states[q, 2], states[q, 3]
+    for j in range(n):
+        ph, pl = _lcg(ph, pl, pih, pil)
+        words_p[j] = _xsl_rr(ph, pl)
+        qh, ql = _lcg(qh, ql, qih, qil)
+        words_q[j] = _xsl_rr(qh, ql)
+    used, i = _ziggurat_fill(words_p[:n], out_p, 0, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+    for j in range(n - used):
+        words_p[j] = words_p[used + j]
+    states[p, 0], states[p, 1] = _pcg64_rounds(ph, pl, pih, pil, out_p, words_p, n - used, i)
+    used, i = _ziggurat_fill(words_q[:n], out_q, 0, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+    for j in range(n - used):
+        words_q[j] = words_q[used + j]
+    states[q, 0], states[q, 1] = _pcg64_rounds(qh, ql, qih, qil, out_q, words_q, n - used, i)
 
 
 @njit(cache=True, nogil=True)
 def _pcg64_normals(states, out):
     """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
     P, n = out.shape
-    words = np.empty(n + 64, dtype=np.uint64)
-    for p in range(P):
-        _pcg64_fill(states, p, out[p], words)
+    wp = np.empty(n + 64, dtype=np.uint64)
+    wq = np.empty(n + 64, dtype=np.uint64)
+    for p in range(0, P - 1, 2):
+        _pcg64_fill2(states, p, p + 1, out[p], out[p + 1], wp, wq)
+    if P % 2:
+        _pcg64_fill(states, P - 1, out[P - 1], wp)
 
 
 def _uint32_words(value: int) -> list:

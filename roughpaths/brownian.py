@@ -297,7 +297,7 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
 
 
 # ---------------------------------------------------------------------------- the driver
-_BLOCK_BYTES = 2 << 20
+_BLOCK_BYTES = 16 << 20
 _NO_STATES = np.empty((0, 4), dtype=np.uint64)
 # tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
 _EXACT_T1 = (np.pi ** 2 / 6 - sum(1.0 / k ** 2 for k in range(1, _EXACT_TERMS + 1))) / (2 * np.pi ** 2)
@@ -345,10 +345,11 @@ class BrownianDriver(SeededDriver):
         Per-component L² error per step for the Fourier samplers; default ``h^1.5`` (the accuracy at
         which the order-1 schemes keep order 1 against Brownian motion).
     block_bytes : int
-        Target memory of one block (increments, areas and random buffers), default 2 MiB (at
+        Target memory of one block (increments, areas and random buffers), default 16 MiB (at
         least one step per block); it sets the default of :meth:`blocks`, never the numbers.
-        Measured (1000 paths x 1000 steps, d = 3): 1-2 MiB blocks, which stay in cache while a
-        solver consumes them, sample 10-25 % faster than 32 MiB blocks.
+        Measured (the rigid body with Davie areas, 1000 paths x 5000 steps, d = 3, CPU time per
+        path-step): 2 MiB 144 ns, 8 MiB 119 ns, 16 MiB 109 ns, 64 MiB 108 ns; small blocks
+        pay the per-block Python overhead of the driver and the solver (~0.2 ms).
 
     Notes
     -----

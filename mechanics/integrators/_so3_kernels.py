@@ -16,6 +16,7 @@ not converge) is marked by itself; the others go on.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba
@@ -342,19 +343,28 @@ def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
             out[p, k, 2] = e2
 
 
+@functools.lru_cache(maxsize=32)
+def _pairs(nm: int):
+    """The pairs ``i < j`` of ``nm`` noise components (``numpy.triu_indices`` order), as int64 arrays."""
+    pi, pj = np.triu_indices(nm, 1)
+    return pi.astype(np.int64), pj.astype(np.int64)
+
+
 def stochastic_velocities(system, dX, dXX, batch):
     """``system.stochastic_velocity`` of a block for the so(3) kernels, shape ``(prod(batch), K, 3)``."""
     nk, nm = dX.shape[-2:]
     nb = int(np.prod(batch, dtype=np.int64))
-    dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, nm)).reshape(nb, nk, nm), dtype=np.float64)
+    shape = batch + (nk, nm)
+    dX = np.ascontiguousarray(dX if dX.shape == shape else np.broadcast_to(dX, shape), dtype=np.float64)
+    dX = dX.reshape(nb, nk, nm)
     if dXX is None:
         dXX = np.empty((0, 0, 0, 0))
     else:
-        dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, nm, nm)).reshape(nb, nk, nm, nm),
-                                   dtype=np.float64)
-    pi, pj = np.triu_indices(nm, 1)
+        shape = batch + (nk, nm, nm)
+        dXX = np.ascontiguousarray(dXX if dXX.shape == shape else np.broadcast_to(dXX, shape), dtype=np.float64)
+        dXX = dXX.reshape(nb, nk, nm, nm)
+    pi, pj = _pairs(nm)
     brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
     out = np.empty((nb, nk, 3))
-    _eta_from_increments(dX, dXX, np.ascontiguousarray(system.xi), brk, pi.astype(np.int64), pj.astype(np.int64),
-                         out)
+    _eta_from_increments(dX, dXX, np.ascontiguousarray(system.xi), brk, pi, pj, out)
     return out
