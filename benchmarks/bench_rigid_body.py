@@ -9,13 +9,17 @@ Ours: ``roughpaths.solve(rigid_body, BrownianDriver(3, seed, ...), mu0, LieHeun(
 update, |Π| exact), the Lévy area included (Davie, strong order 1) and, for reference, without it.
 The driver generates per-path seeded increments and areas block by block; the so(3) solver runs a
 structure-of-arrays numba kernel (SIMD over paths, trig-free Rodrigues). The driver alone is timed
-too: with the area it is most of the cost. Peers (where installed, in the
+too: with the area it is most of the cost. Two rows answer the issue "One engine": the same problem
+through ``run_ensemble`` (target ≤ 1.3x the direct solve) and the heavy top on se(3)* with the same
+inertia, noise and θ (target ≤ 3x the rigid body per path-step; its column shows ``||Γ(T)| - 1|``,
+a Casimir). Peers (where installed, in the
 same run): diffrax Heun on a batched (3, N) state (jit), torchsde Heun (noise_type="general",
 sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scaled per path-step).
-Reported: median wall time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
+Reported: median wall (or, with ``--clock cpu``, process CPU) time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
 max ||Π(T)| - 1| over the paths, and ratios peer / ours.
 
-Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R] [--skip torchsde,sdeint]``.
+Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R] [--clock wall|cpu]
+[--skip diffrax,torchsde,sdeint]``.
 """
 
 from __future__ import annotations
@@ -72,6 +76,37 @@ def bench_driver_only(n_paths, n_steps, repeats):
             last = block
         return np.broadcast_to(np.array([0.0, 0.0, 1.0]), (n_paths, 3))
     return _median_time(run, repeats)
+
+
+def bench_heavy_top(n_paths, n_steps, repeats):
+    """The heavy top on se(3)* (same inertia, θ, σ e_i rotational noise, χ = e3), LieHeun + Davie area."""
+    from mechanics import LieHeun, heavy_top
+    from roughpaths import BrownianDriver, solve
+
+    top = heavy_top(INERTIA, chi=[0.0, 0.0, 1.0], sigma=SIGMA, theta=THETA)
+    mu0 = np.array([0.0, 0.0, 1.0, 0.0, 0.6, 0.8])
+
+    def run(n, p, seed):
+        drv = BrownianDriver(3, seed=seed, dt=DT, n_steps=n, batch_shape=(p,))
+        return solve(top, drv, mu0, LieHeun(), save_at="end").final[..., 3:]   # Γ: |Γ| = 1 is a Casimir
+
+    run(10, 2, 0)
+    return _median_time(lambda: run(n_steps, n_paths, 1), repeats)
+
+
+def bench_ensemble(n_paths, n_steps, repeats):
+    """``run_ensemble`` on the same rigid-body problem (moment statistics streamed, serial)."""
+    from mechanics import rigid_body, run_ensemble
+
+    rb = rigid_body(INERTIA, sigma=SIGMA, theta=THETA)
+
+    def run(n, p):
+        res = run_ensemble(rb, [0.0, 0.0, 1.0], dt=DT, n_steps=n, n_paths=p, seed=1, levy_area="davie",
+                           keep_final=True)
+        return res.final_states
+
+    run(10, 2)
+    return _median_time(lambda: run(n_steps, n_paths), repeats)
 
 
 def _drift_np(y):
@@ -209,6 +244,8 @@ def main(argv=None):
     record("ours LieHeun + Levy area", n_paths, lambda: bench_ours(n_paths, n_steps, args.repeats, True))
     record("ours LieHeun, no area", n_paths, lambda: bench_ours(n_paths, n_steps, args.repeats, False))
     record("  (BrownianDriver alone, Davie)", n_paths, lambda: bench_driver_only(n_paths, n_steps, args.repeats))
+    record("  (run_ensemble, same problem)", n_paths, lambda: bench_ensemble(n_paths, n_steps, args.repeats))
+    record("  (heavy top, LieHeun + area)", n_paths, lambda: bench_heavy_top(n_paths, n_steps, args.repeats))
     if "diffrax" not in skip:
         record("diffrax Heun (batched 3xN)", n_paths, lambda: bench_diffrax(n_paths, n_steps, args.repeats))
     if "torchsde" not in skip:
@@ -217,7 +254,7 @@ def main(argv=None):
         record(f"sdeint stratHeun ({sde_paths} paths)", sde_paths,
                lambda: bench_sdeint(sde_paths, n_steps, max(1, args.repeats // 3)))
     ran = [r[0] for r in rows]
-    print("peers that ran:", ", ".join(ran[3:]) or "none")
+    print("peers that ran:", ", ".join(ran[5:]) or "none")
     ours = rows[0][2]
     print("ratios (ns per path-step, peer / ours with Levy area):")
     for name, _, ns, _ in rows[1:]:
