@@ -178,7 +178,8 @@ def test_bad_arguments_name_the_argument(kw, exc, word):
 
 
 def test_sizes_are_checked_before_allocating():
-    drv = BrownianDriver(3, seed=0, dt=1e-9, n_steps=10**9, batch_shape=(10**6,))   # ~10^17 bytes
+    # ~10^17 bytes of path on a grid of 10^5 steps (a 10^9-step grid alone would take 16 GB here)
+    drv = BrownianDriver(3, seed=0, dt=1e-9, n_steps=10**5, batch_shape=(10**10,))
     with pytest.raises(ValueError, match="GiB"):
         drv.rough_path()
     huge = BrownianDriver(3, seed=0, dt=0.1, n_steps=2, batch_shape=(10**14,))
