@@ -225,28 +225,54 @@ def _se3_chord(mu, e, s, dt, q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji
     return False
 
 
+@numba.njit(cache=True, inline="always")
+def _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e):
+    """e = Σ_r dX_r ξ_r + Σ_{r: i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for member p, step k."""
+    nm = dX.shape[2]
+    for i in range(6):
+        acc = 0.0
+        for r in range(nm):
+            acc += dX[p, k, r] * xi[r, i]
+        e[i] = acc
+    if area:
+        for r in range(pi.shape[0]):
+            aij = 0.5 * (dXX[p, k, pi[r], pj[r]] - dXX[p, k, pj[r], pi[r]])
+            for i in range(6):
+                e[i] += aij * brk[r, i]
+
+
+@numba.njit(cache=True, inline="always")
+def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slot):
+    """mu = new (NaN if not ok or not finite; first failure recorded); save it. Returns (finite, slot)."""
+    finite = ok
+    for i in range(6):
+        mu[i] = new[i]
+        if not math.isfinite(new[i]):
+            finite = False
+    nfail = 0
+    if not finite:
+        for i in range(6):
+            mu[i] = np.nan
+        if first_bad[p] < 0:
+            first_bad[p] = k
+            reason[p] = NON_FINITE if (not finite_in or ok) else CHORD_FAILED
+            nfail = 1
+    if save[k]:
+        for i in range(6):
+            out[p, slot, i] = mu[i]
+        slot += 1
+    return finite, slot, nfail
+
+
 @numba.njit(cache=True)
-def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, tol, max_iter, save, out,
-               first_bad, reason, stop):
+def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop):
     """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
-    (code 0), Lie–Heun (code 1) or the implicit midpoint rule (code 2, chord iteration). A failed
-    member gets ``first_bad`` and ``reason``. Returns the number of members that failed."""
+    (code 0) or Lie–Heun (code 1). A failed member gets ``first_bad`` and ``reason``. Returns the
+    number of members that failed."""
     nb, nk, nm = dX.shape
     area = dXX.shape[0] > 0
-    mu = np.empty(6)
-    e = np.empty(6)
-    w0 = np.empty(6)
-    w1 = np.empty(6)
-    s = np.empty(6)
-    a1 = np.empty(6)
-    a2 = np.empty(6)
-    pred = np.empty(6)
-    g = np.empty(6)
-    t1 = np.empty(6)
-    t2 = np.empty(6)
-    new = np.empty(6)
-    L, Dw, J, Ji, W = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12))
-    m1, mid, u = np.empty(6), np.empty(6), np.empty(6)
+    mu, e, w0, w1, s = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
+    a1, a2, pred, g, t1, t2, new = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     nfail = 0
     for p in range(nb):
         for i in range(6):
@@ -254,27 +280,10 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, t
         slot = 0
         for k in range(nk):
             dt = dts[k]
-            for i in range(6):
-                acc = 0.0
-                for r in range(nm):
-                    acc += dX[p, k, r] * xi[r, i]
-                e[i] = acc
-            if area:
-                for r in range(pi.shape[0]):
-                    aij = 0.5 * (dXX[p, k, pi[r], pj[r]] - dXX[p, k, pj[r], pi[r]])
-                    for i in range(6):
-                        e[i] += aij * brk[r, i]
-            finite_in = True
-            for i in range(6):
-                if not (math.isfinite(mu[i]) and math.isfinite(e[i])):
-                    finite_in = False
+            _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e)
             _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
             for i in range(6):
                 s[i] = w0[i] * dt + e[i]
-            conv = True
-            if code == 2 and finite_in:
-                conv = _se3_chord(mu, e, s, dt, q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji, W, g, t1, t2,
-                                  m1, mid, u)
             if code == 1:
                 _ad_star(s, mu, a1)
                 _ad_star(s, a1, a2)
@@ -284,22 +293,52 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, t
                 for i in range(6):
                     s[i] = 0.5 * (w0[i] + w1[i]) * dt + e[i]
             _exp(s, mu, new)
-            finite = conv
+            finite, slot, nf = _finish_step(mu, new, True, True, p, k, first_bad, reason, save, out, slot)
+            nfail += nf
+            if stop and not finite:
+                break
+        for i in range(6):
+            y[p, i] = mu[i]
+    return nfail
+
+
+@numba.njit(cache=True)
+def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
+                        first_bad, reason, stop):
+    """As :func:`_se3_block` for the implicit midpoint rule: sigma from the chord iteration
+    (:func:`_se3_chord`); a member whose iteration fails gets ``reason = CHORD_FAILED``. A separate
+    kernel, so that the explicit schemes do not compile the chord."""
+    nb, nk, nm = dX.shape
+    area = dXX.shape[0] > 0
+    mu, e, w0, s, g, t1, t2, new = (np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6),
+                                    np.empty(6), np.empty(6))
+    L, Dw, J, Ji, W = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12))
+    m1, mid, u = np.empty(6), np.empty(6), np.empty(6)
+    nfail = 0
+    for p in range(nb):
+        for i in range(6):
+            mu[i] = y[p, i]
+        slot = 0
+        for k in range(nk):
+            dt = dts[k]
+            _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e)
+            finite_in = True
             for i in range(6):
-                mu[i] = new[i]
-                if not math.isfinite(new[i]):
-                    finite = False
-            if not finite:
+                if not (math.isfinite(mu[i]) and math.isfinite(e[i])):
+                    finite_in = False
+            conv = True
+            if finite_in:
+                _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
                 for i in range(6):
-                    mu[i] = np.nan
-                if first_bad[p] < 0:
-                    first_bad[p] = k
-                    reason[p] = NON_FINITE if (not finite_in or conv) else CHORD_FAILED
-                    nfail += 1
-            if save[k]:
+                    s[i] = w0[i] * dt + e[i]
+                conv = _se3_chord(mu, e, s, dt, q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji, W, g, t1, t2,
+                                  m1, mid, u)
+                _exp(s, mu, new)
+            else:
                 for i in range(6):
-                    out[p, slot, i] = mu[i]
-                slot += 1
+                    new[i] = np.nan
+            finite, slot, nf = _finish_step(mu, new, conv, finite_in, p, k, first_bad, reason, save, out, slot)
+            nfail += nf
             if stop and not finite:
                 break
         for i in range(6):
@@ -321,9 +360,13 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     out = np.full((nb, int(np.count_nonzero(save)), 6), np.nan)
     first_bad = np.full(nb, -1, dtype=np.int64)
     reason = np.zeros(nb, dtype=np.int8)
-    _se3_block(y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
-               pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64), int(code),
-               data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
-               data["metric_inv"], float(data["theta"]), float(tol), int(max_iter), np.ascontiguousarray(save, dtype=np.bool_),
-               out, first_bad, reason, bool(stop_on_failure))
+    args = (y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
+            pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64))
+    consts = (data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
+              data["metric_inv"], float(data["theta"]))
+    tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
+    if code == 2:
+        _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail)
+    else:
+        _se3_block(*args, int(code), *consts, *tail)
     return y, out, first_bad, reason
