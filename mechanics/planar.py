@@ -94,6 +94,9 @@ class PlanarExample:
         :class:`roughpaths.BrownianDriver`) or with the ``brownian`` blocks of
         :meth:`roughpaths.ColouredNoiseDriver.blocks_with_brownian` (the coupled ``B``).
         """
+        if not isinstance(torque, (bool, np.bool_)):
+            raise TypeError(f"torque must be True (the limit, with N12 S) or False (the plain Stratonovich guess), "
+                            f"got {torque!r}.")
         G = np.einsum("ik,iab->kab", self.limit.scaling, self.noise_matrices)
         return LinearVectorFields(G, self.drift if torque else np.diag([self.lam, self.mu]))
 

@@ -125,6 +125,10 @@ def test_driver_grid_and_limit_fields():
         ex.driver(-0.1, 1.0, seed=0)
     with pytest.raises(TypeError, match="seed"):
         ex.driver(0.1, 1.0, seed=np.random.default_rng(0))
+    with pytest.raises(ValueError, match="T"):
+        ex.driver(0.1, -1.0, seed=0)
+    with pytest.raises(TypeError, match="torque"):
+        planar_limit_moments(ex, X0, T, torque="yes")
 
 
 def test_planar_reduced():
