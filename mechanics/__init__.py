@@ -39,16 +39,13 @@ from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
 from .lie_poisson import LiePoissonSystem, girsanov_shift, levy_velocity
 from .rigid_body import RigidBody, isotropic_xi, rigid_body
 from .wong_zakai import (
-    PlanarExample,
     RigidBodyWongZakai,
     integrate_rigid_body,
     levy_torque,
-    planar_example,
-    planar_limit_moments,
     rigid_body_wong_zakai_limit,
-    simulate_planar_coloured,
     simulate_wong_zakai_rigid_body,
 )
+from .planar import PlanarExample, planar_example, planar_limit_moments
 
 __version__ = "0.1.0"
 
@@ -71,5 +68,4 @@ __all__ = [
     # coloured noise and the Wong–Zakai anomaly
     "levy_torque", "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "integrate_rigid_body",
     "simulate_wong_zakai_rigid_body", "PlanarExample", "planar_example", "planar_limit_moments",
-    "simulate_planar_coloured",
 ]

@@ -30,11 +30,7 @@ the torque enters the conservative part only. The dissipation of (srbcoloured) i
 paper's (srblevy) (whose dissipation uses ``h̃``) — :func:`rigid_body_wong_zakai_limit` exposes both
 (``dissipation_shift``) and the tests tell them apart.
 
-Planar example (paper eq. (2dexample)): ``dx = Qx dt + P(x) y/ε dt`` with ``A = αI + γJ``,
-``D = √δ I``. Fields ``V_1 = (0, x_1)``, ``V_2 = (x_2, 0)`` (columns of ``P``), ``[V_1, V_2] = Sx``,
-``S = diag(1, −1)``. ``M = A⁻¹D = √(δ/(α²+γ²)) R`` with ``R = (αI − γJ)/√(α²+γ²)`` a rotation, so
-``MB = √(δ/(α²+γ²)) W`` with ``W = RB`` a Brownian motion (the paper's scaling is right) and the limit
-is ``dX = (Q + N_{12}S)X dt + √(δ/(α²+γ²)) P(X)∘dW`` with ``N_{12} = δγ/(2α(α²+γ²))``.
+The paper's planar example (2dexample) is in :mod:`mechanics.planar`.
 
 Integrators. All systems are :class:`~mechanics.lie_poisson.LiePoissonSystem` rigid bodies (the
 limit with ``levy_in_dissipation=False``: torque in the conservative term only) integrated by the
@@ -47,13 +43,11 @@ used steps far below ``ε²``); see ``benchmarks/bench_coloured_paper_scale.py``
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
-from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_real, check_rng,
+from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_rng,
                                    check_work)
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
@@ -71,10 +65,6 @@ __all__ = [
     "rigid_body_wong_zakai_limit",
     "integrate_rigid_body",
     "simulate_wong_zakai_rigid_body",
-    "PlanarExample",
-    "planar_example",
-    "planar_limit_moments",
-    "simulate_planar_coloured",
 ]
 
 
@@ -384,137 +374,3 @@ def _coloured_grid(eps, T, h, nrm, n_paths):
                f"n_paths={n_paths}", "use fewer paths, a larger eps, a larger h or a shorter T")
     n_steps = max(1, int(round(steps)))
     return n_steps, T / n_steps
-
-
-# -------------------------------------------------------------------------------- planar example
-@dataclass(frozen=True)
-class PlanarExample:
-    r"""The paper's planar example (2dexample) and its homogenised limit.
-
-    Attributes
-    ----------
-    alpha, gamma, delta, lam, mu : float
-    A, D : ndarray ``(2, 2)``
-        ``αI + γJ`` (``J = [[0, 1], [−1, 0]]``) and ``√δ I``.
-    limit : ColouredNoiseLimit
-    N12 : float
-        ``N[0, 1]`` computed from ``Alt(ΣA⁻ᵀ)``; equals ``δγ/(2α(α²+γ²))`` (:attr:`paper_constant`).
-    paper_constant : float
-        ``δγ/(2α(α²+γ²))`` (the paper's formula).
-    limit_scale : float
-        ``√(δ/(α²+γ²))``: ``A⁻¹D = limit_scale · R`` with ``R`` a rotation.
-    drift : ndarray ``(2, 2)``
-        ``Q + N12 S``, ``S = diag(1, −1) = [V_1, V_2]``.
-    noise_matrices : ndarray ``(2, 2, 2)``
-        ``E_1, E_2`` with ``V_i(x) = E_i x`` (columns of ``P(x)``).
-    """
-
-    alpha: float
-    gamma: float
-    delta: float
-    lam: float
-    mu: float
-    A: np.ndarray
-    D: np.ndarray
-    limit: ColouredNoiseLimit
-    N12: float
-    paper_constant: float
-    limit_scale: float
-    drift: np.ndarray
-    noise_matrices: np.ndarray
-
-
-def planar_example(alpha=1.0, gamma=1.0, delta=1.0, lam=0.0, mu=0.0) -> PlanarExample:
-    r"""Build the planar example ``dx = Qx dt + P(x) y/ε dt``, ``dy = −ε⁻²(αI + γJ)y dt + ε⁻¹√δ dB``.
-
-    Examples
-    --------
-    >>> ex = planar_example(alpha=1.0, gamma=2.0, delta=3.0)
-    >>> round(ex.N12, 12) == round(ex.paper_constant, 12) == round(3 * 2 / (2 * 1 * 5), 12)
-    True
-    """
-    vals = []
-    for name, v in (("alpha", alpha), ("gamma", gamma), ("delta", delta), ("lam", lam), ("mu", mu)):
-        vals.append(check_real(v, name))
-    alpha, gamma, delta, lam, mu = vals
-    if alpha <= 0 or delta <= 0:
-        raise ValueError(f"alpha and delta must be > 0 (alpha is the OU damping, delta the noise variance), "
-                         f"got alpha={alpha!r}, delta={delta!r}.")
-    J = np.array([[0.0, 1.0], [-1.0, 0.0]])
-    A = alpha * np.eye(2) + gamma * J
-    D = math.sqrt(delta) * np.eye(2)
-    lim = coloured_noise_limit(A, D)
-    N12 = float(lim.levy_perturbation[0, 1])
-    E = np.array([[[0.0, 0.0], [1.0, 0.0]], [[0.0, 1.0], [0.0, 0.0]]])
-    S = np.diag([1.0, -1.0])
-    return PlanarExample(alpha=alpha, gamma=gamma, delta=delta, lam=lam, mu=mu, A=A, D=D, limit=lim, N12=N12,
-                         paper_constant=delta * gamma / (2 * alpha * (alpha ** 2 + gamma ** 2)),
-                         limit_scale=math.sqrt(delta / (alpha ** 2 + gamma ** 2)),
-                         drift=np.diag([lam, mu]) + N12 * S, noise_matrices=E)
-
-
-def _check_example(ex):
-    if not isinstance(ex, PlanarExample):
-        raise TypeError(f"ex must be a PlanarExample (from planar_example(...)), got {type(ex).__name__}.")
-
-
-def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
-    r"""Exact ``E[X_T]`` and ``E[X_T X_Tᵀ]`` of the limit ``dX = (Q + N12 S)X dt + Σ_k G_k X∘dB^k``.
-
-    ``G_k = Σ_i M_{ik} E_i`` (``M = A⁻¹D``). Itô drift ``B = Q + N12 S + ½ Σ_k G_k²``;
-    ``E[X_T] = e^{BT}x0``; ``vec E[XXᵀ]`` solves ``d/dt vec P = (I⊗B + B⊗I + Σ_k G_k⊗G_k) vec P``.
-    ``torque=False`` drops ``N12 S`` (the plain Stratonovich guess).
-    """
-    _check_example(ex)
-    x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
-    T = check_positive_real(T, "T", allow_zero=True)
-    M = ex.limit.scaling
-    G = np.einsum("ik,iab->kab", M, ex.noise_matrices)
-    B = (ex.drift if torque else np.diag([ex.lam, ex.mu])) + 0.5 * np.einsum("kab,kbc->ac", G, G)
-    mean = sla.expm(B * T) @ x0
-    I2 = np.eye(2)
-    L = np.kron(I2, B) + np.kron(B, I2) + sum(np.kron(g, g) for g in G)
-    P = (sla.expm(L * T) @ np.outer(x0, x0).reshape(-1)).reshape(2, 2)
-    return mean, P
-
-
-def _expm2_traceless(a, b, c):
-    """expm([[a, b], [c, -a]]) batched (entries arrays)."""
-    q = a * a + b * c
-    r = np.sqrt(np.abs(q))
-    small = r < 1e-6
-    rs = np.where(small, 1.0, r)
-    ch = np.where(q >= 0, np.cosh(rs), np.cos(rs))
-    sh = np.where(q >= 0, np.sinh(rs), np.sin(rs)) / rs
-    ch = np.where(small, 1.0 + q / 2 + q * q / 24, ch)
-    sh = np.where(small, 1.0 + q / 6 + q * q / 120, sh)
-    return ch + sh * a, sh * b, sh * c, ch - sh * a
-
-
-def simulate_planar_coloured(ex: PlanarExample, eps, x0, T, *, n_paths, rng, h=None, substeps=None,
-                             chunk_steps=None):
-    r"""``X_T`` of the coloured planar system, ``n_paths`` samples, shape ``(n_paths, 2)``.
-
-    Strang splitting ``e^{Qh/2} · exp(X^1E_1 + X^2E_2 + L^{12}S) · e^{Qh/2}`` per grid step, where
-    ``exp(...)`` is the exact log-ODE step of the linear fields on the step's level-2 data of ``B^ε``
-    (increment ``X``, Lévy area ``L``). Default grid step ``h = ε²/(2‖A‖)``.
-    """
-    _check_example(ex)
-    rng = check_rng(rng)
-    x0 = as_float_array(x0, "x0", ndim=1, last_dims=(2,))
-    nrm = float(np.linalg.norm(ex.A, 2))
-    n_paths = check_positive_int(n_paths, "n_paths")
-    n_steps, h = _coloured_grid(eps, T, h, nrm, n_paths)
-    check_memory(8.0 * 16 * n_paths, f"the states of n_paths={n_paths} paths", "use fewer paths")
-    x = np.tile(x0, (n_paths, 1))
-    eq = np.exp(np.array([ex.lam, ex.mu]) * h / 2)
-    for inc, area, _, _, _ in iter_coloured_noise(ex.A, ex.D, eps, h, n_steps, rng=rng, n_paths=n_paths,
-                                                  substeps=substeps, chunk_steps=chunk_steps):
-        L12 = 0.5 * (area[..., 0, 1] - area[..., 1, 0])
-        e11, e12, e21, e22 = _expm2_traceless(L12, inc[..., 1], inc[..., 0])
-        for s in range(inc.shape[1]):
-            x = x * eq
-            x = np.stack([e11[:, s] * x[:, 0] + e12[:, s] * x[:, 1], e21[:, s] * x[:, 0] + e22[:, s] * x[:, 1]],
-                         axis=-1)
-            x = x * eq
-    return x

@@ -44,7 +44,8 @@ from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
 from .solvers_level3 import Davie3, LogODE3
 from .signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
                         signature, signature_vjp)
-from .vector_fields import LinearDrift, LinearVectorFields, VectorFields
+from .vector_fields import LinearDrift, VectorFields
+from .linear_fields import LinearVectorFields
 from .tensor_algebra import (
     from_level2,
     from_lyndon_coordinates,

@@ -116,23 +116,48 @@ def test_perturbed_driver_equals_conservative_torque_with_dissipation(method, rn
     assert np.max(np.abs(a - c)) > 1e-3
 
 
+@pytest.mark.parametrize("theta, metric, lid", [(0.7, None, False), (0.0, None, True),
+                                                 (0.4, np.diag([1.0, 2.0, 0.5, 1.5, 1.0, 3.0]), True)],
+                         ids=["dissipative", "conservative", "metric"])
 @pytest.mark.parametrize("levy", [True, False])
-@pytest.mark.parametrize("cls", [LieEuler, LieHeun], ids=lambda c: c.__name__)
-def test_se3_kernel_equals_numpy_scheme(cls, levy):
-    """The compiled se(3) path (chosen by the SE3Algebra type) computes the numpy path's scheme:
-    same system on se(3) built from its structure constants (no compiled path), same driver."""
+@pytest.mark.parametrize("cls", [LieEuler, LieHeun, ImplicitMidpoint], ids=lambda c: c.__name__)
+def test_se3_kernel_equals_numpy_scheme(cls, levy, theta, metric, lid):
+    """The compiled se(3) path (chosen by the SE3Algebra type) computes the numpy path's scheme, also
+    the implicit midpoint's chord iteration: same system on se(3) built from its structure constants
+    (no compiled path), same driver; Casimirs kept to 1e-12."""
     from mechanics.lie_algebra import LieAlgebra, se3, se3_ad_star_exp
     from mechanics.lie_poisson import LiePoissonSystem
-    from roughpaths import BrownianDriver, solve
 
     S3 = np.array([[0, 1.0, -2.0], [-1.0, 0, 0.5], [2.0, -0.5, 0]])
-    top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.4, s=S3, theta=0.7, levy_in_dissipation=False)
+    top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.4, s=S3, theta=theta, metric=metric,
+                    levy_in_dissipation=lid)
     generic = LiePoissonSystem(LieAlgebra(se3().structure_constants, ad_star_exp=se3_ad_star_exp), top.hamiltonian,
-                               top.xi, s=S3, theta=0.7, levy_in_dissipation=False)
+                               top.xi, s=S3, theta=theta, metric=metric, levy_in_dissipation=lid)
     X = BrownianDriver(3, seed=4, dt=0.05, n_steps=40, batch_shape=(5,), levy_area="davie" if levy else None)
     X = X.rough_path()
-    a = solve(top, X, MU0, cls(levy_area=levy)).states
-    b = solve(generic, X, MU0, cls(levy_area=levy)).states
-    np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
-    c0 = top.casimirs(MU0)
-    assert np.max(np.abs(top.casimirs(a[:, -1]) - c0)) <= 1e-12
+    mu0 = MU0 * np.array([[1.0], [0.1], [2.0], [-1.5], [0.5]])
+    a = solve(top, X, mu0, cls(levy_area=levy)).states
+    b = solve(generic, X, mu0, cls(levy_area=levy)).states
+    np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    c0 = top.casimirs(mu0)
+    assert np.max(np.abs(top.casimirs(a[:, -1]) - c0) / np.maximum(1.0, np.abs(c0))) <= 1e-12
+
+
+def test_se3_kernel_chord_failure_is_per_member():
+    """A member whose chord iteration cannot converge (huge momentum, large step) fails alone in the
+    compiled se(3) path: ChordConvergenceError names it; with on_failure="mask" it is marked and the
+    others equal their solo solves bit for bit."""
+    from mechanics.integrators import ChordConvergenceError
+
+    top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.3, theta=0.5)
+    X = BrownianDriver(3, seed=2, dt=0.05, n_steps=10, batch_shape=(4,)).rough_path()
+    mu0 = np.tile(MU0, (4, 1))
+    mu0[1] *= 1e4                                                      # Δt|Ω| ≫ 1: the chord map does not contract
+    with pytest.raises(ChordConvergenceError, match=r"member\(s\) \(1,\)"):
+        solve(top, X, mu0, ImplicitMidpoint(max_iter=20))
+    sol = solve(top, X, mu0, ImplicitMidpoint(max_iter=20), on_failure="mask")
+    assert sol.failed.tolist() == [False, True, False, False] and sol.failed_step[1] == 0
+    for i in (0, 2, 3):
+        alone = solve(top, RoughPath(X.increments[i], X.areas[i], times=X.times, kind="geometric"), mu0[i],
+                      ImplicitMidpoint(max_iter=20))
+        np.testing.assert_array_equal(sol.states[i], alone.states)

@@ -1,13 +1,16 @@
-r"""Compiled se(3) kernels of the explicit coadjoint solvers (quadratic Hamiltonian): an implementation detail.
+r"""Compiled se(3) kernels of the coadjoint solvers (quadratic Hamiltonian): an implementation detail.
 
 Selected by :meth:`~mechanics.integrators.base.CoadjointSolver.integrate` when the algebra is a
 :class:`~mechanics.lie_algebra.SE3Algebra` and the Hamiltonian is quadratic (the heavy top), for
-Lie–Euler and Lie–Heun. Same scheme as the numpy path; state ``μ = (Π, Γ)``, algebra element
+Lie–Euler, Lie–Heun and the implicit midpoint rule (its chord iteration, :mod:`._chord`, with the
+6×6 chord Jacobian inverted per member by Gauss–Jordan elimination with partial pivoting: a singular
+Jacobian fails that member alone). Same scheme as the numpy path; state ``μ = (Π, Γ)``, algebra element
 ``σ = (ω, v)``, :math:`\mathrm{ad}^*_{(\omega,v)}(\Pi,\Gamma) = (\Pi\times\omega + \Gamma\times v,\ \Gamma\times\omega)`
 and the closed-form exponential of :func:`mechanics.lie_algebra.se3_ad_star_exp`
 (:math:`\Gamma' = T\Gamma`, :math:`\Pi' = T(\Pi - (Jv)\times\Gamma)`), with the one small-angle switch
 and Taylor coefficients of :mod:`mechanics.lie_algebra`. Members are independent (a loop over
-members, then over the block's steps); a member that becomes non-finite is marked by itself.
+members, then over the block's steps); a member that becomes non-finite, or whose chord iteration
+fails, is marked by itself (``reason`` NON_FINITE or CHORD_FAILED, as in :mod:`._so3_kernels`).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 from ..lie_algebra import SMALL_ANGLE2, taylor_coefficients
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
+OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
 
 
 @numba.njit(cache=True, inline="always")
@@ -98,24 +102,177 @@ def _exp(s, mu, out):
     out[3], out[4], out[5] = _rot(w0, w1, w2, a, b, g0, g1, g2)
 
 
+@numba.njit(cache=True, inline="always")
+def _hat_into(M, r0, c0, x0, x1, x2, sign):
+    """M[r0:r0+3, c0:c0+3] = sign * hat(x) (hat(x) y = x × y)."""
+    M[r0, c0], M[r0, c0 + 1], M[r0, c0 + 2] = 0.0, -sign * x2, sign * x1
+    M[r0 + 1, c0], M[r0 + 1, c0 + 1], M[r0 + 1, c0 + 2] = sign * x2, 0.0, -sign * x0
+    M[r0 + 2, c0], M[r0 + 2, c0 + 1], M[r0 + 2, c0 + 2] = -sign * x1, sign * x0, 0.0
+
+
 @numba.njit(cache=True)
-def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, stop):
+def _invert6(J, Ji, W):
+    """Ji = J⁻¹ (6×6) by Gauss–Jordan elimination with partial pivoting; False if a pivot is zero or
+    not finite (the member then fails alone). ``W`` is a (6, 12) work array."""
+    for i in range(6):
+        for j in range(6):
+            W[i, j] = J[i, j]
+            W[i, 6 + j] = 1.0 if i == j else 0.0
+    for c in range(6):
+        piv = c
+        best = abs(W[c, c])
+        for r in range(c + 1, 6):
+            v = abs(W[r, c])
+            if v > best:
+                best, piv = v, r
+        if not (best > 0.0 and best < np.inf):
+            return False
+        if piv != c:
+            for j in range(12):
+                W[c, j], W[piv, j] = W[piv, j], W[c, j]
+        inv = 1.0 / W[c, c]
+        for j in range(12):
+            W[c, j] *= inv
+        for r in range(6):
+            if r != c:
+                f = W[r, c]
+                if f != 0.0:
+                    for j in range(12):
+                        W[r, j] -= f * W[c, j]
+    for i in range(6):
+        for j in range(6):
+            v = W[i, 6 + j]
+            if not math.isfinite(v):
+                return False
+            Ji[i, j] = v
+    return True
+
+
+@numba.njit(cache=True)
+def _se3_chord(mu, e, s, dt, q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji, W, g, t1, t2, m1, mid, u):
+    """Chord iteration for the implicit midpoint sigma (in ``s``, started at w(mu) dt + e) on se(3)*.
+
+    ``J = I - dt/2 Dw(mu) L(mu)`` frozen at ``mu``, ``L(mu) δ = ad*_δ mu = [[hat Π, hat Γ], [hat Γ, 0]] δ``,
+    ``Dw = Q + θ M⁻¹ (ad*_{g+f} + L(mu) Q)`` (``g + f`` the gradient inside the double bracket).
+    Returns True if the member converged (``max|Δσ| ≤ tol (1 + |σ|_∞)``), as the numpy chord does.
+    """
+    for i in range(6):
+        for j in range(6):
+            L[i, j] = 0.0
+    _hat_into(L, 0, 0, mu[0], mu[1], mu[2], 1.0)
+    _hat_into(L, 0, 3, mu[3], mu[4], mu[5], 1.0)
+    _hat_into(L, 3, 0, mu[3], mu[4], mu[5], 1.0)
+    for i in range(6):
+        for j in range(6):
+            Dw[i, j] = q[i, j]
+    if theta != 0.0:
+        # ad*_x mu for fixed x = (ω, v) = g + f: (-hat ω Π - hat v Γ, -hat ω Γ)
+        for i in range(6):
+            acc = lin[i] + f[i]
+            for j in range(6):
+                acc += q[i, j] * mu[j]
+            g[i] = acc
+        for i in range(6):
+            for j in range(6):
+                J[i, j] = 0.0
+        _hat_into(J, 0, 0, g[0], g[1], g[2], -1.0)
+        _hat_into(J, 0, 3, g[3], g[4], g[5], -1.0)
+        _hat_into(J, 3, 3, g[0], g[1], g[2], -1.0)
+        for i in range(6):                      # J += L(mu) Q
+            for j in range(6):
+                acc = 0.0
+                for k in range(6):
+                    acc += L[i, k] * q[k, j]
+                J[i, j] += acc
+        for i in range(6):                      # Dw += θ M⁻¹ J
+            for j in range(6):
+                acc = 0.0
+                for k in range(6):
+                    acc += minv[i, k] * J[k, j]
+                Dw[i, j] += theta * acc
+    for i in range(6):                          # J = I - dt/2 Dw L
+        for j in range(6):
+            acc = 0.0
+            for k in range(6):
+                acc += Dw[i, k] * L[k, j]
+            J[i, j] = (1.0 if i == j else 0.0) - 0.5 * dt * acc
+    if not _invert6(J, Ji, W):
+        return False
+    for it in range(max_iter):
+        _exp(s, mu, m1)
+        for i in range(6):
+            if not math.isfinite(m1[i]):
+                return False
+            mid[i] = 0.5 * (mu[i] + m1[i])
+        _velocity(mid, q, lin, f, minv, theta, g, t1, t2, u)
+        for i in range(6):
+            t1[i] = s[i] - u[i] * dt - e[i]
+        err = 0.0
+        smax = 0.0
+        for i in range(6):
+            acc = 0.0
+            for j in range(6):
+                acc += Ji[i, j] * t1[j]
+            t2[i] = acc
+        for i in range(6):
+            s[i] -= t2[i]
+            err = max(err, abs(t2[i]))
+            smax = max(smax, abs(s[i]))
+        if not (math.isfinite(err) and math.isfinite(smax)):
+            return False
+        if err <= tol * (1.0 + smax):
+            return True
+    return False
+
+
+@numba.njit(cache=True, inline="always")
+def _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e):
+    """e = Σ_r dX_r ξ_r + Σ_{r: i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for member p, step k."""
+    nm = dX.shape[2]
+    for i in range(6):
+        acc = 0.0
+        for r in range(nm):
+            acc += dX[p, k, r] * xi[r, i]
+        e[i] = acc
+    if area:
+        for r in range(pi.shape[0]):
+            aij = 0.5 * (dXX[p, k, pi[r], pj[r]] - dXX[p, k, pj[r], pi[r]])
+            for i in range(6):
+                e[i] += aij * brk[r, i]
+
+
+@numba.njit(cache=True, inline="always")
+def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slot):
+    """mu = new (NaN if not ok or not finite; first failure recorded); save it. Returns (finite, slot)."""
+    finite = ok
+    for i in range(6):
+        mu[i] = new[i]
+        if not math.isfinite(new[i]):
+            finite = False
+    nfail = 0
+    if not finite:
+        for i in range(6):
+            mu[i] = np.nan
+        if first_bad[p] < 0:
+            first_bad[p] = k
+            reason[p] = NON_FINITE if (not finite_in or ok) else CHORD_FAILED
+            nfail = 1
+    if save[k]:
+        for i in range(6):
+            out[p, slot, i] = mu[i]
+        slot += 1
+    return finite, slot, nfail
+
+
+@numba.njit(cache=True)
+def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop):
     """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
-    (code 0) or Lie–Heun (code 1). Returns the number of members that failed."""
+    (code 0) or Lie–Heun (code 1). A failed member gets ``first_bad`` and ``reason``. Returns the
+    number of members that failed."""
     nb, nk, nm = dX.shape
     area = dXX.shape[0] > 0
-    mu = np.empty(6)
-    e = np.empty(6)
-    w0 = np.empty(6)
-    w1 = np.empty(6)
-    s = np.empty(6)
-    a1 = np.empty(6)
-    a2 = np.empty(6)
-    pred = np.empty(6)
-    g = np.empty(6)
-    t1 = np.empty(6)
-    t2 = np.empty(6)
-    new = np.empty(6)
+    mu, e, w0, w1, s = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
+    a1, a2, pred, g, t1, t2, new = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     nfail = 0
     for p in range(nb):
         for i in range(6):
@@ -123,16 +280,7 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
         slot = 0
         for k in range(nk):
             dt = dts[k]
-            for i in range(6):
-                acc = 0.0
-                for r in range(nm):
-                    acc += dX[p, k, r] * xi[r, i]
-                e[i] = acc
-            if area:
-                for r in range(pi.shape[0]):
-                    aij = 0.5 * (dXX[p, k, pi[r], pj[r]] - dXX[p, k, pj[r], pi[r]])
-                    for i in range(6):
-                        e[i] += aij * brk[r, i]
+            _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e)
             _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
             for i in range(6):
                 s[i] = w0[i] * dt + e[i]
@@ -145,21 +293,8 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
                 for i in range(6):
                     s[i] = 0.5 * (w0[i] + w1[i]) * dt + e[i]
             _exp(s, mu, new)
-            finite = True
-            for i in range(6):
-                mu[i] = new[i]
-                if not math.isfinite(new[i]):
-                    finite = False
-            if not finite:
-                for i in range(6):
-                    mu[i] = np.nan
-                if first_bad[p] < 0:
-                    first_bad[p] = k
-                    nfail += 1
-            if save[k]:
-                for i in range(6):
-                    out[p, slot, i] = mu[i]
-                slot += 1
+            finite, slot, nf = _finish_step(mu, new, True, True, p, k, first_bad, reason, save, out, slot)
+            nfail += nf
             if stop and not finite:
                 break
         for i in range(6):
@@ -167,10 +302,54 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
     return nfail
 
 
-def integrate_se3(system, code, y, dX, dXX, dts, save, stop_on_failure):
+@numba.njit(cache=True)
+def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
+                        first_bad, reason, stop):
+    """As :func:`_se3_block` for the implicit midpoint rule: sigma from the chord iteration
+    (:func:`_se3_chord`); a member whose iteration fails gets ``reason = CHORD_FAILED``. A separate
+    kernel, so that the explicit schemes do not compile the chord."""
+    nb, nk, nm = dX.shape
+    area = dXX.shape[0] > 0
+    mu, e, w0, s, g, t1, t2, new = (np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6),
+                                    np.empty(6), np.empty(6))
+    L, Dw, J, Ji, W = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12))
+    m1, mid, u = np.empty(6), np.empty(6), np.empty(6)
+    nfail = 0
+    for p in range(nb):
+        for i in range(6):
+            mu[i] = y[p, i]
+        slot = 0
+        for k in range(nk):
+            dt = dts[k]
+            _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e)
+            finite_in = True
+            for i in range(6):
+                if not (math.isfinite(mu[i]) and math.isfinite(e[i])):
+                    finite_in = False
+            conv = True
+            if finite_in:
+                _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
+                for i in range(6):
+                    s[i] = w0[i] * dt + e[i]
+                conv = _se3_chord(mu, e, s, dt, q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji, W, g, t1, t2,
+                                  m1, mid, u)
+                _exp(s, mu, new)
+            else:
+                for i in range(6):
+                    new[i] = np.nan
+            finite, slot, nf = _finish_step(mu, new, conv, finite_in, p, k, first_bad, reason, save, out, slot)
+            nfail += nf
+            if stop and not finite:
+                break
+        for i in range(6):
+            y[p, i] = mu[i]
+    return nfail
+
+
+def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
     """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
 
-    Returns ``(y, saved (B, S, 6), first_bad (B,))``.
+    Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``.
     """
     data = system.quadratic_velocity_data()
     nb = y.shape[0]
@@ -180,9 +359,14 @@ def integrate_se3(system, code, y, dX, dXX, dts, save, stop_on_failure):
     y = np.array(y, dtype=np.float64, order="C")
     out = np.full((nb, int(np.count_nonzero(save)), 6), np.nan)
     first_bad = np.full(nb, -1, dtype=np.int64)
-    _se3_block(y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
-               pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64), int(code),
-               data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
-               data["metric_inv"], float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out, first_bad,
-               bool(stop_on_failure))
-    return y, out, first_bad
+    reason = np.zeros(nb, dtype=np.int8)
+    args = (y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
+            pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64))
+    consts = (data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
+              data["metric_inv"], float(data["theta"]))
+    tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
+    if code == 2:
+        _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail)
+    else:
+        _se3_block(*args, int(code), *consts, *tail)
+    return y, out, first_bad, reason

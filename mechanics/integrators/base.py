@@ -36,7 +36,7 @@ discrete Proposition 2.1.
 
 Implementation: for a :class:`~mechanics.lie_algebra.SO3Algebra` with a quadratic Hamiltonian,
 :meth:`CoadjointSolver.integrate` runs compiled block kernels (:mod:`mechanics.integrators._so3_kernels`),
-for an :class:`~mechanics.lie_algebra.SE3Algebra` (the heavy top) with the explicit schemes those of
+for an :class:`~mechanics.lie_algebra.SE3Algebra` (the heavy top) those of
 :mod:`mechanics.integrators._se3_kernels`; otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
 :func:`roughpaths.expm_batched` per member otherwise). Either way a batch member's result depends
 on its own data only; a member that fails is reported through ``first_bad`` (contract item 8).
@@ -169,7 +169,7 @@ class CoadjointSolver(Solver):
         return self._advance(fields, y, float(dt), self._eta(fields, dX, dXX))[0]
 
     def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
-        """Advance a block of steps (contract item 8); compiled so(3) kernels where they apply.
+        """Advance a block of steps (contract item 8); compiled so(3)/se(3) kernels where they apply.
 
         Raises :class:`ChordConvergenceError` (with ``stop_on_failure``) when a member's chord
         iteration fails; other failures are reported through ``first_bad``.
@@ -189,17 +189,18 @@ class CoadjointSolver(Solver):
                 getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
             y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
             first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
-        elif isinstance(system.algebra, SE3Algebra) and system.hamiltonian.is_quadratic and self._code in (0, 1):
+        elif isinstance(system.algebra, SE3Algebra) and system.hamiltonian.is_quadratic:
             nb = int(np.prod(batch, dtype=np.int64))
             d = dX.shape[-1]
             dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
             if dXX is not None:
                 dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
                                            dtype=np.float64)
-            y2, saved, first_bad = _se3_kernels.integrate_se3(system, self._code, y.reshape(nb, n), dX, dXX, dts,
-                                                              save, stop_on_failure)
+            y2, saved, first_bad, reason = _se3_kernels.integrate_se3(
+                system, self._code, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1), y.reshape(nb, n), dX,
+                dXX, dts, save, stop_on_failure)
             y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
-            chord = np.zeros(batch, dtype=bool)
+            chord = (reason == _se3_kernels.CHORD_FAILED).reshape(batch)
         else:
             saved = np.full(batch + (nsave, n), np.nan)
             first_bad = np.full(batch, -1, dtype=np.int64)
