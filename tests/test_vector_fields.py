@@ -190,3 +190,35 @@ def test_linear_fast_paths_agree_with_generic_fields(rng):
     # LogODE: exact exponential vs 32 inner RK4 steps of the same generator
     np.testing.assert_allclose(solve(lin, X, y0, LogODE()).states, solve(gen, X, y0, LogODE(inner_steps=32)).states,
                                rtol=1e-8, atol=1e-8)
+
+
+def _expm_longdouble(a):
+    """A naive oracle: Taylor series in 80-bit long double with scaling and squaring."""
+    A = np.asarray(a, dtype=np.longdouble)
+    s = max(0, int(np.ceil(np.log2(max(float(np.abs(A).sum(axis=0).max()), 1e-300)))) + 4)
+    A = A / np.longdouble(2) ** s
+    term = np.eye(A.shape[0], dtype=np.longdouble)
+    out = term.copy()
+    for k in range(1, 40):
+        term = term @ A / k
+        out = out + term
+    for _ in range(s):
+        out = out @ out
+    return out.astype(np.float64)
+
+
+@pytest.mark.parametrize("scale", [1e-9, 1e-3, 0.03, 0.3, 1.0, 5.0, 20.0])
+def test_expm_2x2_closed_form_against_a_long_double_series(scale):
+    """2x2 members take a closed form (cosh/sinh or cos/sin of sqrt(q), a series near q = 0); it must be
+    accurate to a few ulps of the largest entry on both sides of every branch switch."""
+    rng = np.random.default_rng(int(scale * 1e3) + 1)
+    A = rng.standard_normal((40, 2, 2)) * scale
+    # members on both sides of the series switch |q| = 1e-3 and at q = 0 exactly (nilpotent N)
+    A[0] = [[0.0, 1.0], [0.0, 0.0]]
+    A[1] = [[0.5, 2e-4 * 0.999], [1.0, 0.5]]
+    A[2] = [[0.5, 2e-4 * 1.001], [1.0, 0.5]]
+    A[3] = [[0.5, -2e-4 * 1.001], [1.0, 0.5]]
+    got = expm_batched(A)
+    for a, g in zip(A, got):
+        ref = _expm_longdouble(a)
+        assert np.max(np.abs(g - ref)) <= 8e-16 * max(1.0, np.max(np.abs(ref))) * max(1.0, np.abs(a).sum()), a
