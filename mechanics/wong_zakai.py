@@ -52,7 +52,7 @@ from roughpaths.validation import (as_float_array, check_memory, check_positive_
 from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
 from roughpaths.rough_path import RoughPath
 
-from roughpaths import solve
+from roughpaths import Solution, solve
 
 from .integrators import CoadjointSolver, LieHeun
 from .lie_algebra import so3
@@ -291,9 +291,10 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
 
     Returns
     -------
-    dict
-        ``"times"`` ``(K,)``, ``"h"``, ``"n_steps"``, per system the saved states ``(n_paths, K, 3)``,
-        and ``"final"``: per system the states at ``T``, ``(n_paths, 3)``.
+    dict of str to roughpaths.Solution
+        Per system in ``systems``, a :class:`~roughpaths.Solution` (as :func:`roughpaths.solve`
+        returns): ``times`` every ``save_every``-th grid time and ``T``, ``states`` ``(n_paths, K, 3)``,
+        ``final`` the states at ``T``; ``stats`` holds ``h``, ``n_steps`` and the solver.
     """
     wz = rigid_body_wong_zakai_limit(A, D, sigma)
     rng = check_rng(rng)
@@ -318,7 +319,10 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     method = _check_method(method)
     inertia = _check_inertia3(inertia)
     P0 = as_float_array(Pi0, "Pi0", ndim=1, last_dims=(3,))
-    K = n_steps // save_every + 1
+    saved_idx = np.arange(0, n_steps + 1, save_every)
+    if saved_idx[-1] != n_steps:                       # T is always saved (Solution.final is the state at T)
+        saved_idx = np.append(saved_idx, n_steps)
+    K = saved_idx.size
     M = wz.limit.scaling
     if wz.perturbation_B is not None:          # the limit's noise vectors σ M[:, k], driven by B
         lxi, ls, lmap = wz.limit_xi, wz.perturbation_B, None
@@ -350,17 +354,18 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
                 binc, barea = binc @ lmap.T, lmap @ barea @ lmap.T
             XB = RoughPath(binc, barea, times=times, kind="geometric", check=False)
         j = np.arange(done + 1, done + S + 1)
-        keep = j % save_every == 0
+        keep = (j % save_every == 0) | (j == n_steps)
+        slots = np.searchsorted(saved_idx, j[keep])
         for k in systems:
             system, use_b = cfg[k]
             st = solve(system, XB if use_b else X, state[k], method).states          # (P, S + 1, 3)
-            out[k][:, j[keep] // save_every] = st[:, 1:][:, keep]
+            out[k][:, slots] = st[:, 1:][:, keep]
             state[k] = st[:, -1].copy()
         done += S
-    res = {"times": np.arange(K) * h * save_every, "h": h, "n_steps": n_steps}
-    res.update(out)
-    res["final"] = state
-    return res
+    times = saved_idx * h
+    stats = {"solver": repr(method), "n_steps": n_steps, "h": h, "batch_shape": (n_paths,)}
+    return {k: Solution(times=times, states=out[k], failed_step=np.full(n_paths, -1), stats=dict(stats))
+            for k in systems}
 
 
 def _coloured_grid(eps, T, h, nrm, n_paths):

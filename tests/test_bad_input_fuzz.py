@@ -307,7 +307,7 @@ M = [
     ("gibbs_beta", lambda **k: m.gibbs_beta(**k), dict(sigma=0.5, theta=1.0), dict(sigma="real", theta="real")),
     ("GibbsMeasure", lambda **k: m.GibbsMeasure(**k).beta, dict(inertia=I3, beta=1.0),
      dict(inertia="array", beta="real", radius="real", rtol="real", c="array")),
-    ("simulate_wong_zakai_rigid_body", lambda **k: m.simulate_wong_zakai_rigid_body(**k)["final"],
+    ("simulate_wong_zakai_rigid_body", lambda **k: {n: s.final for n, s in m.simulate_wong_zakai_rigid_body(**k).items()},
      dict(A=A3, D=D3, eps=0.5, sigma=0.1, T=0.05, n_paths=2, rng=np.random.default_rng(0), systems=("limit",)),
      dict(A="array", eps="tiny", sigma="real0", T="real", h="real", n_paths="count", rng="rng",
           systems="choice", save_every="count", Pi0="array", inertia="array")),

@@ -107,7 +107,7 @@ def test_shared_integrator_agrees_with_a_naive_strang_splitting(rng):
 def _run(eps, P, seed, T=1.0):
     r = simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, T=T, n_paths=P, rng=np.random.default_rng(seed),
                                        save_every=10 ** 9, systems=("coloured", "limit", "no_torque", "srblevy"))
-    return r["final"]
+    return {k: sol.final for k, sol in r.items()}
 
 
 def _paired(fin, other):

@@ -64,7 +64,7 @@ print("Lévy torque of the limit:", wz.torque)
 n_paths = 600 if SMALL else 2000
 r = simulate_wong_zakai_rigid_body(A, D, 0.02, 0.05, T=2.0, n_paths=n_paths, rng=rng, save_every=10**9,
                                    systems=("coloured", "limit", "no_torque"))
-col, lim_, nt = (r["final"][k] for k in ("coloured", "limit", "no_torque"))
+col, lim_, nt = (r[k].final for k in ("coloured", "limit", "no_torque"))
 for name, other in (("limit with torque", lim_), ("limit without torque", nt)):
     diff = col - other
     m, s = diff.mean(axis=0), diff.std(axis=0, ddof=1) / np.sqrt(n_paths)

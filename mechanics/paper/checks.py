@@ -400,7 +400,7 @@ def check_wong_zakai(ctx) -> CheckResult:
     r = mechanics.simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, inertia=INERTIA, theta=THETA, Pi0=E3, T=T,
                                                  n_paths=P, rng=ctx.rng("wong_zakai"), save_every=10**9,
                                                  systems=("coloured", "limit", "no_torque"))
-    col, lim, nt = r["final"]["coloured"], r["final"]["limit"], r["final"]["no_torque"]
+    col, lim, nt = r["coloured"].final, r["limit"].final, r["no_torque"].final
     d_lim, d_nt = col - lim, col - nt
     g_lim, se_lim = d_lim.mean(axis=0), standard_error(d_lim)
     g_nt, se_nt = d_nt.mean(axis=0), standard_error(d_nt)
@@ -414,7 +414,7 @@ def check_wong_zakai(ctx) -> CheckResult:
         predicted="E[Π_col − Π_lim] = 0 (up to O(ε))", measured=g_lim,
         tolerance="coloured − limit within 4 paired SE; coloured − no-torque beyond 4 paired SE",
         passed=z_lim <= 4 and z_nt > 4,
-        details=f"{P} paths, ε = {eps:g}, h = {r['h']:.3g}; coloured − limit: {np.round(g_lim, 5)} (max {z_lim:.2f} SE); "
+        details=f"{P} paths, ε = {eps:g}, h = {r['coloured'].stats['h']:.3g}; coloured − limit: {np.round(g_lim, 5)} (max {z_lim:.2f} SE); "
                 f"coloured − no torque: {np.round(g_nt, 5)} (max {z_nt:.1f} SE)")
 
 

@@ -307,12 +307,12 @@ def fig4(ctx) -> FigureResult:
     res, T = run["res"], run["T"]
     fig = new_figure(figsize=(18, 5.6), layout="constrained")
     gs = fig.add_gridspec(1, 3)
-    H, frac = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["coloured"][0], res["times"], T,
+    H, frac = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["coloured"].states[0], res["coloured"].times, T,
                       f"coloured, ε = {run['eps']:g}")
-    fig.suptitle(f"Figure 4: coloured noise, k = {K_PAPER:g}, ε = {run['eps']:g}, T = {T:g}, step h = {res['h']:.3g}",
+    fig.suptitle(f"Figure 4: coloured noise, k = {K_PAPER:g}, ε = {run['eps']:g}, T = {T:g}, step h = {res['coloured'].stats['h']:.3g}",
                  fontsize=11)
-    return _result(ctx, "fig4", fig, dict(times=res["times"], coloured=res["coloured"][0], eps=run["eps"], T=T,
-                                            h=res["h"], A=run["A"], D=run["D"], density=H,
+    return _result(ctx, "fig4", fig, dict(times=res["coloured"].times, coloured=res["coloured"].states[0], eps=run["eps"], T=T,
+                                            h=res["coloured"].stats["h"], A=run["A"], D=run["D"], density=H,
                                             fraction_near_e2=frac))
 
 
@@ -329,11 +329,11 @@ def fig5(ctx) -> FigureResult:
     fig = new_figure(figsize=(18, 11), layout="constrained")
     gs = fig.add_gridspec(2, 3)
     c = run["wz"].torque
-    H1, f1 = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["limit"][0], res["times"], T, "limit with torque")
-    H2, f2 = _wz_row(fig, [gs[1, 0], gs[1, 1], gs[1, 2]], res["no_torque"][0], res["times"], T, "limit, no torque")
+    H1, f1 = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["limit"].states[0], res["limit"].times, T, "limit with torque")
+    H2, f2 = _wz_row(fig, [gs[1, 0], gs[1, 1], gs[1, 2]], res["no_torque"].states[0], res["no_torque"].times, T, "limit, no torque")
     fig.suptitle(f"Figure 5: white-noise limit, noise σA⁻¹D, torque c = ({', '.join(f'{v + 0.0:+.4g}' for v in c)}), "
                  f"N¹³ = {run['wz'].limit.N[0, 2]:.4g}, T = {T:g}", fontsize=11)
-    return _result(ctx, "fig5", fig, dict(times=res["times"], limit=res["limit"][0], no_torque=res["no_torque"][0],
-                                            srblevy=res["srblevy"][0], torque=c, N=run["wz"].limit.N,
+    return _result(ctx, "fig5", fig, dict(times=res["limit"].times, limit=res["limit"].states[0], no_torque=res["no_torque"].states[0],
+                                            srblevy=res["srblevy"].states[0], torque=c, N=run["wz"].limit.N,
                                             limit_xi=run["wz"].limit_xi, density_limit=H1, density_no_torque=H2,
                                             fraction_near_e2_limit=f1, fraction_near_e2_no_torque=f2))
