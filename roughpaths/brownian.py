@@ -439,6 +439,17 @@ class BrownianDriver(SeededDriver):
         return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
                 f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
 
+    def refine(self, factor):
+        """The same Brownian path on the grid with every step split into ``factor`` equal sub-steps.
+
+        Returns a lazy :class:`~roughpaths.brownian_refined.RefinedBrownianDriver` (what is exact and what
+        is approximate, per ``levy_area``: :mod:`roughpaths.brownian_refined`); this driver's numbers are
+        unchanged, the refinement draws from its own per-path streams.
+        """
+        from .brownian_refined import RefinedBrownianDriver
+
+        return RefinedBrownianDriver(self, factor)
+
     # ------------------------------------------------------------------ generation
     def blocks(self, max_steps=None):
         """Yield consecutive ``RoughPath`` blocks of at most ``max_steps`` steps covering the grid.
