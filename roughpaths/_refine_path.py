@@ -60,6 +60,13 @@ def _outer_sum(X, Y):
     return np.swapaxes(X, -1, -2) @ Y
 
 
+def _psd_sqrt(lam, V):
+    """``V diag(√λ)`` with round-off eigenvalues (below 1e-12 of the largest) set to zero: the directions a
+    conditioning fixes exactly (e.g. sums of fine increments) get no noise."""
+    top = float(lam.max()) if lam.size else 0.0
+    return V * np.sqrt(np.where(lam > 1e-12 * top, lam, 0.0))
+
+
 # ------------------------------------------------------------------ plans (per coarse step length)
 class _FourierPlan:
     """Constants of the Fourier-path refinement of steps of length ``h`` into ``F`` sub-steps."""
@@ -90,7 +97,7 @@ class _FourierPlan:
         self.rem_gain = c / self.var_SK if F > 1 else c
         cond = cov - np.outer(c, c) / self.var_SK if F > 1 else cov
         lam, V = np.linalg.eigh(cond) if F > 1 else (np.zeros(0), np.zeros((0, 0)))
-        self.rem_sqrt = V * np.sqrt(np.clip(lam, 0.0, None))
+        self.rem_sqrt = _psd_sqrt(lam, V)
         self.fine = fine                                                # (method, n, width) at δ = h/F
         M = K - n
         p = d * (d - 1) // 2
@@ -130,7 +137,7 @@ class _BridgePlan:
         self.gain = np.linalg.solve(Scc, Sfc.T).T          # (2F-1, 2m)
         cond = Sff - self.gain @ Sfc.T
         lam, V = np.linalg.eigh(0.5 * (cond + cond.T))
-        self.sqrt = V * np.sqrt(np.clip(lam, 0.0, None))
+        self.sqrt = _psd_sqrt(lam, V)
         p = d * (d - 1) // 2
         self.width = (2 * F - 1) * d + (F * p if davie else 0)
 
