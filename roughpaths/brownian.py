@@ -442,9 +442,9 @@ class BrownianDriver(SeededDriver):
     def refine(self, factor):
         """The same Brownian path on the grid with every step split into ``factor`` equal sub-steps.
 
-        Returns a lazy :class:`~roughpaths.brownian_refined.RefinedBrownianDriver` (what is exact and what
-        is approximate, per ``levy_area``: :mod:`roughpaths.brownian_refined`); this driver's numbers are
-        unchanged, the refinement draws from its own per-path streams.
+        Returns a lazy ``RefinedBrownianDriver`` (module ``roughpaths.brownian_refined``, which states what
+        is exact and what is approximate per ``levy_area``); this driver's numbers are unchanged, the
+        refinement draws from its own per-path streams. ``factor == 1`` gives this driver's path itself.
         """
         from .brownian_refined import RefinedBrownianDriver
 
