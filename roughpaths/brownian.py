@@ -440,14 +440,9 @@ class BrownianDriver(SeededDriver):
                 f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
 
     def refine(self, factor):
-        """The same Brownian path on the grid with every step split into ``factor`` equal sub-steps.
-
-        Returns a lazy ``RefinedBrownianDriver`` (module ``roughpaths.brownian_refined``, which states what
-        is exact and what is approximate per ``levy_area``); this driver's numbers are unchanged, the
-        refinement draws from its own per-path streams. ``factor == 1`` gives this driver's path itself.
-        """
+        """The same Brownian path with every step split into ``factor`` equal sub-steps: a lazy driver whose
+        exactness, per ``levy_area``, is stated in ``roughpaths.brownian_refined`` (own per-path streams)."""
         from .brownian_refined import RefinedBrownianDriver
-
         return RefinedBrownianDriver(self, factor)
 
     # ------------------------------------------------------------------ generation

@@ -114,7 +114,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
       area, as in the true conditional law given ``(W, L)``, which is not Gaussian either);
     * higher moments (the fine Lévy areas are lighter-tailed than Brownian ones);
     * for ``factor > 2`` the steps are refined in one go by the construction of
-      :mod:`roughpaths.brownian_refined` for a step whose only data are ``(W, L)`` (as for
+      ``roughpaths.brownian_refined`` for a step whose only data are ``(W, L)`` (as for
       ``levy_area="exact"``: Fourier terms drawn given the area by Gibbs sweeps of exact Gaussian
       updates, fine areas conditioned on Chen's identity the same way), which keeps the fine Lévy-area
       variance and fourth moment Brownian within sampling error
@@ -189,7 +189,7 @@ def _assemble(dw, A, fine_t, X, d):
 
 
 def _refine_by_fourier_path(W, L, h, m, rng):
-    """``factor > 2``: the construction of :mod:`roughpaths.brownian_refined` with no stored Fourier terms.
+    """``factor > 2``: the construction of ``roughpaths.brownian_refined`` with no stored Fourier terms.
 
     Rows ``W (R, d)``, Lévy areas ``L (R, d, d)``, step lengths ``h (R,)``; returns ``(R, m, d)`` increments
     and ``(R, m, d, d)`` Lévy areas. The normals are drawn from ``rng`` per distinct step length, in row order.

@@ -57,10 +57,14 @@ What is approximate, and why: the coarse tail area is a Gaussian (the method's o
 terms beyond ``K`` enter the conditioning as a Gaussian slack (the path they add at the sub-grid points is
 exact given their sum); the Gibbs sweeps are finite; the fine areas have the fine method's law error. So
 the joint law of the fine increments and areas is the Brownian one up to the coarse and fine methods'
-stated errors. Measured (``tests/test_brownian_refinement_same_path.py``, 10⁵–2·10⁵ fine areas): the
-fine Lévy areas' variance :math:`\delta^2/4` and fourth moment :math:`5\delta^4/16` are reproduced
-within 4 standard errors (about 1 % and 3 %) for factors 2, 3, 8 and 64, ``d = 2, 3``; the sequential
-splits of :func:`roughpaths.brownian.refine` inflated the variance by 7–18 %.
+stated errors. Measured (``tests/test_brownian_refinement_same_path.py``, 1–2·10⁵ fine areas per case,
+coarse error :math:`h^{3/2}/4`): the fine Lévy areas' variance :math:`\delta^2/4` and fourth moment
+:math:`5\delta^4/16` are reproduced within 4 standard errors (about 1 % and 3 % of the values) for
+factors 2, 3, 8 and 64, ``d = 2, 3``, where the former sequential splits of ``refine(X, F, rng)`` (which
+now uses this construction for ``F > 2``) inflated the variance by 7–18 %. At the default error
+:math:`h^{3/2}` with ``h = 1/16`` (one or two retained terms), ``d = 3``, ``F = 8``, the fine variance
+comes out 1–2 % high: the coarse method's Gaussian tail shows. Cost: about ``14 F d`` normals and
+``O(F^2)`` operations per coarse step; refine by up to ~100 at once.
 
 Refinement of ``"davie"`` / ``"foster"``
 ----------------------------------------
@@ -69,9 +73,11 @@ What those samplers draw of the path is linear: the increments and the space-tim
 is the exact Gaussian bridge given them (the fine increments and fine space-time areas, from their
 closed-form joint covariance), and the fine areas are drawn by the same method (one sub-step per fine
 step): :math:`H_l\wedge w_l` (+ Davie's independent Gaussian of variance :math:`\delta^2/12`). The coarse
-area is *not* the area of the refined path (Davie's added Gaussian, or Foster's missing part, is
-independent of the path): Chen's identity fails by exactly that amount, which is why "davie" areas give
-strong order ½ against Brownian motion.
+area is *not* the area of the refined path: Davie's added Gaussian is independent of the path, and
+Foster's conditional mean lacks the path's own residual. The Chen defect (coarse area minus the Chen sum
+of the fine ones) has mean square :math:`h^2/6` (davie) and :math:`h^2(1 - 1/F)/12` (foster) per
+component, their stated L² errors, which is why "davie" areas give strong order ½ against Brownian
+motion. ``factor = 1`` returns the coarse path itself.
 
 Streams: path ``i`` draws the refinement's normals from ``SeedSequence(S.entropy, spawn_key=S.spawn_key
 + (i, 2))`` (the coarse driver uses ``(i, 0)`` and ``(i, 1)``), a fixed number per coarse step, steps in
