@@ -12,8 +12,8 @@ reference falls to about ½ (asserted: below 0.7).
 Strong error: root mean square over paths of :math:`|Y_T - Y_T^{\text{ref}}|`; order: slope of
 ``log error`` against ``log h`` (least squares). Reduced run (default suite): ``h = 1/8 … 1/64``, 160 paths, ``F = 4``, order within 0.15 (seeds
 3, 4, 5 gave 0.99/0.99, 1.02/1.03, 0.99/0.97 for Davie/LogODE and 0.54, 0.55, 0.53 with Davie's areas);
-full run (``slow``): ``h = 1/4 … 1/4096``, three decades. Measured (full, 64 paths, ``F = 16``): see
-``docs/strong_order_one.md``.
+full run (``slow``): ``h = 1/4 … 1/4096``, three decades, 64 paths, ``F = 16``: measured Davie 0.98,
+LogODE 1.00, Davie's areas 0.52 (about 20 minutes on the shared machine).
 """
 
 import numpy as np
