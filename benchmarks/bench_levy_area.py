@@ -151,6 +151,7 @@ def main(argv=None):
     p.add_argument("--quick", action="store_true", help="small sizes (smoke run, numbers not meaningful)")
     p.add_argument("--sigma", type=float, default=0.3)
     p.add_argument("--dims", type=int, nargs="+", default=[2, 3, 5])
+    p.add_argument("--throughput-only", action="store_true", help="skip the work-precision part")
     args = p.parse_args(argv)
     q = args.quick
     args.paths, args.batch, args.repeats = (16, 50, 1) if q else (64, 1000, 3)
@@ -158,7 +159,8 @@ def main(argv=None):
     args.n_max, args.n_max_heun, args.n_time_max = (64, 64, 4096) if q else (512, 512, 65536)
     args.steps = 100 if q else 1000
     t0 = time.perf_counter()
-    work_precision(args)
+    if not args.throughput_only:
+        work_precision(args)
     throughput(args)
     print(f"\ntotal {time.perf_counter() - t0:.0f} s")
     return 0
