@@ -81,7 +81,9 @@ motion. ``factor = 1`` returns the coarse path itself.
 
 Streams: path ``i`` draws the refinement's normals from ``SeedSequence(S.entropy, spawn_key=S.spawn_key
 + (i, 2))`` (the coarse driver uses ``(i, 0)`` and ``(i, 1)``), a fixed number per coarse step, steps in
-order: invariant under block size, :meth:`select` and executor.
+order: invariant under block size, :meth:`select` and executor. Refinements by different factors are
+each consistent with the coarse driver, not with one another (``refine(4)`` is not a refinement of
+``refine(2)``); for nested grids take the finest and restrict it (``RoughPath.restrict``: exact Chen sums).
 """
 
 from __future__ import annotations
