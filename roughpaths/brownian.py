@@ -440,6 +440,12 @@ class BrownianDriver(SeededDriver):
         return (f"BrownianDriver(dim={self.dim}, n_steps={self.n_steps}, batch_shape={self.batch_shape}, "
                 f"levy_area={self.levy_area!r}, substeps={self.substeps}, kind={self.kind!r})")
 
+    def refine(self, factor):
+        """The same Brownian path with every step split into ``factor`` equal sub-steps: a lazy driver whose
+        exactness, per ``levy_area``, is stated in ``roughpaths.brownian_refined`` (own per-path streams)."""
+        from .brownian_refined import RefinedBrownianDriver
+        return RefinedBrownianDriver(self, factor)
+
     # ------------------------------------------------------------------ generation
     def blocks(self, max_steps=None):
         """Yield consecutive ``RoughPath`` blocks of at most ``max_steps`` steps covering the grid.

@@ -90,7 +90,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
 
     Notes
     -----
-    The step ``[0, h]`` is cut by successive binary splits ``h = δ + (h - δ)``. One split of a
+    ``factor = 2``: one split. A split of a
     step with increment ``W`` and Lévy area ``L`` draws the bridge point
     ``b = w_1 - ρW ~ N(0, ρ(1-ρ)h I)`` and Davie-type Lévy areas ``L_k = H_k ∧ w_k + λ_k`` for both
     parts, then corrects ``(b, L_1, L_2)`` by the linear (Matheron / Kalman) update
@@ -113,16 +113,15 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     * the fine increments are not exactly Gaussian given ``W`` (they are correlated with the coarse
       area, as in the true conditional law given ``(W, L)``, which is not Gaussian either);
     * higher moments (the fine Lévy areas are lighter-tailed than Brownian ones);
-    * for ``factor > 2``, second moments: each later split treats the previous split's output as if
-      it had the Brownian conditional law given its increment, which it has only on average. The
-      fine Lévy-area variance comes out too large: measured (d = 3, 2·10⁵ paths) by +7 % for
-      ``factor = 3``, +11 % for 4, +18 % for 8 (repeated halving is worse: +12 % at 4, +21 % at 8).
-      The fine increments keep the bridge covariance to sampling error (< 1 %), but explain too
-      little of the coarse area: the polygon through the refined points has Lévy-area variance
-      9 % (factor 4) / 5 % (factor 16) below the Brownian ``(1 - 1/m) h²/4``. A few
-      preconditioned Crank–Nicolson Metropolis sweeps on the increments (target: the bridge
-      conditioned on the coarse area under the Davie model) remove this bias (40 sweeps: +0.8 %
-      at ``factor = 8``), but cost ~40 times more; not done here.
+    * for ``factor > 2`` the steps are refined in one go by the construction of
+      ``roughpaths.brownian_refined`` for a step whose only data are ``(W, L)`` (as for
+      ``levy_area="exact"``: Fourier terms drawn given the area by Gibbs sweeps of exact Gaussian
+      updates, fine areas conditioned on Chen's identity the same way), which keeps the fine Lévy-area
+      variance and fourth moment Brownian within sampling error
+      (``tests/test_brownian_refinement_same_path.py``); the former sequential splits inflated the
+      variance by 7 % (factor 3) to 18 % (factor 8). Repeated halving (``refine`` by 2, again and
+      again) still compounds the factor-2 split's approximation: +12 % at 4, +21 % at 8; refine by the
+      whole factor at once instead.
 
     Itô paths are converted to Stratonovich (``+ ½ h I``), refined, and converted back.
 
@@ -157,6 +156,12 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     W = X.increments.reshape(-1, d)
     hr = np.broadcast_to(h, batch + (N,)).reshape(-1)
     L = X.step_levy_areas.reshape(-1, d, d) if with_area else None
+    if m > 2 and with_area:
+        dw, A = _refine_by_fourier_path(W, L, hr, m, rng)
+        dw = dw.reshape(batch + (N * m, d))
+        A = A.reshape(batch + (N * m, d, d))
+        fine_t = np.append((t[:-1, None] + h[:, None] * (np.arange(m) / m)).reshape(-1), t[-1])
+        return _assemble(dw, A, fine_t, X, d)
     ws, Ls = [], []
     rest_W, rest_L, rest_h = W, L, hr
     for j in range(m - 1):
@@ -172,8 +177,34 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     if not with_area:
         return RoughPath(dw, None, times=fine_t, x0=X.x0, check=False)
     A = np.stack(Ls, axis=1).reshape(batch + (N * m, d, d))
+    return _assemble(dw, A, fine_t, X, d)
+
+
+def _assemble(dw, A, fine_t, X, d):
     areas = A + 0.5 * outer(dw, dw)
     if X.kind == "ito":
         fine_h = np.diff(fine_t)
         areas[..., np.arange(d), np.arange(d)] -= 0.5 * fine_h[:, None]
     return RoughPath(dw, areas, times=fine_t, x0=X.x0, kind=X.kind, check=False)
+
+
+def _refine_by_fourier_path(W, L, h, m, rng):
+    """``factor > 2``: the construction of ``roughpaths.brownian_refined`` with no stored Fourier terms.
+
+    Rows ``W (R, d)``, Lévy areas ``L (R, d, d)``, step lengths ``h (R,)``; returns ``(R, m, d)`` increments
+    and ``(R, m, d, d)`` Lévy areas. The normals are drawn from ``rng`` per distinct step length, in row order.
+    """
+    from ._refine_path import _FourierPlan, _refine_fourier
+    from .levy_area import step_plan
+
+    R, d = W.shape
+    w = np.empty((R, m, d))
+    A = np.empty((R, m, d, d))
+    for hv in np.unique(h):
+        idx = np.flatnonzero(h == hv)
+        delta = float(hv) / m
+        fine = step_plan("auto", d, [delta])[delta] if d > 1 else ("fourier", 1, 0)
+        plan = _FourierPlan(float(hv), m, d, "exact", 0, False, fine)
+        z = rng.standard_normal((idx.size, plan.width))
+        w[idx], A[idx] = _refine_fourier(plan, W[idx], L[idx], None, None, None, z)
+    return w, A

@@ -282,15 +282,22 @@ def step_plan(method: str, dim: int, steps, error=None) -> dict:
 
 def block_areas(dW, h, plan, normals, ito: bool) -> np.ndarray:
     """Full areas ``(P, k, d, d)`` of a block from its increments ``(P, k, d)``, step lengths ``(k,)`` and the
-    paths' normals ``(P, Σ widths)`` consumed step by step in order (Stratonovich, or Itô if ``ito``)."""
+    paths' normals ``(P, Σ widths)`` consumed step by step in order (Stratonovich, or Itô if ``ito``).
+
+    Steps of equal length are computed together (one call over ``(P, steps)``; each member's numbers are
+    those of its own step).
+    """
     P, k, d = dW.shape
     areas = np.empty((P, k, d, d))
-    off = 0
-    for j in range(k):
-        method, n, w = plan[float(h[j])]
-        A = levy_areas_from_normals(dW[:, j], float(h[j]), normals[:, off:off + w], method, n)
-        off += w
-        areas[:, j] = A + 0.5 * dW[:, j, :, None] * dW[:, j, None, :]
+    widths = np.array([plan[float(x)][2] for x in h], dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(widths)])
+    for hv in np.unique(h):
+        idx = np.flatnonzero(h == hv)
+        method, n, w = plan[float(hv)]
+        cols = offsets[idx][:, None] + np.arange(w)
+        A = levy_areas_from_normals(dW[:, idx], float(hv), normals[:, cols], method, n)
+        A += 0.5 * dW[:, idx, :, None] * dW[:, idx, None, :]
         if ito:
-            areas[:, j] -= 0.5 * float(h[j]) * np.eye(d)
+            A -= 0.5 * float(hv) * np.eye(d)
+        areas[:, idx] = A
     return areas
