@@ -13,7 +13,7 @@ Claims tested:
   independent oracle: the ``iisignature`` area of the piecewise-linear path through the refined
   points correlates with the coarse Lévy area as ``sqrt(1 - 1/m)``; a transposed area
   ordering gives the opposite sign and fails;
-* the documented bias of the fine-area variance for factors > 2 stays below its stated bound.
+* factors > 2: the fine-area variance is unbiased (within four standard errors).
 """
 
 import iisignature
@@ -105,14 +105,17 @@ def test_refined_polygon_area_explains_coarse_area_iisignature_oracle(m, tol_cor
     assert np.corrcoef(-a_poly, L)[0, 1] < -0.6
 
 
-@pytest.mark.parametrize("factor, bound", [(3, 0.10), (4, 0.15)])
-def test_documented_bias_of_fine_area_variance(factor, bound):
+@pytest.mark.parametrize("factor", [3, 4, 8])
+def test_fine_area_variance_is_unbiased_for_factors_above_2(factor):
+    # factors > 2 are refined in one go (the Fourier-path construction); the former bridge splits
+    # inflated this variance by 7-18 %. Kurtosis 5 of the area: the relative SE of the mean of a²
+    # over n = 40000 samples is 2/√n = 0.01, so ±0.04 is four standard errors.
     n, h, d = 40000, 1.0, 3
     X = brownian_rough_path([0.0, h], d, np.random.default_rng(21), batch_shape=(n,))
     Y = refine(X, factor, np.random.default_rng(22))
     a = Y.step_levy_areas[..., 0, 1]
     rel = np.mean(a ** 2) / ((h / factor) ** 2 / 4) - 1
-    assert -0.03 < rel < bound
+    assert abs(rel) < 0.04
     w = Y.increments - X.increments / factor
     assert abs(np.mean(w[..., 0] ** 2) / ((h / factor) * (1 - 1 / factor)) - 1) < 0.03
 
