@@ -14,7 +14,8 @@ Gradients: :func:`signature_vjp`, :func:`logsignature_vjp` (w.r.t. the path poin
 :func:`rough_path_signature_vjp` (w.r.t. the step increments and areas) are vector–Jacobian
 products, the quantities of ``iisignature.sigbackprop`` / ``logsigbackprop``.
 
-Kernels are numba-compiled and cached (:mod:`roughpaths._signature_kernels`): level 2 is a fused
+Kernels are numba-compiled and cached (:mod:`roughpaths._sig_level2`, :mod:`roughpaths._sig_lanes`,
+:mod:`roughpaths._sig_vjp`, :mod:`roughpaths._signature_kernels`): level 2 is a fused
 one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment,
 run side by side on groups of work units (paths, or chunks of a long path glued by Chen's
 identity). The split of the work depends on the input's size only, so results are bitwise
@@ -28,6 +29,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _sig_lanes as _lanes
+from . import _sig_level2 as _l2
+from . import _sig_vjp as _vjp
 from . import _signature_kernels as _k
 from . import _signature_threads as _threads
 from .validation import as_float_array, check_positive_int
@@ -128,13 +132,9 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     nunits = nb * nchunks
     part = np.empty((nunits, dim))
     per_unit = (n / nchunks) * 1.5 * d ** depth
-    if nunits < _k.LANES:                     # too few units to fill the lanes: one at a time
-        _threads.run(lambda lo, hi: _k.scalar_units(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(nunits, per_unit))
-    else:
-        ngroups = -(-nunits // _k.LANES)
-        _threads.run(lambda lo, hi: _k.lane_groups(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, per_unit * _k.LANES))
+    ngroups = -(-nunits // _lanes.LANES)
+    _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
+                 _threads.ranges(ngroups, per_unit * _lanes.LANES))
     return part
 
 
@@ -148,13 +148,13 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if depth == 2:
         nchunks = _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2)
         part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
-        _threads.run(lambda lo, hi: _k.sig2_tasks(x, nchunks, lo, hi, part),
+        _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, lo, hi, part),
                      _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
-        return _k.sig2_glue(part, nb, nchunks, d)
+        return _l2.sig2_glue(part, nb, nchunks, d)
     nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
-        out = _k.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
+        out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
 
 
@@ -266,7 +266,7 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     units = _units(nb, n, nchunks)
     part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
-    _threads.run(lambda lo, hi: _k.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+    _threads.run(lambda lo, hi: _vjp.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
                  _threads.ranges(nb * nchunks, (n / nchunks) * 5 * d ** depth))
     return _increments_to_points(gd, n)
 
@@ -367,7 +367,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     g_log_rev = np.empty_like(g_log_row)
     g_log_rev[:, perm] = g_log_row
     g_sig_rev = np.empty_like(sig_rev)
-    _threads.run(lambda lo, hi: _k.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
+    _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
                  _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
     return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
 
@@ -486,7 +486,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
     off = _offsets(d, depth)
-    _threads.run(lambda lo, hi: _k.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
+    _threads.run(lambda lo, hi: _vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
                  _threads.ranges(inc.shape[0], 4 * n * depth * depth * sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
     return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))

@@ -11,7 +11,7 @@ import numba
 import numpy as np
 import pytest
 
-from roughpaths import _signature_kernels as kern
+from roughpaths import _sig_lanes as kern
 from roughpaths.signature import _offsets, _units, logsignature, signature, signature_vjp
 
 
@@ -39,18 +39,33 @@ def test_one_thread_equals_two_threads(shape, m):
 
 
 @pytest.mark.parametrize("nchunks", [1, 5])
-def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks):
-    x = np.ascontiguousarray(_path((9, 700, 3)))
-    m = 4
+@pytest.mark.parametrize("d,m", [(2, 5), (3, 4), (5, 3), (6, 3)])   # d <= 5 specialised, 6 generic
+def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m):
+    # 9 paths: a group of 8 lanes and one of 1; with 5 chunks the last chunk of each path is
+    # shorter than the others (units end at different steps); one path is scaled by 1e12
+    x = _path((9, 700, d))
+    x[4] *= 1e12
     units = _units(9, 700, nchunks)
     nu = 9 * nchunks
-    off = _offsets(3, m)
+    off = _offsets(d, m)
     one = np.empty((nu, off[m + 1]))
     kern.scalar_units(x, *units, m, off, 0, nu, one)
     lanes = np.empty_like(one)
     groups = -(-nu // kern.LANES)
     for g in range(groups):                       # one range per group, in reverse order
         kern.lane_groups(x, *units, m, off, groups - 1 - g, groups - g, lanes)
+    assert one.tobytes() == lanes.tobytes()
+
+
+def test_lanes_with_empty_units():
+    x = _path((3, 10, 3))                         # 9 segments in 4 chunks of 3: the last is empty
+    units = _units(3, 10, 4)
+    assert np.any(units[1] == units[2])
+    off = _offsets(3, 3)
+    one = np.empty((12, off[4]))
+    kern.scalar_units(x, *units, 3, off, 0, 12, one)
+    lanes = np.full_like(one, np.nan)
+    kern.lane_groups(x, *units, 3, off, 0, 2, lanes)
     assert one.tobytes() == lanes.tobytes()
 
 
