@@ -92,55 +92,102 @@ def _horner_step(s, delta, d, m, offsets, buf):
 
 
 @njit(cache=True, inline="always")
-def _lane_step_d(s, delta, do, d, m, offsets, buf, sc):
+def _lane_step_d(s, delta, do, d, m, offsets, buf):
     """``S <- S ⊗ exp(D)`` on every lane; ``D`` is rows ``do/LANES ..`` of ``delta``.
 
-    ``buf`` holds two scratch blocks of ``d^(m-1)`` rows, ``sc`` ``d`` rows.
+    ``T_1 .. T_{k-2}`` go through ``buf`` (two blocks of ``d^(m-2)`` rows); ``T_{k-1}``, the
+    largest, is formed one row at a time in registers and used at once (never stored).
     """
     L = LANES
-    half = d ** (m - 1) * L
+    half = d ** max(m - 2, 1) * L
     for lev in range(m, 1, -1):
+        ok = offsets[lev] * L
+        if lev == 2:                                         # S_2 += (D/2 + S_1) ⊗ D
+            inv = vsplat(0.5)
+            for p in range(d):
+                t1 = vadd(vmul(vload(delta, do + p * L), inv), vload(s, p * L))
+                for q in range(d):
+                    r = ok + (p + q * d) * L
+                    vstore(s, r, vadd(vload(s, r), vmul(t1, vload(delta, do + q * L))))
+            continue
         inv = vsplat(1.0 / lev)
         for i in range(d):                                   # T_1 = D / lev + S_1
             vstore(buf, i * L, vadd(vmul(vload(delta, do + i * L), inv), vload(s, i * L)))
         size = d
         cur = 0
         nxt = half
-        for j in range(1, lev - 1):                          # T_{j+1} = T_j ⊗ D/(lev-j) + S_{j+1}
+        for j in range(1, lev - 2):                          # T_{j+1} = T_j ⊗ D/(lev-j) + S_{j+1}
             f = vsplat(1.0 / (lev - j))
-            for q in range(d):
-                vstore(sc, q * L, vmul(vload(delta, do + q * L), f))
             o = offsets[j + 1] * L
             for p in range(size):
                 t = vload(buf, cur + p * L)
                 for q in range(d):
                     r = (p + q * size) * L
-                    vstore(buf, nxt + r, vadd(vmul(t, vload(sc, q * L)), vload(s, o + r)))
+                    sc = vmul(vload(delta, do + q * L), f)
+                    vstore(buf, nxt + r, vadd(vmul(t, sc), vload(s, o + r)))
             size *= d
             cur, nxt = nxt, cur
-        ok = offsets[lev] * L
-        for p in range(size):                                # S_lev += T_{lev-1} ⊗ D
+        f = vsplat(0.5)                                      # T_{lev-1} = T_{lev-2} ⊗ D/2 + S_{lev-1}
+        o = offsets[lev - 1] * L
+        big = size * d
+        for p in range(size):
             t = vload(buf, cur + p * L)
-            for q in range(d):
-                r = ok + (p + q * size) * L
-                vstore(s, r, vadd(vload(s, r), vmul(t, vload(delta, do + q * L))))
+            for q1 in range(d):
+                p1 = p + q1 * size
+                sc = vmul(vload(delta, do + q1 * L), f)
+                t1 = vadd(vmul(t, sc), vload(s, o + p1 * L))
+                for q in range(d):                           # S_lev += T_{lev-1} ⊗ D
+                    r = ok + (p1 + q * big) * L
+                    vstore(s, r, vadd(vload(s, r), vmul(t1, vload(delta, do + q * L))))
     for i in range(d):
         vstore(s, i * L, vadd(vload(s, i * L), vload(delta, do + i * L)))
 
 
 @njit(cache=True)
-def _lane_step(s, delta, do, d, m, offsets, buf, sc):
+def _lane_step(s, delta, do, d, m, offsets, buf):
     # a compile-time d lets LLVM unroll the loops over the letters and keep D in registers
     if d == 2:
-        _lane_step_d(s, delta, do, 2, m, offsets, buf, sc)
+        _lane_step_d(s, delta, do, 2, m, offsets, buf)
     elif d == 3:
-        _lane_step_d(s, delta, do, 3, m, offsets, buf, sc)
+        _lane_step_d(s, delta, do, 3, m, offsets, buf)
     elif d == 4:
-        _lane_step_d(s, delta, do, 4, m, offsets, buf, sc)
+        _lane_step_d(s, delta, do, 4, m, offsets, buf)
     elif d == 5:
-        _lane_step_d(s, delta, do, 5, m, offsets, buf, sc)
+        _lane_step_d(s, delta, do, 5, m, offsets, buf)
     else:
-        _lane_step_d(s, delta, do, d, m, offsets, buf, sc)
+        _lane_step_d(s, delta, do, d, m, offsets, buf)
+
+
+@njit(cache=True, inline="always")
+def _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk):
+    L = LANES
+    for l in range(L):
+        live = min(max(nsteps[l] - t0, 0), nt)
+        if live > 0:
+            u = g * L + l
+            k0 = ulo[u] + t0
+            seg = x[ub[u], k0:k0 + live + 1]
+            for t in range(live):
+                for i in range(d):
+                    blk[(t * d + i) * L + l] = seg[t + 1, i] - seg[t, i]
+        for t in range(live, nt):
+            for i in range(d):
+                blk[(t * d + i) * L + l] = 0.0
+
+
+@njit(cache=True)
+def _gather(x, ub, ulo, nsteps, g, t0, nt, d, blk):
+    """Increments of segments ``t0 .. t0+nt-1`` of the units of group ``g``, as ``blk[t, i, lane]`` (0 past a unit's end)."""
+    if d == 2:
+        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 2, blk)
+    elif d == 3:
+        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 3, blk)
+    elif d == 4:
+        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 4, blk)
+    elif d == 5:
+        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 5, blk)
+    else:
+        _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk)
 
 
 @njit(**_NOGIL)
@@ -156,8 +203,7 @@ def lane_groups(x, ub, ulo, uhi, m, offsets, lo, hi, part):
     dim = offsets[m + 1]
     nunits = ub.shape[0]
     s = np.empty(dim * L)
-    buf = np.empty(2 * d ** (m - 1) * L)
-    sc = np.empty(d * L)
+    buf = np.empty(2 * d ** max(m - 2, 1) * L)
     blk = np.empty(T * d * L)
     nsteps = np.zeros(L, dtype=np.int64)
     for g in range(lo, hi):
@@ -171,20 +217,9 @@ def lane_groups(x, ub, ulo, uhi, m, offsets, lo, hi, part):
                 part[u, :] = 0.0
         for t0 in range(0, steps, T):
             nt = min(T, steps - t0)
-            for l in range(L):                               # gather and transpose the increments
-                u = g * L + l
-                live = min(max(nsteps[l] - t0, 0), nt)
-                if live > 0:
-                    xb = x[ub[u]]
-                    k0 = ulo[u] + t0
-                    for t in range(live):
-                        for i in range(d):
-                            blk[(t * d + i) * L + l] = xb[k0 + t + 1, i] - xb[k0 + t, i]
-                for t in range(live, nt):
-                    for i in range(d):
-                        blk[(t * d + i) * L + l] = 0.0
+            _gather(x, ub, ulo, nsteps, g, t0, nt, d, blk)
             for t in range(nt):
-                _lane_step(s, blk, t * d * L, d, m, offsets, buf, sc)
+                _lane_step(s, blk, t * d * L, d, m, offsets, buf)
                 for l in range(L):
                     if nsteps[l] == t0 + t + 1:              # unit done: copy it out
                         u = g * L + l
