@@ -143,19 +143,33 @@ def _lane_step_d(s, delta, do, d, m, offsets, buf):
         vstore(s, i * L, vadd(vload(s, i * L), vload(delta, do + i * L)))
 
 
+@njit(cache=True, inline="always")
+def _block_d(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part):
+    """Segments ``t0 .. t0+nt-1`` of group ``g`` (increments in ``blk``); copies out the units that end."""
+    L = LANES
+    dim = offsets[m + 1]
+    for t in range(nt):
+        _lane_step_d(s, blk, t * d * L, d, m, offsets, buf)
+        for l in range(L):
+            if nsteps[l] == t0 + t + 1:                      # unit done: copy it out
+                u = g * L + l
+                for r in range(dim):
+                    part[u, r] = s[r * L + l]
+
+
 @njit(cache=True)
-def _lane_step(s, delta, do, d, m, offsets, buf):
-    # a compile-time d lets LLVM unroll the loops over the letters and keep D in registers
+def _block(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part):
+    # a compile-time d lets LLVM unroll the loops over the letters
     if d == 2:
-        _lane_step_d(s, delta, do, 2, m, offsets, buf)
+        _block_d(s, blk, nt, t0, g, nsteps, 2, m, offsets, buf, part)
     elif d == 3:
-        _lane_step_d(s, delta, do, 3, m, offsets, buf)
+        _block_d(s, blk, nt, t0, g, nsteps, 3, m, offsets, buf, part)
     elif d == 4:
-        _lane_step_d(s, delta, do, 4, m, offsets, buf)
+        _block_d(s, blk, nt, t0, g, nsteps, 4, m, offsets, buf, part)
     elif d == 5:
-        _lane_step_d(s, delta, do, 5, m, offsets, buf)
+        _block_d(s, blk, nt, t0, g, nsteps, 5, m, offsets, buf, part)
     else:
-        _lane_step_d(s, delta, do, d, m, offsets, buf)
+        _block_d(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part)
 
 
 @njit(cache=True, inline="always")
@@ -218,13 +232,7 @@ def lane_groups(x, ub, ulo, uhi, m, offsets, lo, hi, part):
         for t0 in range(0, steps, T):
             nt = min(T, steps - t0)
             _gather(x, ub, ulo, nsteps, g, t0, nt, d, blk)
-            for t in range(nt):
-                _lane_step(s, blk, t * d * L, d, m, offsets, buf)
-                for l in range(L):
-                    if nsteps[l] == t0 + t + 1:              # unit done: copy it out
-                        u = g * L + l
-                        for r in range(dim):
-                            part[u, r] = s[r * L + l]
+            _block(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part)
 
 
 @njit(cache=True)

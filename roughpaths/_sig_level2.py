@@ -30,6 +30,7 @@ def _area_chunk_d2(x, b, lo, hi, out):
     out[1] = p1
     out[2] = a01
 
+
 @njit(cache=True)
 def _area_chunk_d3(x, b, lo, hi, out):
     x0, x1, x2 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2]
@@ -54,6 +55,77 @@ def _area_chunk_d3(x, b, lo, hi, out):
     out[4] = a02
     out[5] = a12
 
+
+@njit(cache=True)
+def _area_chunk_d4(x, b, lo, hi, out):
+    x0, x1, x2, x3 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2], x[b, lo, 3]
+    p0, p1, p2, p3 = 0.0, 0.0, 0.0, 0.0
+    a01, a02, a03, a12, a13 = 0.0, 0.0, 0.0, 0.0, 0.0
+    a23 = 0.0
+    for k in range(lo + 1, hi + 1):
+        y0 = x[b, k, 0] - x0
+        y1 = x[b, k, 1] - x1
+        y2 = x[b, k, 2] - x2
+        y3 = x[b, k, 3] - x3
+        a01 += p0 * y1 - p1 * y0
+        a02 += p0 * y2 - p2 * y0
+        a03 += p0 * y3 - p3 * y0
+        a12 += p1 * y2 - p2 * y1
+        a13 += p1 * y3 - p3 * y1
+        a23 += p2 * y3 - p3 * y2
+        p0, p1, p2, p3 = y0, y1, y2, y3
+    out[0] = p0
+    out[1] = p1
+    out[2] = p2
+    out[3] = p3
+    out[4] = a01
+    out[5] = a02
+    out[6] = a03
+    out[7] = a12
+    out[8] = a13
+    out[9] = a23
+
+
+@njit(cache=True)
+def _area_chunk_d5(x, b, lo, hi, out):
+    x0, x1, x2, x3, x4 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2], x[b, lo, 3], x[b, lo, 4]
+    p0, p1, p2, p3, p4 = 0.0, 0.0, 0.0, 0.0, 0.0
+    a01, a02, a03, a04, a12 = 0.0, 0.0, 0.0, 0.0, 0.0
+    a13, a14, a23, a24, a34 = 0.0, 0.0, 0.0, 0.0, 0.0
+    for k in range(lo + 1, hi + 1):
+        y0 = x[b, k, 0] - x0
+        y1 = x[b, k, 1] - x1
+        y2 = x[b, k, 2] - x2
+        y3 = x[b, k, 3] - x3
+        y4 = x[b, k, 4] - x4
+        a01 += p0 * y1 - p1 * y0
+        a02 += p0 * y2 - p2 * y0
+        a03 += p0 * y3 - p3 * y0
+        a04 += p0 * y4 - p4 * y0
+        a12 += p1 * y2 - p2 * y1
+        a13 += p1 * y3 - p3 * y1
+        a14 += p1 * y4 - p4 * y1
+        a23 += p2 * y3 - p3 * y2
+        a24 += p2 * y4 - p4 * y2
+        a34 += p3 * y4 - p4 * y3
+        p0, p1, p2, p3, p4 = y0, y1, y2, y3, y4
+    out[0] = p0
+    out[1] = p1
+    out[2] = p2
+    out[3] = p3
+    out[4] = p4
+    out[5] = a01
+    out[6] = a02
+    out[7] = a03
+    out[8] = a04
+    out[9] = a12
+    out[10] = a13
+    out[11] = a14
+    out[12] = a23
+    out[13] = a24
+    out[14] = a34
+
+
 @njit(cache=True)
 def _area_chunk_generic(x, b, lo, hi, out):
     d = x.shape[2]
@@ -75,6 +147,7 @@ def _area_chunk_generic(x, b, lo, hi, out):
     for q in range(acc.shape[0]):
         out[d + q] = acc[q]
 
+
 @njit(cache=True)
 def _area_chunk(x, b, lo, hi, out):
     """Write ``(X, twice the Lévy area over i<j)`` of points ``lo..hi`` of path ``b`` into ``out``."""
@@ -83,6 +156,10 @@ def _area_chunk(x, b, lo, hi, out):
         _area_chunk_d2(x, b, lo, hi, out)
     elif d == 3:
         _area_chunk_d3(x, b, lo, hi, out)
+    elif d == 4:
+        _area_chunk_d4(x, b, lo, hi, out)
+    elif d == 5:
+        _area_chunk_d5(x, b, lo, hi, out)
     else:
         _area_chunk_generic(x, b, lo, hi, out)
 
@@ -101,6 +178,7 @@ def sig2_tasks(x, nchunks, lo, hi, part):
             part[t, r] = 0.0
         if e > a:
             _area_chunk(x, b, a, e, part[t])
+
 
 @njit(**_NOGIL)
 def sig2_glue(part, nb, nchunks, d):

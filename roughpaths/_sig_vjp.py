@@ -42,6 +42,7 @@ def _lcon(x0, s, g, d, m, offsets, out):
                     acc += s[oi + u] * g[base + u]
                 out[oj + w] += acc
 
+
 @njit(cache=True)
 def _rcon(x0, g, e, d, m, offsets, out):
     """``out <- g ◁ (x0 + e)``: ``out_i[p] = x0 g_i[p] + sum_{j>=1} sum_q g_{i+j}[p q] e_j[q]``."""
@@ -58,6 +59,7 @@ def _rcon(x0, g, e, d, m, offsets, out):
                 base = ok + ni * q
                 for p in range(ni):
                     out[oi + p] += g[base + p] * eq
+
 
 @njit(cache=True)
 def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
@@ -115,6 +117,7 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
         for q in range(d):
             gdelta[q] += ga[q] * inv
 
+
 @njit(cache=True)
 def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
     """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
@@ -138,6 +141,7 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
         for r in range(dim):
             g[r] = gn[r]
 
+
 @njit(cache=True)
 def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
     """Cotangent of unit ``u``'s signature: ``P ▷ (G ◁ Q)``, P/Q the products of the units before/after."""
@@ -153,6 +157,7 @@ def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
     for cc in range(c):
         mul_inplace(pre, part[b * nchunks + cc], d, m, offsets)
     _lcon(1.0, pre, tmp, d, m, offsets, g)
+
 
 @njit(cache=True)
 def _mul_rev(x0, xs, a, d, m, offsets, out):
@@ -170,6 +175,7 @@ def _mul_rev(x0, xs, a, d, m, offsets, out):
                 base = ok + ni * q
                 for p in range(ni):
                     out[base + p] += xs[oi + p] * aq
+
 
 @njit(cache=True)
 def _log_vjp_one(a, g, d, m, offsets, ga):
@@ -196,6 +202,7 @@ def _log_vjp_one(a, g, d, m, offsets, ga):
     cm = (-1.0) ** (m + 1) / m
     for u in range(dim):
         ga[u] += cm * gc[u]
+
 
 @njit(cache=True)
 def _rough_vjp_one(inc, lev, s, g, d, m, offsets, ginc, glev):
@@ -279,11 +286,13 @@ def sig_vjp_units(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
         s = part[u].copy()
         _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
 
+
 @njit(**_NOGIL)
 def log_vjp_rows(a, g, d, m, offsets, lo, hi, out):
     """Row-wise :func:`_log_vjp_one` (reversed layout) for rows ``lo..hi-1``."""
     for b in range(lo, hi):
         _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+
 
 @njit(**_NOGIL)
 def rough_vjp_rows(inc, lev, s, g, m, offsets, lo, hi, ginc, glev):

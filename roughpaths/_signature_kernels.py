@@ -72,6 +72,7 @@ def _exp_lie2(x, a, d, m, offsets, out, p, q):
             p[r] = q[r]
             out[r] += q[r]
 
+
 @njit(cache=True)
 def _log_one(a, d, m, offsets, r, t):
     """``r <- log(1 + a)`` (row-major, truncated at ``m``) by Horner, ``t`` scratch of the same size.
@@ -101,6 +102,7 @@ def _log_one(a, d, m, offsets, r, t):
         for u in range(offsets[kmax + 1]):
             r[u] = t[u]
 
+
 @njit(cache=True)
 def _lyndon_one(z, lev_off, lidx, indptr, indices, data, out, out_off):
     for i in range(lidx.shape[0]):
@@ -125,6 +127,7 @@ def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
         for i in range(n):
             gz[b, lev_off + lidx[i]] = y[i]
 
+
 @njit(**_NOGIL)
 def log_rows(a, d, m, offsets, lo, hi, out):
     """Row-major ``log(1 + a)`` of rows ``lo..hi-1`` of ``a`` (B, sigdim) into ``out``."""
@@ -132,11 +135,13 @@ def log_rows(a, d, m, offsets, lo, hi, out):
     for b in range(lo, hi):
         _log_one(a[b], d, m, offsets, out[b], t)
 
+
 @njit(**_NOGIL)
 def lyndon_rows(z, lev_off, lidx, indptr, indices, data, out, out_off, lo, hi):
     """Lyndon coordinates of one level (forward substitution with the sparse ``M``), rows ``lo..hi-1``."""
     for b in range(lo, hi):
         _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
+
 
 @njit(**_NOGIL)
 def rough_sig_rows(inc, lev, m, offsets, lo, hi, out):
