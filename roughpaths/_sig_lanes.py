@@ -162,6 +162,8 @@ def _block(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part):
     # a compile-time d lets LLVM unroll the loops over the letters
     if d == 2:
         _block_d(s, blk, nt, t0, g, nsteps, 2, m, offsets, buf, part)
+    elif d == 3 and m == 3:
+        _block_d(s, blk, nt, t0, g, nsteps, 3, 3, offsets, buf, part)
     elif d == 3:
         _block_d(s, blk, nt, t0, g, nsteps, 3, m, offsets, buf, part)
     elif d == 4:

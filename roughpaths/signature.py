@@ -92,6 +92,10 @@ def _available_bytes() -> int:
         return 1 << 62
 
 
+#: Requests below this many bytes are not checked against the available memory.
+_SMALL_REQUEST = 64 * 2 ** 20
+
+
 def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     """Refuse, before allocating, a request whose working arrays would not fit in memory.
 
@@ -103,6 +107,8 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
     if log and depth > 1 and d > 1:
         need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+    if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
+        return
     avail = _available_bytes()
     if need > avail:
         what = "logsignature" if log else "signature"
@@ -112,15 +118,31 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
             f"Lower depth, process the batch in smaller pieces, or use fewer dimensions.")
 
 
-def _check_paths(paths) -> np.ndarray:
-    x = as_float_array(paths, "paths", min_ndim=2)
+def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
+    """Validated float64 paths; ``finite=False`` leaves NaN/inf to :func:`_finite_or_raise`."""
+    x = as_float_array(paths, "paths", min_ndim=2, allow_nonfinite=True)
     if x.shape[-2] < 1:
         raise ValueError(f"paths needs at least one point along axis -2 (shape (..., n, d)), got shape "
                          f"{x.shape}.")
     if x.shape[-1] < 1:
         raise ValueError(f"paths needs at least one coordinate along the last axis (shape (..., n, d)), "
                          f"got shape {x.shape}.")
+    if finite or x.shape[-2] == 1:             # a lone point does not enter the output: check it here
+        as_float_array(x, "paths")
     return x
+
+
+def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Return ``out``; if it holds NaN/inf, first raise the input check's error if the input does.
+
+    At depth >= 2 every point of a path of two or more points enters the output (through the
+    increments on both sides of it, and NaN/inf never cancel), so a non-finite input always gives a non-finite output: scanning the
+    small output replaces scanning the whole path on every call. A finite input whose signature
+    overflows returns the overflowed values, as before.
+    """
+    if not np.isfinite(out).all():
+        as_float_array(x, "paths")
+    return out
 
 
 def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
@@ -182,11 +204,11 @@ def signature(paths, depth: int) -> np.ndarray:
     array([1. , 1. , 0.5, 1. , 0. , 0.5])
     """
     depth = _check_depth(depth)
-    x = _check_paths(paths)
+    x = _check_paths(paths, finite=depth == 1)     # depth >= 2: checked through the output
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
     _check_fits(flat.shape[0], d, depth)
-    return _signature_flat(flat, depth).reshape(batch + (sigdim(d, depth),))
+    return _finite_or_raise(_signature_flat(flat, depth), x).reshape(batch + (sigdim(d, depth),))
 
 
 def logsignature(paths, depth: int) -> np.ndarray:
@@ -214,7 +236,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     array([1. , 1. , 0.5])
     """
     depth = _check_depth(depth)
-    x = _check_paths(paths)
+    x = _check_paths(paths, finite=False)          # checked by signature(x, 1) or through the output
     d = x.shape[-1]
     if depth == 1 or d == 1:
         # d = 1: the free Lie algebra is R (a path's log-signature is its increment).
@@ -222,7 +244,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     batch, n = x.shape[:-2], x.shape[-2]
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
     _check_fits(flat.shape[0], d, depth, log=True)
-    sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    sig = np.ascontiguousarray(_finite_or_raise(_signature_flat(flat, depth), x))
     if depth == 2:
         # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas
         iu, ju = np.triu_indices(d, k=1)
