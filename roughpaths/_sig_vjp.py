@@ -10,6 +10,8 @@ Backward through S = S_prev ⊗ exp(D) per segment (last to first):
 
 :func:`_lcon` / :func:`_rcon` (general contractions) serve the chunk cotangents and the log's
 backward pass. Serial kernels over a range ``[lo, hi)`` of work items (GIL released).
+:func:`sig_vjp_groups` runs the backward pass of LANES units side by side in packed registers
+(about 4-5x faster than :func:`sig_vjp_units`, one unit at a time, and bitwise the same).
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._sig_lanes import _horner_step, mul_inplace
+from ._sig_lanes import BLOCK, _horner_step, _lane_step_d, mul_inplace
+from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 from ._signature_kernels import _exp_lie2
 
 _NOGIL = dict(cache=True, nogil=True)
@@ -300,3 +303,151 @@ def rough_vjp_rows(inc, lev, s, g, m, offsets, lo, hi, ginc, glev):
     d = inc.shape[2]
     for b in range(lo, hi):
         _rough_vjp_one(inc[b], lev[b], s[b].copy(), g[b].copy(), d, m, offsets, ginc[b], glev[b])
+
+
+# ---------------------------------------------------------------------------------- lanes
+# The backward pass on LANES units side by side (rows of LANES values, roughpaths._simd), the
+# operations of _unit_vjp / _step_vjp on every lane; the sums over p are per lane, in the same
+# order, so the results are bitwise those of sig_vjp_units. Units are aligned at their last
+# segment: step tau handles segment uhi - tau of every unit that has it; the others get zero
+# increments and their values are not used.
+
+
+@njit(cache=True, inline="always")
+def _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """:func:`_step_vjp` on every lane; the increment is rows ``do/LANES ..`` of ``blk``."""
+    L = LANES
+    dim = offsets[m + 1]
+    for r in range(dim):
+        vstore(gprev, r * L, vload(g, r * L))
+    for q in range(d):
+        vstore(gdelta, q * L, vload(g, q * L))
+    for k in range(m, 1, -1):
+        inv = vsplat(1.0 / k)
+        for q in range(d):
+            vstore(tb, q * L, vadd(vmul(vload(blk, do + q * L), inv), vload(s, q * L)))
+        size = d
+        for j in range(1, k - 1):
+            f = vsplat(1.0 / (k - j))
+            oj = offsets[j] * L
+            on = offsets[j + 1] * L
+            for q in range(d):
+                e = vmul(vload(blk, do + q * L), f)
+                base = on + size * q * L
+                for p in range(size):
+                    vstore(tb, base + p * L, vadd(vmul(vload(tb, oj + p * L), e), vload(s, base + p * L)))
+            size *= d
+        ok = offsets[k] * L
+        for r in range(d ** k):
+            vstore(ga, r * L, vload(g, ok + r * L))
+        for j in range(k - 1, 0, -1):
+            f = vsplat(1.0 / (k - j))
+            nj = d ** j
+            oj = offsets[j] * L
+            zero = vsplat(0.0)
+            for p in range(nj):
+                vstore(gb, p * L, zero)
+            for q in range(d):
+                e = vmul(vload(blk, do + q * L), f)
+                base = nj * q * L
+                acc = vsplat(0.0)
+                for p in range(nj):
+                    a = vload(ga, base + p * L)
+                    vstore(gb, p * L, vadd(vload(gb, p * L), vmul(a, e)))
+                    acc = vadd(acc, vmul(a, vload(tb, oj + p * L)))
+                vstore(gdelta, q * L, vadd(vload(gdelta, q * L), vmul(acc, f)))
+            for p in range(nj):
+                b = vload(gb, p * L)
+                vstore(gprev, oj + p * L, vadd(vload(gprev, oj + p * L), b))
+                vstore(ga, p * L, b)
+        for q in range(d):
+            vstore(gdelta, q * L, vadd(vload(gdelta, q * L), vmul(vload(ga, q * L), inv)))
+
+
+@njit(cache=True, inline="always")
+def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                  gdelta, gd):
+    L = LANES
+    for l in range(L):                                       # increments, last segment first
+        u = grp * L + l
+        live = min(max(nsteps[l] - t0, 0), nt)
+        for t in range(live):
+            b = ub[u]
+            k = uhi[u] - t0 - t
+            for i in range(d):
+                v = x[b, k, i] - x[b, k - 1, i]
+                blk[(t * d + i) * L + l] = v
+                neg[(t * d + i) * L + l] = -v
+        for t in range(live, nt):
+            for i in range(d):
+                blk[(t * d + i) * L + l] = 0.0
+                neg[(t * d + i) * L + l] = 0.0
+    for t in range(nt):
+        do = t * d * L
+        _lane_step_d(s, neg, do, d, m, offsets, buf)          # S_prev = S ⊗ exp(-D)
+        _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gn, tb, ga, gb, gdelta)
+        for l in range(L):
+            if t0 + t < nsteps[l]:
+                u = grp * L + l
+                k = uhi[u] - t0 - t
+                for i in range(d):
+                    gd[ub[u], k - 1, i] = gdelta[i * L + l]
+        dim = offsets[m + 1]
+        for r in range(dim * L):
+            g[r] = gn[r]
+
+
+@njit(cache=True)
+def _back_block(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                gdelta, gd):
+    if d == 2:
+        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, 2, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                      gdelta, gd)
+    elif d == 3:
+        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, 3, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                      gdelta, gd)
+    else:
+        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                      gdelta, gd)
+
+
+@njit(**_NOGIL)
+def sig_vjp_groups(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    """:func:`sig_vjp_units` on lane groups ``lo..hi-1`` (units ``g*LANES ..``), the same bits."""
+    L = LANES
+    T = BLOCK
+    d = x.shape[2]
+    dim = offsets[m + 1]
+    nunits = ub.shape[0]
+    s = np.empty(dim * L)
+    g = np.empty(dim * L)
+    gn = np.empty(dim * L)
+    tb = np.empty(dim * L)
+    ga = np.empty(d ** m * L)
+    gb = np.empty(d ** m * L)
+    gdelta = np.empty(d * L)
+    blk = np.empty(T * d * L)
+    neg = np.empty(T * d * L)
+    buf = np.empty(2 * d ** max(m - 2, 1) * L)
+    gu = np.empty(dim)
+    nsteps = np.zeros(L, dtype=np.int64)
+    for grp in range(lo, hi):
+        steps = 0
+        for l in range(L):
+            u = grp * L + l
+            if u < nunits:
+                nsteps[l] = uhi[u] - ulo[u]
+                _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, gu)
+                for r in range(dim):
+                    s[r * L + l] = part[u, r]
+                    g[r * L + l] = gu[r]
+            else:
+                nsteps[l] = 0
+                for r in range(dim):
+                    s[r * L + l] = 0.0
+                    g[r * L + l] = 0.0
+            steps = max(steps, nsteps[l])
+        for t0 in range(0, steps, T):
+            nt = min(T, steps - t0)
+            _back_block(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                        gdelta, gd)

@@ -288,8 +288,9 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     units = _units(nb, n, nchunks)
     part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
-    _threads.run(lambda lo, hi: _vjp.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
-                 _threads.ranges(nb * nchunks, (n / nchunks) * 5 * d ** depth))
+    ngroups = -(-(nb * nchunks) // _lanes.LANES)
+    _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+                 _threads.ranges(ngroups, (n / nchunks) * 5 * d ** depth * _lanes.LANES))
     return _increments_to_points(gd, n)
 
 

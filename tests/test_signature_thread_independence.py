@@ -3,7 +3,8 @@
 The split of a path into chunks depends on the input's size only; each work unit is computed by
 the same arithmetic whichever thread runs it (and whichever range of units a thread takes), and
 the units are glued by Chen's identity in a fixed order. So ``numba.set_num_threads(1)`` and
-``(2)`` give the same bits, the lane kernel (units side by side) gives the same bits as the
+``(2)`` give the same bits, the lane kernels (units side by side; signature and gradient) give the
+same bits as the
 one-unit-at-a-time kernel, and splitting the work into other ranges changes nothing.
 """
 
@@ -82,3 +83,25 @@ def test_gradients_one_thread_equals_two_threads():
     finally:
         numba.set_num_threads(before)
     assert one.tobytes() == two.tobytes()
+
+
+@pytest.mark.parametrize("nchunks", [1, 5])
+@pytest.mark.parametrize("d,m", [(2, 4), (3, 3), (4, 3)])
+def test_gradient_lanes_equal_one_unit_at_a_time(nchunks, d, m):
+    from roughpaths import _sig_vjp
+    from roughpaths.signature import _reversed_parts
+
+    x = _path((9, 300, d))
+    x[2] *= 1e6
+    g = np.random.default_rng(5).standard_normal((9, _offsets(d, m)[m + 1]))
+    units = _units(9, 300, nchunks)
+    nu = 9 * nchunks
+    off = _offsets(d, m)
+    part = _reversed_parts(x, m, nchunks)
+    one = np.zeros((9, 299, d))
+    _sig_vjp.sig_vjp_units(x, *units, nchunks, m, off, part, g, 0, nu, one)
+    lanes = np.full_like(one, np.nan)
+    groups = -(-nu // kern.LANES)
+    for grp in range(groups):                     # one range per group, in reverse order
+        _sig_vjp.sig_vjp_groups(x, *units, nchunks, m, off, part, g, groups - 1 - grp, groups - grp, lanes)
+    assert one.tobytes() == lanes.tobytes()
