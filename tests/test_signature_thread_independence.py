@@ -4,8 +4,8 @@ The split of a path into chunks depends on the input's size only; each work unit
 the same arithmetic whichever thread runs it (and whichever range of units a thread takes), and
 the units are glued by Chen's identity in a fixed order. So ``numba.set_num_threads(1)`` and
 ``(2)`` give the same bits, the lane kernels (units side by side; signature and gradient) give the
-same bits as the
-one-unit-at-a-time kernel, and splitting the work into other ranges changes nothing.
+same bits as the one-unit-at-a-time kernels, and splitting the work into other ranges changes
+nothing.
 """
 
 import numba
