@@ -1,7 +1,9 @@
 """Benchmark: signatures, log-signatures and their gradients against pysiglib and iisignature.
 
 Everything is timed in one run on the same data; each cell is the median of ``--repeats`` calls
-after one untimed warm-up call (compilation, caches, pysiglib's prepared log-signature basis).
+after one untimed warm-up call (compilation, caches, pysiglib's prepared log-signature basis). In
+the tables the three libraries of a row are timed in turn, call by call, so that a burst of load
+from other processes hits them alike.
 The machine is shared and noisy: medians and same-run ratios are what this prints.
 
 Cases (float64): (a) one path of 100,000 points in d = 3; (b) 1,000 paths of 1,000 points,
@@ -40,6 +42,27 @@ def median_time(fn, repeats: int) -> float:
     if time.perf_counter() - t0 > 2.0:        # very slow cell: fewer repeats
         repeats = min(repeats, 3)
     return _median_time(fn, repeats)
+
+
+def interleaved_medians(fns, repeats: int) -> list:
+    """Median wall times of several functions timed in turn (ours, peer, peer, ours, ...).
+
+    On a shared machine a burst of load then hits every library of a cell alike, instead of
+    whichever happened to be running; each function gets one untimed warm-up call first.
+    """
+    slow = False
+    for fn in fns:
+        t0 = time.perf_counter()
+        fn()
+        slow |= time.perf_counter() - t0 > 2.0
+    repeats = min(repeats, 3) if slow else repeats
+    times = [[] for _ in fns]
+    for _ in range(max(1, repeats)):
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            fn()
+            times[i].append(time.perf_counter() - t0)
+    return [float(np.median(t)) for t in times]
 
 
 DEPTH10 = r"""
@@ -116,7 +139,7 @@ def main() -> None:
                     ours = lambda: logsignature(x, m)
                     peer = lambda: pysiglib.log_sig(x, m, method=2, n_jobs=-1)
                     ii = lambda: iisignature.logsig(x, prep)
-                t_o, t_p, t_i = (median_time(f, args.repeats) for f in (ours, peer, ii))
+                t_o, t_p, t_i = interleaved_medians((ours, peer, ii), args.repeats)
                 ref = ii()
                 err = float(np.max(np.abs(ours() - ref)) / max(1.0, float(np.max(np.abs(ref)))))
                 print(f"{name:<22}{m:>4}{'':>2}{1e3 * t_o:>10.2f}{1e3 * t_p:>10.2f}{1e3 * t_i:>10.2f}"
