@@ -119,7 +119,7 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
 
 
 def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
-    """Validated float64 paths; ``finite=False`` leaves NaN/inf to :func:`_finite_or_raise`."""
+    """Validated float64 paths; ``finite=False`` leaves NaN/inf to :func:`_finite_or_raise` where it can."""
     x = as_float_array(paths, "paths", min_ndim=2, allow_nonfinite=True)
     if x.shape[-2] < 1:
         raise ValueError(f"paths needs at least one point along axis -2 (shape (..., n, d)), got shape "
@@ -127,7 +127,8 @@ def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
     if x.shape[-1] < 1:
         raise ValueError(f"paths needs at least one coordinate along the last axis (shape (..., n, d)), "
                          f"got shape {x.shape}.")
-    if finite or x.shape[-2] == 1:             # a lone point does not enter the output: check it here
+    if finite or x.shape[-2] == 1 or x.shape[-1] == 1:
+        # a lone point does not enter the output, nor (d = 1, level 2 = ½ X²) an interior point
         as_float_array(x, "paths")
     return x
 
@@ -135,10 +136,11 @@ def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
 def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Return ``out``; if it holds NaN/inf, first raise the input check's error if the input does.
 
-    At depth >= 2 every point of a path of two or more points enters the output (through the
-    increments on both sides of it, and NaN/inf never cancel), so a non-finite input always gives a non-finite output: scanning the
-    small output replaces scanning the whole path on every call. A finite input whose signature
-    overflows returns the overflowed values, as before.
+    At depth >= 2 and d >= 2 every point of a path of two or more points enters the output
+    (through the increments on both sides of it, and NaN/inf never cancel), so a non-finite
+    input always gives a non-finite output: scanning the small output replaces scanning the whole
+    path on every call. A finite input whose signature overflows returns the overflowed values,
+    as before.
     """
     if not np.isfinite(out).all():
         as_float_array(x, "paths")

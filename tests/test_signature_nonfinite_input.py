@@ -24,6 +24,16 @@ def test_nonfinite_point_is_refused_with_its_index(bad, f):
                 f(y, m)
 
 
+@pytest.mark.parametrize("f", [signature, logsignature])
+def test_nonfinite_interior_point_is_refused_in_one_dimension(f):
+    # d = 1: level 2 is ½ X², which an interior point does not enter
+    x = np.cumsum(np.ones((2, 10, 1)), axis=-2)
+    x[1, 4, 0] = np.nan
+    for m in (1, 2, 3):
+        with pytest.raises(ValueError, match=r"paths contains 1 non-finite value.*index \(1, 4, 0\)"):
+            f(x, m)
+
+
 def test_finite_overflow_is_returned_not_refused():
     x = np.array([[0.0, 0.0], [1e200, 1e200], [0.0, 2e200]])     # level 2 overflows to inf
     s = signature(x, 2)
