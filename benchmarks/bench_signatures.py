@@ -2,8 +2,8 @@
 
 Everything is timed in one run on the same data; each cell is the median of ``--repeats`` calls
 after one untimed warm-up call (compilation, caches, pysiglib's prepared log-signature basis). In
-the tables the three libraries of a row are timed in turn, call by call, so that a burst of load
-from other processes hits them alike.
+the tables the three libraries of a row are timed in turn (each timed call right after an untimed
+call of the same library), so that a burst of load from other processes hits them alike.
 The machine is shared and noisy: medians and same-run ratios are what this prints.
 
 Cases (float64): (a) one path of 100,000 points in d = 3; (b) 1,000 paths of 1,000 points,
@@ -48,7 +48,9 @@ def interleaved_medians(fns, repeats: int) -> list:
     """Median wall times of several functions timed in turn (ours, peer, peer, ours, ...).
 
     On a shared machine a burst of load then hits every library of a cell alike, instead of
-    whichever happened to be running; each function gets one untimed warm-up call first.
+    whichever happened to be running. Each timed call directly follows an untimed call of the same
+    function, so that it finds its own data in the caches as in a loop of calls (a call right
+    after another library's measured up to 2x slower for small cells).
     """
     slow = False
     for fn in fns:
@@ -59,6 +61,8 @@ def interleaved_medians(fns, repeats: int) -> list:
     times = [[] for _ in fns]
     for _ in range(max(1, repeats)):
         for i, fn in enumerate(fns):
+            if not slow:
+                fn()
             t0 = time.perf_counter()
             fn()
             times[i].append(time.perf_counter() - t0)
