@@ -22,7 +22,7 @@ import numba
 __all__ = ["run", "ranges"]
 
 #: Below this much work (roughly, floating-point operations) a job stays on the calling thread.
-SERIAL_WORK = 1 << 18
+SERIAL_WORK = 1 << 20
 #: Target work per range (enough to amortise a hand-off of a few tens of microseconds).
 RANGE_WORK = 1 << 17
 
@@ -45,7 +45,7 @@ def ranges(n_items: int, work_per_item: float) -> list:
     total = n_items * max(work_per_item, 1.0)
     if total < SERIAL_WORK:
         return [(0, n_items)]
-    k = int(min(n_items, max(1, total // RANGE_WORK), 256))
+    k = int(min(n_items, max(1, total // RANGE_WORK), 64))
     step = -(-n_items // k)
     return [(lo, min(lo + step, n_items)) for lo in range(0, n_items, step)]
 

@@ -14,7 +14,8 @@ Gradients: :func:`signature_vjp`, :func:`logsignature_vjp` (w.r.t. the path poin
 :func:`rough_path_signature_vjp` (w.r.t. the step increments and areas) are vector–Jacobian
 products, the quantities of ``iisignature.sigbackprop`` / ``logsigbackprop``.
 
-Kernels are numba-compiled and cached (:mod:`roughpaths._signature_kernels`): level 2 is a fused
+Kernels are numba-compiled and cached (:mod:`roughpaths._sig_level2`, :mod:`roughpaths._sig_lanes`,
+:mod:`roughpaths._sig_vjp`, :mod:`roughpaths._signature_kernels`): level 2 is a fused
 one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment,
 run side by side on groups of work units (paths, or chunks of a long path glued by Chen's
 identity). The split of the work depends on the input's size only, so results are bitwise
@@ -28,6 +29,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _sig_lanes as _lanes
+from . import _sig_level2 as _l2
+from . import _sig_vjp as _vjp
 from . import _signature_kernels as _k
 from . import _signature_threads as _threads
 from .validation import as_float_array, check_positive_int
@@ -88,6 +92,10 @@ def _available_bytes() -> int:
         return 1 << 62
 
 
+#: Requests below this many bytes are not checked against the available memory.
+_SMALL_REQUEST = 64 * 2 ** 20
+
+
 def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     """Refuse, before allocating, a request whose working arrays would not fit in memory.
 
@@ -99,6 +107,8 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
     if log and depth > 1 and d > 1:
         need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+    if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
+        return
     avail = _available_bytes()
     if need > avail:
         what = "logsignature" if log else "signature"
@@ -108,15 +118,33 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
             f"Lower depth, process the batch in smaller pieces, or use fewer dimensions.")
 
 
-def _check_paths(paths) -> np.ndarray:
-    x = as_float_array(paths, "paths", min_ndim=2)
+def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
+    """Validated float64 paths; ``finite=False`` leaves NaN/inf to :func:`_finite_or_raise` where it can."""
+    x = as_float_array(paths, "paths", min_ndim=2, allow_nonfinite=True)
     if x.shape[-2] < 1:
         raise ValueError(f"paths needs at least one point along axis -2 (shape (..., n, d)), got shape "
                          f"{x.shape}.")
     if x.shape[-1] < 1:
         raise ValueError(f"paths needs at least one coordinate along the last axis (shape (..., n, d)), "
                          f"got shape {x.shape}.")
+    if finite or x.shape[-2] == 1 or x.shape[-1] == 1:
+        # a lone point does not enter the output, nor (d = 1, level 2 = ½ X²) an interior point
+        as_float_array(x, "paths")
     return x
+
+
+def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Return ``out``; if it holds NaN/inf, first raise the input check's error if the input does.
+
+    At depth >= 2 and d >= 2 every point of a path of two or more points enters the output
+    (through the increments on both sides of it, and NaN/inf never cancel), so a non-finite
+    input always gives a non-finite output: scanning the small output replaces scanning the whole
+    path on every call. A finite input whose signature overflows returns the overflowed values,
+    as before.
+    """
+    if not np.isfinite(out).all():
+        as_float_array(x, "paths")
+    return out
 
 
 def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
@@ -128,13 +156,9 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     nunits = nb * nchunks
     part = np.empty((nunits, dim))
     per_unit = (n / nchunks) * 1.5 * d ** depth
-    if nunits < _k.LANES:                     # too few units to fill the lanes: one at a time
-        _threads.run(lambda lo, hi: _k.scalar_units(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(nunits, per_unit))
-    else:
-        ngroups = -(-nunits // _k.LANES)
-        _threads.run(lambda lo, hi: _k.lane_groups(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, per_unit * _k.LANES))
+    ngroups = -(-nunits // _lanes.LANES)
+    _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
+                 _threads.ranges(ngroups, per_unit * _lanes.LANES))
     return part
 
 
@@ -148,13 +172,13 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if depth == 2:
         nchunks = _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2)
         part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
-        _threads.run(lambda lo, hi: _k.sig2_tasks(x, nchunks, lo, hi, part),
+        _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, lo, hi, part),
                      _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
-        return _k.sig2_glue(part, nb, nchunks, d)
+        return _l2.sig2_glue(part, nb, nchunks, d)
     nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
-        out = _k.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
+        out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
 
 
@@ -182,11 +206,11 @@ def signature(paths, depth: int) -> np.ndarray:
     array([1. , 1. , 0.5, 1. , 0. , 0.5])
     """
     depth = _check_depth(depth)
-    x = _check_paths(paths)
+    x = _check_paths(paths, finite=depth == 1)     # depth >= 2: checked through the output
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
     _check_fits(flat.shape[0], d, depth)
-    return _signature_flat(flat, depth).reshape(batch + (sigdim(d, depth),))
+    return _finite_or_raise(_signature_flat(flat, depth), x).reshape(batch + (sigdim(d, depth),))
 
 
 def logsignature(paths, depth: int) -> np.ndarray:
@@ -214,7 +238,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     array([1. , 1. , 0.5])
     """
     depth = _check_depth(depth)
-    x = _check_paths(paths)
+    x = _check_paths(paths, finite=False)          # checked by signature(x, 1) or through the output
     d = x.shape[-1]
     if depth == 1 or d == 1:
         # d = 1: the free Lie algebra is R (a path's log-signature is its increment).
@@ -222,7 +246,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     batch, n = x.shape[:-2], x.shape[-2]
     flat = np.ascontiguousarray(x.reshape((-1, n, d)))
     _check_fits(flat.shape[0], d, depth, log=True)
-    sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    sig = np.ascontiguousarray(_finite_or_raise(_signature_flat(flat, depth), x))
     if depth == 2:
         # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas
         iu, ju = np.triu_indices(d, k=1)
@@ -266,8 +290,9 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     units = _units(nb, n, nchunks)
     part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
-    _threads.run(lambda lo, hi: _k.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
-                 _threads.ranges(nb * nchunks, (n / nchunks) * 5 * d ** depth))
+    ngroups = -(-(nb * nchunks) // _lanes.LANES)
+    _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+                 _threads.ranges(ngroups, (n / nchunks) * 5 * d ** depth * _lanes.LANES))
     return _increments_to_points(gd, n)
 
 
@@ -367,7 +392,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     g_log_rev = np.empty_like(g_log_row)
     g_log_rev[:, perm] = g_log_row
     g_sig_rev = np.empty_like(sig_rev)
-    _threads.run(lambda lo, hi: _k.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
+    _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
                  _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
     return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
 
@@ -486,7 +511,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
     off = _offsets(d, depth)
-    _threads.run(lambda lo, hi: _k.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
+    _threads.run(lambda lo, hi: _vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
                  _threads.ranges(inc.shape[0], 4 * n * depth * depth * sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
     return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from roughpaths import RoughPath
-from roughpaths import _signature_kernels as kern
+from roughpaths import _sig_lanes, _sig_level2
 from roughpaths.signature import _units, logsignature, rough_path_signature, signature
 from roughpaths.tensor_algebra import (_reversed_to_rowmajor, lyndon_basis, sigdim, tensor_exp,
                                        tensor_log, tensor_product)
@@ -175,16 +175,16 @@ def test_chunked_kernels_match_iisignature(rng, m, nchunks):
     xc = np.ascontiguousarray(x)
     if m == 2:
         part = np.empty((2 * nchunks, d + d * (d - 1) // 2))
-        kern.sig2_tasks(xc, nchunks, 0, 2 * nchunks, part)
-        got = kern.sig2_glue(part, 2, nchunks, d)
+        _sig_level2.sig2_tasks(xc, nchunks, 0, 2 * nchunks, part)
+        got = _sig_level2.sig2_glue(part, 2, nchunks, d)
     else:
         off = np.zeros(m + 2, dtype=np.int64)
         for k in range(1, m + 1):
             off[k + 1] = off[k] + d ** k
         ub, lo, hi = _units(x.shape[0], x.shape[1], nchunks)
         part = np.empty((2 * nchunks, off[m + 1]))
-        kern.scalar_units(xc, ub, lo, hi, m, off, 0, 2 * nchunks, part)
-        got = kern.lane_glue(part, 2, nchunks, m, off)[:, _reversed_to_rowmajor(d, m)]
+        _sig_lanes.lane_groups(xc, ub, lo, hi, m, off, 0, 1, part)
+        got = _sig_lanes.lane_glue(part, 2, nchunks, m, off)[:, _reversed_to_rowmajor(d, m)]
     np.testing.assert_allclose(got, ref, rtol=0, atol=TOL)
 
 

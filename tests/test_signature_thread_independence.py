@@ -3,15 +3,16 @@
 The split of a path into chunks depends on the input's size only; each work unit is computed by
 the same arithmetic whichever thread runs it (and whichever range of units a thread takes), and
 the units are glued by Chen's identity in a fixed order. So ``numba.set_num_threads(1)`` and
-``(2)`` give the same bits, the lane kernel (units side by side) gives the same bits as the
-one-unit-at-a-time kernel, and splitting the work into other ranges changes nothing.
+``(2)`` give the same bits, the lane kernels (units side by side; signature and gradient) give the
+same bits as the one-unit-at-a-time kernels, and splitting the work into other ranges changes
+nothing.
 """
 
 import numba
 import numpy as np
 import pytest
 
-from roughpaths import _signature_kernels as kern
+from roughpaths import _sig_lanes as kern
 from roughpaths.signature import _offsets, _units, logsignature, signature, signature_vjp
 
 
@@ -39,18 +40,33 @@ def test_one_thread_equals_two_threads(shape, m):
 
 
 @pytest.mark.parametrize("nchunks", [1, 5])
-def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks):
-    x = np.ascontiguousarray(_path((9, 700, 3)))
-    m = 4
+@pytest.mark.parametrize("d,m", [(2, 5), (3, 4), (5, 3), (6, 3)])   # d <= 5 specialised, 6 generic
+def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m):
+    # 9 paths: a group of 8 lanes and one of 1; with 5 chunks the last chunk of each path is
+    # shorter than the others (units end at different steps); one path is scaled by 1e12
+    x = _path((9, 700, d))
+    x[4] *= 1e12
     units = _units(9, 700, nchunks)
     nu = 9 * nchunks
-    off = _offsets(3, m)
+    off = _offsets(d, m)
     one = np.empty((nu, off[m + 1]))
     kern.scalar_units(x, *units, m, off, 0, nu, one)
     lanes = np.empty_like(one)
     groups = -(-nu // kern.LANES)
     for g in range(groups):                       # one range per group, in reverse order
         kern.lane_groups(x, *units, m, off, groups - 1 - g, groups - g, lanes)
+    assert one.tobytes() == lanes.tobytes()
+
+
+def test_lanes_with_empty_units():
+    x = _path((3, 10, 3))                         # 9 segments in 4 chunks of 3: the last is empty
+    units = _units(3, 10, 4)
+    assert np.any(units[1] == units[2])
+    off = _offsets(3, 3)
+    one = np.empty((12, off[4]))
+    kern.scalar_units(x, *units, 3, off, 0, 12, one)
+    lanes = np.full_like(one, np.nan)
+    kern.lane_groups(x, *units, 3, off, 0, 2, lanes)
     assert one.tobytes() == lanes.tobytes()
 
 
@@ -67,3 +83,25 @@ def test_gradients_one_thread_equals_two_threads():
     finally:
         numba.set_num_threads(before)
     assert one.tobytes() == two.tobytes()
+
+
+@pytest.mark.parametrize("nchunks", [1, 5])
+@pytest.mark.parametrize("d,m", [(2, 4), (3, 3), (4, 3)])
+def test_gradient_lanes_equal_one_unit_at_a_time(nchunks, d, m):
+    from roughpaths import _sig_vjp
+    from roughpaths.signature import _reversed_parts
+
+    x = _path((9, 300, d))
+    x[2] *= 1e6
+    g = np.random.default_rng(5).standard_normal((9, _offsets(d, m)[m + 1]))
+    units = _units(9, 300, nchunks)
+    nu = 9 * nchunks
+    off = _offsets(d, m)
+    part = _reversed_parts(x, m, nchunks)
+    one = np.zeros((9, 299, d))
+    _sig_vjp.sig_vjp_units(x, *units, nchunks, m, off, part, g, 0, nu, one)
+    lanes = np.full_like(one, np.nan)
+    groups = -(-nu // kern.LANES)
+    for grp in range(groups):                     # one range per group, in reverse order
+        _sig_vjp.sig_vjp_groups(x, *units, nchunks, m, off, part, g, groups - 1 - grp, groups - grp, lanes)
+    assert one.tobytes() == lanes.tobytes()

@@ -1,0 +1,211 @@
+"""Level-2 signature kernels (private; called by :mod:`roughpaths.signature`).
+
+The level-2 signature of a piecewise-linear path y (y_0 = 0) has symmetric part ½ X⊗X (X the
+total increment) and antisymmetric part ½ Σ_k y_{k-1} ∧ y_k (the Lévy area, shoelace formula).
+One pass over the points, d(d-1)/2 accumulators, no temporaries. A long path is cut into chunks
+(:func:`sig2_tasks`, any range of chunks on any thread) glued by Chen's identity in a fixed order
+(:func:`sig2_glue`), so the split into ranges never changes a bit of the result.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_NOGIL = dict(cache=True, nogil=True)
+
+
+@njit(cache=True)
+def _area_chunk_d2(x, b, lo, hi, out):
+    x0, x1 = x[b, lo, 0], x[b, lo, 1]
+    p0 = 0.0
+    p1 = 0.0
+    a01 = 0.0
+    for k in range(lo + 1, hi + 1):
+        y0 = x[b, k, 0] - x0
+        y1 = x[b, k, 1] - x1
+        a01 += p0 * y1 - p1 * y0
+        p0, p1 = y0, y1
+    out[0] = p0
+    out[1] = p1
+    out[2] = a01
+
+
+@njit(cache=True)
+def _area_chunk_d3(x, b, lo, hi, out):
+    x0, x1, x2 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2]
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    a01 = 0.0
+    a02 = 0.0
+    a12 = 0.0
+    for k in range(lo + 1, hi + 1):
+        y0 = x[b, k, 0] - x0
+        y1 = x[b, k, 1] - x1
+        y2 = x[b, k, 2] - x2
+        a01 += p0 * y1 - p1 * y0
+        a02 += p0 * y2 - p2 * y0
+        a12 += p1 * y2 - p2 * y1
+        p0, p1, p2 = y0, y1, y2
+    out[0] = p0
+    out[1] = p1
+    out[2] = p2
+    out[3] = a01
+    out[4] = a02
+    out[5] = a12
+
+
+@njit(cache=True)
+def _area_chunk_d4(x, b, lo, hi, out):
+    x0, x1, x2, x3 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2], x[b, lo, 3]
+    p0, p1, p2, p3 = 0.0, 0.0, 0.0, 0.0
+    a01, a02, a03, a12, a13 = 0.0, 0.0, 0.0, 0.0, 0.0
+    a23 = 0.0
+    for k in range(lo + 1, hi + 1):
+        y0 = x[b, k, 0] - x0
+        y1 = x[b, k, 1] - x1
+        y2 = x[b, k, 2] - x2
+        y3 = x[b, k, 3] - x3
+        a01 += p0 * y1 - p1 * y0
+        a02 += p0 * y2 - p2 * y0
+        a03 += p0 * y3 - p3 * y0
+        a12 += p1 * y2 - p2 * y1
+        a13 += p1 * y3 - p3 * y1
+        a23 += p2 * y3 - p3 * y2
+        p0, p1, p2, p3 = y0, y1, y2, y3
+    out[0] = p0
+    out[1] = p1
+    out[2] = p2
+    out[3] = p3
+    out[4] = a01
+    out[5] = a02
+    out[6] = a03
+    out[7] = a12
+    out[8] = a13
+    out[9] = a23
+
+
+@njit(cache=True)
+def _area_chunk_d5(x, b, lo, hi, out):
+    x0, x1, x2, x3, x4 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2], x[b, lo, 3], x[b, lo, 4]
+    p0, p1, p2, p3, p4 = 0.0, 0.0, 0.0, 0.0, 0.0
+    a01, a02, a03, a04, a12 = 0.0, 0.0, 0.0, 0.0, 0.0
+    a13, a14, a23, a24, a34 = 0.0, 0.0, 0.0, 0.0, 0.0
+    for k in range(lo + 1, hi + 1):
+        y0 = x[b, k, 0] - x0
+        y1 = x[b, k, 1] - x1
+        y2 = x[b, k, 2] - x2
+        y3 = x[b, k, 3] - x3
+        y4 = x[b, k, 4] - x4
+        a01 += p0 * y1 - p1 * y0
+        a02 += p0 * y2 - p2 * y0
+        a03 += p0 * y3 - p3 * y0
+        a04 += p0 * y4 - p4 * y0
+        a12 += p1 * y2 - p2 * y1
+        a13 += p1 * y3 - p3 * y1
+        a14 += p1 * y4 - p4 * y1
+        a23 += p2 * y3 - p3 * y2
+        a24 += p2 * y4 - p4 * y2
+        a34 += p3 * y4 - p4 * y3
+        p0, p1, p2, p3, p4 = y0, y1, y2, y3, y4
+    out[0] = p0
+    out[1] = p1
+    out[2] = p2
+    out[3] = p3
+    out[4] = p4
+    out[5] = a01
+    out[6] = a02
+    out[7] = a03
+    out[8] = a04
+    out[9] = a12
+    out[10] = a13
+    out[11] = a14
+    out[12] = a23
+    out[13] = a24
+    out[14] = a34
+
+
+@njit(cache=True)
+def _area_chunk_generic(x, b, lo, hi, out):
+    d = x.shape[2]
+    prev = np.zeros(d)
+    cur = np.empty(d)
+    acc = np.zeros(d * (d - 1) // 2)
+    for k in range(lo + 1, hi + 1):
+        for i in range(d):
+            cur[i] = x[b, k, i] - x[b, lo, i]
+        q = 0
+        for i in range(d):
+            for j in range(i + 1, d):
+                acc[q] += prev[i] * cur[j] - prev[j] * cur[i]
+                q += 1
+        for i in range(d):
+            prev[i] = cur[i]
+    for i in range(d):
+        out[i] = prev[i]
+    for q in range(acc.shape[0]):
+        out[d + q] = acc[q]
+
+
+@njit(cache=True)
+def _area_chunk(x, b, lo, hi, out):
+    """Write ``(X, twice the Lévy area over i<j)`` of points ``lo..hi`` of path ``b`` into ``out``."""
+    d = x.shape[2]
+    if d == 2:
+        _area_chunk_d2(x, b, lo, hi, out)
+    elif d == 3:
+        _area_chunk_d3(x, b, lo, hi, out)
+    elif d == 4:
+        _area_chunk_d4(x, b, lo, hi, out)
+    elif d == 5:
+        _area_chunk_d5(x, b, lo, hi, out)
+    else:
+        _area_chunk_generic(x, b, lo, hi, out)
+
+
+@njit(**_NOGIL)
+def sig2_tasks(x, nchunks, lo, hi, part):
+    """``(increment, twice the Lévy area)`` of chunks ``t = lo..hi-1`` (path ``t // nchunks``) into ``part``."""
+    n = x.shape[1]
+    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
+    for t in range(lo, hi):
+        b = t // nchunks
+        c = t - b * nchunks
+        a = min(c * seg, n - 1)
+        e = min(a + seg, n - 1)
+        for r in range(part.shape[1]):
+            part[t, r] = 0.0
+        if e > a:
+            _area_chunk(x, b, a, e, part[t])
+
+
+@njit(**_NOGIL)
+def sig2_glue(part, nb, nchunks, d):
+    """Level-2 signatures ``(B, d + d*d)`` from the chunk data, glued by Chen: ``2A = 2A_1 + 2A_2 + X_1 ∧ X_2``."""
+    width = part.shape[1]
+    out = np.empty((nb, d + d * d))
+    tot = np.empty(width)
+    for b in range(nb):
+        for r in range(width):
+            tot[r] = 0.0
+        for c in range(nchunks):
+            p = part[b * nchunks + c]
+            q = 0
+            for i in range(d):
+                for j in range(i + 1, d):
+                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
+                    q += 1
+            for i in range(d):
+                tot[i] += p[i]
+        for i in range(d):
+            out[b, i] = tot[i]
+        q = 0
+        for i in range(d):
+            out[b, d + i * d + i] = 0.5 * tot[i] * tot[i]
+            for j in range(i + 1, d):
+                sym = 0.5 * tot[i] * tot[j]
+                out[b, d + i * d + j] = sym + 0.5 * tot[d + q]
+                out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
+                q += 1
+    return out

@@ -1,0 +1,453 @@
+"""Vector–Jacobian products of the signature kernels (private; called by :mod:`roughpaths.signature`).
+
+Reversed layout (word (i_1..i_k) at sum_j i_j d^(j-1)), so that a word u w splits as
+index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
+Backward through S = S_prev ⊗ exp(D) per segment (last to first):
+
+* S_prev = S ⊗ exp(-D) (the same Horner step, nothing of the forward pass stored);
+* then backward through the Horner step itself (:func:`_step_vjp`), which gives both the
+  cotangent of D and G_prev = G ◁ exp(D) for about three Horner steps' work.
+
+:func:`_lcon` / :func:`_rcon` (general contractions) serve the chunk cotangents and the log's
+backward pass. Serial kernels over a range ``[lo, hi)`` of work items (GIL released).
+:func:`sig_vjp_groups` runs the backward pass of LANES units side by side in packed registers
+(about 4-5x faster than :func:`sig_vjp_units`, one unit at a time, and bitwise the same).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ._sig_lanes import BLOCK, _horner_step, _lane_step_d, mul_inplace
+from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
+from ._signature_kernels import _exp_lie2
+
+_NOGIL = dict(cache=True, nogil=True)
+
+
+@njit(cache=True)
+def _lcon(x0, s, g, d, m, offsets, out):
+    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``."""
+    for j in range(1, m + 1):
+        oj = offsets[j]
+        nj = d ** j
+        for w in range(nj):
+            out[oj + w] = x0 * g[oj + w]
+        for i in range(1, m - j + 1):
+            ni = d ** i
+            oi = offsets[i]
+            ok = offsets[i + j]
+            for w in range(nj):
+                base = ok + ni * w
+                acc = 0.0
+                for u in range(ni):
+                    acc += s[oi + u] * g[base + u]
+                out[oj + w] += acc
+
+
+@njit(cache=True)
+def _rcon(x0, g, e, d, m, offsets, out):
+    """``out <- g ◁ (x0 + e)``: ``out_i[p] = x0 g_i[p] + sum_{j>=1} sum_q g_{i+j}[p q] e_j[q]``."""
+    for i in range(1, m + 1):
+        oi = offsets[i]
+        ni = d ** i
+        for p in range(ni):
+            out[oi + p] = x0 * g[oi + p]
+        for j in range(1, m - i + 1):
+            oj = offsets[j]
+            ok = offsets[i + j]
+            for q in range(d ** j):
+                eq = e[oj + q]
+                base = ok + ni * q
+                for p in range(ni):
+                    out[oi + p] += g[base + p] * eq
+
+
+@njit(cache=True)
+def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
+
+    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
+    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
+    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
+    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
+    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``.
+    """
+    dim = offsets[m + 1]
+    for r in range(dim):
+        gprev[r] = g[r]
+    for q in range(d):
+        gdelta[q] = g[q]
+    for k in range(m, 1, -1):
+        # forward: T_1 = delta/k + S_1, T_{j+1} = T_j ⊗ delta/(k-j) + S_{j+1}
+        inv = 1.0 / k
+        for q in range(d):
+            tb[q] = delta[q] * inv + s[q]
+        size = d
+        for j in range(1, k - 1):
+            f = 1.0 / (k - j)
+            oj = offsets[j]
+            on = offsets[j + 1]
+            for q in range(d):
+                e = delta[q] * f
+                base = on + size * q
+                for p in range(size):
+                    tb[base + p] = tb[oj + p] * e + s[base + p]
+            size *= d
+        # backward: gB_k = G_k
+        ok = offsets[k]
+        nk = d ** k
+        for r in range(nk):
+            ga[r] = g[ok + r]
+        for j in range(k - 1, 0, -1):
+            f = 1.0 / (k - j)
+            nj = d ** j
+            oj = offsets[j]
+            for p in range(nj):
+                gb[p] = 0.0
+            for q in range(d):
+                e = delta[q] * f
+                base = nj * q
+                acc = 0.0
+                for p in range(nj):
+                    gb[p] += ga[base + p] * e
+                    acc += ga[base + p] * tb[oj + p]
+                gdelta[q] += acc * f
+            for p in range(nj):
+                gprev[oj + p] += gb[p]
+                ga[p] = gb[p]
+        for q in range(d):
+            gdelta[q] += ga[q] * inv
+
+
+@njit(cache=True)
+def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
+    """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
+    dim = offsets[m + 1]
+    buf = np.empty(2 * d ** m)
+    tb = np.empty(dim)
+    ga = np.empty(d ** m)
+    gb = np.empty(d ** m)
+    gn = np.empty(dim)
+    delta = np.empty(d)
+    neg = np.empty(d)
+    gdelta = np.empty(d)
+    for k in range(hi, lo, -1):
+        for i in range(d):
+            delta[i] = x[b, k, i] - x[b, k - 1, i]
+            neg[i] = -delta[i]
+        _horner_step(s, neg, d, m, offsets, buf)
+        _step_vjp(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
+        for i in range(d):
+            gd[b, k - 1, i] = gdelta[i]
+        for r in range(dim):
+            g[r] = gn[r]
+
+
+@njit(cache=True)
+def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
+    """Cotangent of unit ``u``'s signature: ``P ▷ (G ◁ Q)``, P/Q the products of the units before/after."""
+    dim = offsets[m + 1]
+    b = u // nchunks
+    c = u - b * nchunks
+    q = np.zeros(dim)
+    for cc in range(c + 1, nchunks):
+        mul_inplace(q, part[b * nchunks + cc], d, m, offsets)
+    tmp = np.empty(dim)
+    _rcon(1.0, gtot[b], q, d, m, offsets, tmp)
+    pre = np.zeros(dim)
+    for cc in range(c):
+        mul_inplace(pre, part[b * nchunks + cc], d, m, offsets)
+    _lcon(1.0, pre, tmp, d, m, offsets, g)
+
+
+@njit(cache=True)
+def _mul_rev(x0, xs, a, d, m, offsets, out):
+    """``out <- (x0 + xs) ⊗ a`` (``a`` with no scalar), reversed layout, levels 1..m."""
+    for k in range(1, m + 1):
+        ok = offsets[k]
+        for r in range(d ** k):
+            out[ok + r] = x0 * a[ok + r]
+        for i in range(1, k):
+            oi = offsets[i]
+            oj = offsets[k - i]
+            ni = d ** i
+            for q in range(d ** (k - i)):
+                aq = a[oj + q]
+                base = ok + ni * q
+                for p in range(ni):
+                    out[base + p] += xs[oi + p] * aq
+
+
+@njit(cache=True)
+def _log_vjp_one(a, g, d, m, offsets, ga):
+    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion."""
+    dim = offsets[m + 1]
+    r = np.zeros((m + 2, dim))
+    for u in range(dim):
+        r[m, u] = a[u] * ((-1.0) ** (m + 1) / m)
+    for n in range(m - 1, 0, -1):
+        c = (-1.0) ** (n + 1) / n
+        _mul_rev(c, r[n + 1], a, d, m, offsets, r[n])
+    gc = g.copy()
+    tmp = np.empty(dim)
+    for u in range(dim):
+        ga[u] = 0.0
+    for n in range(1, m):
+        c = (-1.0) ** (n + 1) / n
+        _lcon(c, r[n + 1], gc, d, m, offsets, tmp)
+        for u in range(dim):
+            ga[u] += tmp[u]
+        _rcon(0.0, gc, a, d, m, offsets, tmp)
+        for u in range(dim):
+            gc[u] = tmp[u]
+    cm = (-1.0) ** (m + 1) / m
+    for u in range(dim):
+        ga[u] += cm * gc[u]
+
+
+@njit(cache=True)
+def _rough_vjp_one(inc, lev, s, g, d, m, offsets, ginc, glev):
+    """Backward through ``S = prod_k exp(inc_k + lev_k)`` for one path (reversed layout).
+
+    ``s`` is the final signature (overwritten), ``g`` its cotangent (overwritten). Per step, last
+    to first: ``S_prev = S ⊗ exp(-z)``, cotangent of ``E = exp(z)`` is ``S_prev ▷ G``,
+    ``G <- G ◁ E``, and the cotangent of ``z`` comes from the powers ``P_n = P_{n-1} ⊗ z / n``.
+    """
+    dim = offsets[m + 1]
+    nsteps = inc.shape[0]
+    e = np.empty(dim)
+    en = np.empty(dim)
+    p = np.empty(dim)
+    q = np.empty(dim)
+    ge = np.empty(dim)
+    gn = np.empty(dim)
+    z = np.zeros(dim)
+    pw = np.zeros((m + 1, dim))
+    gp = np.empty(dim)
+    gz = np.empty(dim)
+    tmp = np.empty(dim)
+    neg_x = np.empty(d)
+    neg_a = np.empty((d, d))
+    o2 = offsets[2] if m >= 2 else 0
+    for k in range(nsteps - 1, -1, -1):
+        for i in range(d):
+            neg_x[i] = -inc[k, i]
+            for j in range(d):
+                neg_a[i, j] = -lev[k, i, j]
+        _exp_lie2(neg_x, neg_a, d, m, offsets, en, p, q)
+        mul_inplace(s, en, d, m, offsets)                     # s = S_prev
+        _exp_lie2(inc[k], lev[k], d, m, offsets, e, p, q)
+        _lcon(1.0, s, g, d, m, offsets, ge)                   # cotangent of E
+        _rcon(1.0, g, e, d, m, offsets, gn)
+        # powers of z (levels 1 and 2 only)
+        for r in range(dim):
+            z[r] = 0.0
+        for i in range(d):
+            z[i] = inc[k, i]
+        if m >= 2:
+            for i in range(d):
+                for j in range(d):
+                    z[o2 + i + d * j] = lev[k, i, j]
+        for r in range(dim):
+            pw[1, r] = z[r]
+        for n in range(2, m + 1):
+            _mul_rev(0.0, pw[n - 1], z, d, m, offsets, pw[n])
+            for r in range(dim):
+                pw[n, r] /= n
+        # backward: E = sum_n P_n, P_n = P_{n-1} ⊗ z / n
+        for r in range(dim):
+            gp[r] = ge[r]
+            gz[r] = 0.0
+        for n in range(m, 1, -1):
+            _lcon(0.0, pw[n - 1], gp, d, m, offsets, tmp)      # P_{n-1} ▷ gP_n
+            for r in range(dim):
+                gz[r] += tmp[r] / n
+            _rcon(0.0, gp, z, d, m, offsets, tmp)              # gP_n ◁ z
+            for r in range(dim):
+                gp[r] = ge[r] + tmp[r] / n
+        for r in range(dim):
+            gz[r] += gp[r]
+        for i in range(d):
+            ginc[k, i] = gz[i]
+        if m >= 2:
+            for i in range(d):
+                for j in range(d):
+                    glev[k, i, j] = gz[o2 + i + d * j]
+        for r in range(dim):
+            g[r] = gn[r]
+
+
+@njit(**_NOGIL)
+def sig_vjp_units(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    """Cotangents of the segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d)."""
+    d = x.shape[2]
+    g = np.empty(offsets[m + 1])
+    for u in range(lo, hi):
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+        s = part[u].copy()
+        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+
+
+@njit(**_NOGIL)
+def log_vjp_rows(a, g, d, m, offsets, lo, hi, out):
+    """Row-wise :func:`_log_vjp_one` (reversed layout) for rows ``lo..hi-1``."""
+    for b in range(lo, hi):
+        _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
+
+
+@njit(**_NOGIL)
+def rough_vjp_rows(inc, lev, s, g, m, offsets, lo, hi, ginc, glev):
+    """Cotangents of the step increments / Lévy areas of paths ``lo..hi-1``."""
+    d = inc.shape[2]
+    for b in range(lo, hi):
+        _rough_vjp_one(inc[b], lev[b], s[b].copy(), g[b].copy(), d, m, offsets, ginc[b], glev[b])
+
+
+# ---------------------------------------------------------------------------------- lanes
+# The backward pass on LANES units side by side (rows of LANES values, roughpaths._simd), the
+# operations of _unit_vjp / _step_vjp on every lane; the sums over p are per lane, in the same
+# order, so the results are bitwise those of sig_vjp_units. Units are aligned at their last
+# segment: step tau handles segment uhi - tau of every unit that has it; the others get zero
+# increments and their values are not used.
+
+
+@njit(cache=True, inline="always")
+def _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """:func:`_step_vjp` on every lane; the increment is rows ``do/LANES ..`` of ``blk``."""
+    L = LANES
+    dim = offsets[m + 1]
+    for r in range(dim):
+        vstore(gprev, r * L, vload(g, r * L))
+    for q in range(d):
+        vstore(gdelta, q * L, vload(g, q * L))
+    for k in range(m, 1, -1):
+        inv = vsplat(1.0 / k)
+        for q in range(d):
+            vstore(tb, q * L, vadd(vmul(vload(blk, do + q * L), inv), vload(s, q * L)))
+        size = d
+        for j in range(1, k - 1):
+            f = vsplat(1.0 / (k - j))
+            oj = offsets[j] * L
+            on = offsets[j + 1] * L
+            for q in range(d):
+                e = vmul(vload(blk, do + q * L), f)
+                base = on + size * q * L
+                for p in range(size):
+                    vstore(tb, base + p * L, vadd(vmul(vload(tb, oj + p * L), e), vload(s, base + p * L)))
+            size *= d
+        ok = offsets[k] * L
+        for r in range(d ** k):
+            vstore(ga, r * L, vload(g, ok + r * L))
+        for j in range(k - 1, 0, -1):
+            f = vsplat(1.0 / (k - j))
+            nj = d ** j
+            oj = offsets[j] * L
+            zero = vsplat(0.0)
+            for p in range(nj):
+                vstore(gb, p * L, zero)
+            for q in range(d):
+                e = vmul(vload(blk, do + q * L), f)
+                base = nj * q * L
+                acc = vsplat(0.0)
+                for p in range(nj):
+                    a = vload(ga, base + p * L)
+                    vstore(gb, p * L, vadd(vload(gb, p * L), vmul(a, e)))
+                    acc = vadd(acc, vmul(a, vload(tb, oj + p * L)))
+                vstore(gdelta, q * L, vadd(vload(gdelta, q * L), vmul(acc, f)))
+            for p in range(nj):
+                b = vload(gb, p * L)
+                vstore(gprev, oj + p * L, vadd(vload(gprev, oj + p * L), b))
+                vstore(ga, p * L, b)
+        for q in range(d):
+            vstore(gdelta, q * L, vadd(vload(gdelta, q * L), vmul(vload(ga, q * L), inv)))
+
+
+@njit(cache=True, inline="always")
+def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                  gdelta, gd):
+    L = LANES
+    for l in range(L):                                       # increments, last segment first
+        u = grp * L + l
+        live = min(max(nsteps[l] - t0, 0), nt)
+        for t in range(live):
+            b = ub[u]
+            k = uhi[u] - t0 - t
+            for i in range(d):
+                v = x[b, k, i] - x[b, k - 1, i]
+                blk[(t * d + i) * L + l] = v
+                neg[(t * d + i) * L + l] = -v
+        for t in range(live, nt):
+            for i in range(d):
+                blk[(t * d + i) * L + l] = 0.0
+                neg[(t * d + i) * L + l] = 0.0
+    for t in range(nt):
+        do = t * d * L
+        _lane_step_d(s, neg, do, d, m, offsets, buf)          # S_prev = S ⊗ exp(-D)
+        _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gn, tb, ga, gb, gdelta)
+        for l in range(L):
+            if t0 + t < nsteps[l]:
+                u = grp * L + l
+                k = uhi[u] - t0 - t
+                for i in range(d):
+                    gd[ub[u], k - 1, i] = gdelta[i * L + l]
+        dim = offsets[m + 1]
+        for r in range(dim * L):
+            g[r] = gn[r]
+
+
+@njit(cache=True)
+def _back_block(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                gdelta, gd):
+    if d == 2:
+        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, 2, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                      gdelta, gd)
+    elif d == 3:
+        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, 3, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                      gdelta, gd)
+    else:
+        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                      gdelta, gd)
+
+
+@njit(**_NOGIL)
+def sig_vjp_groups(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    """:func:`sig_vjp_units` on lane groups ``lo..hi-1`` (units ``g*LANES ..``), the same bits."""
+    L = LANES
+    T = BLOCK
+    d = x.shape[2]
+    dim = offsets[m + 1]
+    nunits = ub.shape[0]
+    s = np.empty(dim * L)
+    g = np.empty(dim * L)
+    gn = np.empty(dim * L)
+    tb = np.empty(dim * L)
+    ga = np.empty(d ** m * L)
+    gb = np.empty(d ** m * L)
+    gdelta = np.empty(d * L)
+    blk = np.empty(T * d * L)
+    neg = np.empty(T * d * L)
+    buf = np.empty(2 * d ** max(m - 2, 1) * L)
+    gu = np.empty(dim)
+    nsteps = np.zeros(L, dtype=np.int64)
+    for grp in range(lo, hi):
+        steps = 0
+        for l in range(L):
+            u = grp * L + l
+            if u < nunits:
+                nsteps[l] = uhi[u] - ulo[u]
+                _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, gu)
+                for r in range(dim):
+                    s[r * L + l] = part[u, r]
+                    g[r * L + l] = gu[r]
+            else:
+                nsteps[l] = 0
+                for r in range(dim):
+                    s[r * L + l] = 0.0
+                    g[r * L + l] = 0.0
+            steps = max(steps, nsteps[l])
+        for t0 in range(0, steps, T):
+            nt = min(T, steps - t0)
+            _back_block(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
+                        gdelta, gd)
