@@ -41,12 +41,13 @@ from .tensor_algebra import (_log_flat, _lyndon_flat, _lyndon_flat_vjp, _reverse
 __all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp", "logsignature_vjp",
            "rough_path_signature_vjp"]
 
-# Work splitting depends on the input's size only (never on the thread count), so results are
-# bitwise identical for any number of threads. A path is cut into chunks (glued by Chen's identity)
-# only when the batch alone gives fewer than _TARGET_UNITS work units; a chunk has at least
-# _MIN_CHUNK segments. Small inputs run on the calling thread (see _signature_threads).
+# Work splitting depends on each path's length only (never on the thread count nor on the batch), so
+# a member's result is bitwise the same alone or in any batch, on any number of threads. A path of
+# n points is cut into min(_TARGET_UNITS, (n - 1) // _MIN_CHUNK) chunks glued by Chen's identity once
+# it has at least 2 _MIN_CHUNK segments (the glue costs ~depth d^depth per chunk, against
+# _MIN_CHUNK d^depth for the chunk itself). Small inputs run on the calling thread (_signature_threads).
 _TARGET_UNITS = 64
-_MIN_CHUNK = 256
+_MIN_CHUNK = 1024
 _MIN_CHUNK_L2 = 8192
 _TARGET_UNITS_L2 = 16
 
@@ -59,10 +60,11 @@ def _offsets(dim: int, depth: int) -> np.ndarray:
 
 
 def _n_chunks(batch: int, n: int, target: int, min_chunk: int) -> int:
-    """Chunks per path: a function of the input's size only."""
-    if batch >= target or n - 1 < 2 * min_chunk:
+    """Chunks per path: a function of the path length ``n`` only (``batch`` is deliberately unused, so
+    that a member's arithmetic does not depend on its neighbours)."""
+    if n - 1 < 2 * min_chunk:
         return 1
-    return max(1, min(-(-target // max(batch, 1)), (n - 1) // min_chunk))
+    return max(1, min(target, (n - 1) // min_chunk))
 
 
 def _units(nb: int, n: int, nchunks: int) -> tuple:

@@ -154,3 +154,19 @@ def test_logsignature_members_independent(data, depth):
     s = rp.logsignature(paths, depth)
     for i in range(paths.shape[0]):
         assert _same(s[i], rp.logsignature(paths[i], depth)), f"member {i}"
+
+
+@pytest.mark.parametrize("depth, n", [(2, 40_000), (3, 2_500), (4, 2_100)])
+def test_long_path_members_independent(depth, n):
+    """Long paths are cut into chunks glued by Chen's identity; the cut must depend on the path's length
+    only, so a member alone and the same member among 1 or 40 others get the same bits."""
+    rng = np.random.default_rng(depth)
+    paths = np.cumsum(rng.standard_normal((40, n, 3)) * 0.05, axis=-2)
+    alone = [rp.signature(paths[i], depth) for i in (0, 17, 39)]
+    for batch in (paths[:2], paths):
+        s = rp.signature(batch, depth)
+        for j, i in enumerate((0, 17, 39)):
+            if i < batch.shape[0]:
+                assert _same(s[i], alone[j]), f"member {i} in a batch of {batch.shape[0]}"
+    ls = rp.logsignature(paths[:2], depth)
+    assert _same(ls[0], rp.logsignature(paths[0], depth))
