@@ -3,11 +3,13 @@
     dY = A Y dt + Σ_{i=1}^{3} σ M_i Y ∘ dW^i,   Y_0 = (1, 0.5, -0.3),   T = 1.
 
 Strong error = root-mean-square over paths of |Y_T − Y_T^ref| (Euclidean), against a reference on the
-*same* Brownian rough path: a coarse Brownian rough path (increments exact, Lévy areas from
-``brownian_rough_path(levy_area="davie")``) is refined by Brownian-bridge splits
-(``roughpaths.brownian.refine``, factor 2 at a time; Chen-consistent: every coarser grid is an exact
-restriction of the fine path) to ``N_ref`` steps, where ``LogODE`` (exact exponential per step) gives the
-reference. Every solver then runs on restrictions of that same path, so the errors are pathwise.
+*same* Brownian rough path: a ``BrownianDriver`` on the fine grid of ``N_ref`` steps with
+error-controlled areas (``levy_area="mrongowius-rossler"``, L² error ``h^1.5`` per step, so the fine
+path has the Brownian law up to ~1e-7 per step), where ``LogODE`` (exact exponential per step) gives
+the reference. Every solver then runs on restrictions of that same path (Chen sums: the coarse
+increments and areas are those of the fine path), so the errors are pathwise. The errors of sampled
+coarse areas (Davie's, Foster's, the error-controlled ones) against the refined path are measured by
+``bench_levy_area.py``.
 
 The time to reach strong error 1e-3 is measured for each solver at its own required number of
 steps ``N*`` (interpolated on the error ladder), **including the sampling of its driver**: the order-1
@@ -25,7 +27,7 @@ import time
 
 import numpy as np
 
-from roughpaths.brownian import brownian_rough_path, refine
+from roughpaths.brownian import BrownianDriver, brownian_rough_path
 from roughpaths.solve import solve
 from roughpaths.solvers import Davie, Euler, Heun, LogODE
 from roughpaths.vector_fields import LinearVectorFields
@@ -49,10 +51,10 @@ from _timing import median_time
 
 
 def error_ladder(V, paths, n0, levels, seed):
-    rng = np.random.default_rng(seed)
-    X = brownian_rough_path(np.linspace(0.0, 1.0, n0 + 1), 3, rng, batch_shape=(paths,))
-    for _ in range(levels):
-        X = refine(X, 2, rng)
+    n_ref = n0 * 2 ** levels
+    drv = BrownianDriver(3, seed=seed, dt=1.0 / n_ref, n_steps=n_ref, batch_shape=(paths,),
+                         levy_area="mrongowius-rossler")
+    X = drv.rough_path()
     ref = solve(V, X, Y0, LogODE(), save_at="end").final
     return X, ref
 
@@ -84,7 +86,7 @@ def main(argv=None):
     t0 = time.perf_counter()
     X, ref = error_ladder(V, paths, n0, levels, seed=7)
     n_ref = X.n_steps
-    print(f"reference: {paths} paths, N_ref = {n_ref} steps (LogODE on refined Brownian rough path), "
+    print(f"reference: {paths} paths, N_ref = {n_ref} steps (LogODE on a Brownian rough path, MR areas), "
           f"{time.perf_counter() - t0:.1f} s")
 
     solvers = {"Davie": Davie(), "LogODE": LogODE(), "Heun (no area)": Heun()}
