@@ -46,6 +46,21 @@ def _scale_accumulate(dW, sqh, x):
 
 
 @njit(cache=True, nogil=True)
+def _path_normals(states, p, zrows, words):
+    """Path ``p``'s normals for the whole block (a row of ``zrows (2, n)``), in stream order.
+
+    Called for ``p = 0, 1, 2, ...`` in turn: at even ``p`` the streams of ``p`` and ``p + 1`` are
+    drawn together (:func:`roughpaths._random._pcg64_fill2`) into the two rows.
+    """
+    if p % 2 == 0:
+        if p + 1 < states.shape[0]:
+            _pcg64_fill2(states, p, p + 1, zrows[0], zrows[1], words[0], words[1])
+        else:
+            _pcg64_fill(states, p, zrows[0], words[0])
+    return zrows[p % 2]
+
+
+@njit(cache=True, nogil=True)
 def _areas_m1(dW, h, buf, states, davie, ito, out):
     """:func:`_block_areas` for ``m = 1`` (Davie's own method, ``A = H ∧ W + λ``, no substeps).
 
@@ -60,13 +75,8 @@ def _areas_m1(dW, h, buf, states, davie, ito, out):
     words = np.empty((2, K * na + 64 if draw else 0), dtype=np.uint64)
     zb = buf
     for p in range(P):
-        if draw:                      # the path's normals for the whole block, in stream order
-            if p % 2 == 0:            # two paths' streams at a time (see _pcg64_fill2)
-                if p + 1 < P:
-                    _pcg64_fill2(states, p, p + 1, zrows[0], zrows[1], words[0], words[1])
-                else:
-                    _pcg64_fill(states, p, zrows[0], words[0])
-            zb = zrows[p % 2].reshape((1, K, na))
+        if draw:
+            zb = _path_normals(states, p, zrows, words).reshape((1, K, na))
         for r in range(K):
             hr = h[r]
             sH = sHs[r]
@@ -139,13 +149,8 @@ def _block_areas(dW, h, buf, states, m, davie, ito, out):
     words = np.empty((2, K * na + 64 if draw else 0), dtype=np.uint64)
     zb = buf
     for p in range(P):
-        if draw:                      # the path's normals for the whole block, in stream order
-            if p % 2 == 0:            # two paths' streams at a time (see _pcg64_fill2)
-                if p + 1 < P:
-                    _pcg64_fill2(states, p, p + 1, zrows[0], zrows[1], words[0], words[1])
-                else:
-                    _pcg64_fill(states, p, zrows[0], words[0])
-            zb = zrows[p % 2].reshape((1, K, na))
+        if draw:
+            zb = _path_normals(states, p, zrows, words).reshape((1, K, na))
         for r in range(K):
             hr = h[r]
             sH = sHs[r]
