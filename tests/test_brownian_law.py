@@ -122,10 +122,16 @@ def test_kolmogorov_smirnov_d2_levy_area():
 
 @pytest.mark.slow
 def test_kolmogorov_smirnov_d2_levy_area_large():
+    """At 4e5 samples the exact d = 2 sampler passes, and Davie's one-step area (exact second moments
+    only, the documented default) is rejected: the test has the power to see the approximation."""
     t, n = 1.3, 400000
-    dW, XX = brownian_increments_and_areas(np.random.default_rng(77), 1, t, 2, batch_shape=(n,))
+    dW, XX = brownian_increments_and_areas(np.random.default_rng(77), 1, t, 2, batch_shape=(n,),
+                                           levy_area="exact")
     a = _levy(XX)[:, 0, 0, 1]
     assert stats.kstest(a, _levy_cdf, args=(t,)).pvalue > 1e-3
+    dW, XX = brownian_increments_and_areas(np.random.default_rng(77), 1, t, 2, batch_shape=(n,),
+                                           levy_area="davie")
+    assert stats.kstest(_levy(XX)[:, 0, 0, 1], _levy_cdf, args=(t,)).pvalue < 1e-6
 
 
 # ----------------------------------------------------------------------------- reproducibility
