@@ -34,7 +34,7 @@ from . import _sig_level2 as _l2
 from . import _sig_vjp as _vjp
 from . import _signature_kernels as _k
 from . import _signature_threads as _threads
-from .validation import as_float_array, check_positive_int
+from .validation import as_float_array, check_memory, check_positive_int
 from .tensor_algebra import (_log_flat, _lyndon_flat, _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim,
                              sigdim)
 
@@ -79,21 +79,6 @@ def _check_depth(depth) -> int:
     return check_positive_int(depth, "depth")
 
 
-def _available_bytes() -> int:
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        import os
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return 1 << 62
-
-
 #: Requests below this many bytes are not checked against the available memory.
 _SMALL_REQUEST = 64 * 2 ** 20
 
@@ -111,13 +96,10 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
         need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
     if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
         return
-    avail = _available_bytes()
-    if need > avail:
-        what = "logsignature" if log else "signature"
-        raise ValueError(
-            f"depth={depth} with d={d} and {batch} path(s): the {what} needs about {need / 2**30:.1f} GiB "
-            f"(sigdim({d}, {depth}) = {dim} floats per path) but {avail / 2**30:.1f} GiB is available. "
-            f"Lower depth, process the batch in smaller pieces, or use fewer dimensions.")
+    what = "logsignature" if log else "signature"
+    check_memory(need, f"depth={depth} with d={d} and {batch} path(s): the {what} (sigdim({d}, {depth}) = "
+                 f"{dim} floats per path)", "lower depth, process the batch in smaller pieces, or use "
+                 "fewer dimensions")
 
 
 def _check_paths(paths, *, finite: bool = True) -> np.ndarray:

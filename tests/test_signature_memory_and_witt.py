@@ -62,7 +62,7 @@ def test_lyndon_cache_stays_under_budget(rng):
 def test_refuses_a_depth_that_cannot_fit():
     x = np.zeros((3, 10))
     for fn in (lambda: signature(x, 14), lambda: logsignature(x, 14)):
-        with pytest.raises(ValueError, match=r"GiB.*Lower depth"):
+        with pytest.raises(ValueError, match=r"GiB.*lower depth"):
             fn()
 
 
