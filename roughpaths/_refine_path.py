@@ -192,7 +192,7 @@ def _refine_fourier(plan, W, A, xi, eta, S, z):
         G = zc.antisym((), d) * (h * math.sqrt(_tail_zeta2(n) / (2 * math.pi ** 2)))
         A_tail, A = A_tail + G, A + G
     beta = zc.take((M, d))
-    alpha = S_K = Rr = None
+    alpha = S_K = None
     for _ in range(GIBBS_SWEEPS):
         # α-block (α, S_K, R) given β: area Σ u_k∧α_k + W∧S_K + R = A_tail [, Σσα + S_K = S]
         u = sig[None, :, None] * W[:, None, :] - gam[None, :, None] * beta          # (R, M, d)
@@ -206,9 +206,8 @@ def _refine_fourier(plan, W, A, xi, eta, S, z):
             Y = _pair_solve(N, plan.var_R, A_tail - area0) if p else np.zeros((R, d, d))
             alpha = a0 - u @ np.swapaxes(Y, 1, 2)
             S_K = sk0 - plan.var_SK * (Y @ W[..., None])[..., 0]
-            Rr = r0 + plan.var_R * Y
         else:
-            alpha, S_K, Rr = _alpha_block_with_s(plan, W, u, N, a0, sk0, r0, area0, A_tail, S, sig)
+            alpha, S_K = _alpha_block_with_s(plan, W, u, N, a0, sk0, area0, A_tail, S, sig)
         # β-block (β, R) given α: Σ γ_k α_k∧β_k + R = A_tail - W∧S_tail
         S_tail = (alpha * sig[None, :, None]).sum(axis=1) + S_K
         target = A_tail - _wedge(W, S_tail)
@@ -220,7 +219,6 @@ def _refine_fourier(plan, W, A, xi, eta, S, z):
         if p:
             Y = _pair_solve(_pair_gram(ga), plan.var_R, target - lin0)
             beta = b0 - ga @ np.swapaxes(Y, 1, 2)
-            Rr = r0 + plan.var_R * Y
         else:
             beta = b0
     # the path at the interior sub-grid points
@@ -235,7 +233,7 @@ def _refine_fourier(plan, W, A, xi, eta, S, z):
     return w, _fine_areas_gibbs(plan.h / F, plan.fine, w, A, zc)
 
 
-def _alpha_block_with_s(plan, W, u, N, a0, sk0, r0, area0, A_tail, S, sig):
+def _alpha_block_with_s(plan, W, u, N, a0, sk0, area0, A_tail, S, sig):
     """The α-block update with the stored tail sum ``S`` as a further (``d``-row) constraint."""
     R, M, d = a0.shape
     iu, ju = np.triu_indices(d, 1)
@@ -267,7 +265,7 @@ def _alpha_block_with_s(plan, W, u, N, a0, sk0, r0, area0, A_tail, S, sig):
     YS = y[:, p:]
     alpha = a0 - u @ np.swapaxes(YA, 1, 2) + sig[None, :, None] * YS[:, None, :]
     S_K = sk0 + vS * (YS - (YA @ W[..., None])[..., 0])
-    return alpha, S_K, r0 + plan.var_R * YA
+    return alpha, S_K
 
 
 def _wedge_rows(v, iu, ju):
