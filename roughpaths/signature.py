@@ -43,13 +43,13 @@ __all__ = ["signature", "logsignature", "rough_path_signature", "signature_vjp",
 
 # Work splitting depends on each path's length only (never on the thread count nor on the batch), so
 # a member's result is bitwise the same alone or in any batch, on any number of threads. A path of
-# n points is cut into min(_TARGET_UNITS, (n - 1) // _MIN_CHUNK) chunks glued by Chen's identity once
+# n points is cut into min(_MAX_CHUNKS, (n - 1) // _MIN_CHUNK) chunks glued by Chen's identity once
 # it has at least 2 _MIN_CHUNK segments (the glue costs ~depth d^depth per chunk, against
 # _MIN_CHUNK d^depth for the chunk itself). Small inputs run on the calling thread (_signature_threads).
-_TARGET_UNITS = 64
+_MAX_CHUNKS = 64
 _MIN_CHUNK = 1024
 _MIN_CHUNK_L2 = 8192
-_TARGET_UNITS_L2 = 16
+_MAX_CHUNKS_L2 = 16
 
 
 def _offsets(dim: int, depth: int) -> np.ndarray:
@@ -59,9 +59,9 @@ def _offsets(dim: int, depth: int) -> np.ndarray:
     return off
 
 
-def _n_chunks(batch: int, n: int, target: int, min_chunk: int) -> int:
-    """Chunks per path: a function of the path length ``n`` only (``batch`` is deliberately unused, so
-    that a member's arithmetic does not depend on its neighbours)."""
+def _n_chunks(n: int, target: int, min_chunk: int) -> int:
+    """Chunks per path: a function of the path length ``n`` only, so that a member's arithmetic does not
+    depend on its neighbours."""
     if n - 1 < 2 * min_chunk:
         return 1
     return max(1, min(target, (n - 1) // min_chunk))
@@ -154,12 +154,12 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if depth == 1:
         return x[:, -1, :] - x[:, 0, :]
     if depth == 2:
-        nchunks = _n_chunks(nb, n, _TARGET_UNITS_L2, _MIN_CHUNK_L2)
+        nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
         part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
         _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, lo, hi, part),
                      _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
         return _l2.sig2_glue(part, nb, nchunks, d)
-    nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
+    nchunks = _n_chunks(n, _MAX_CHUNKS, _MIN_CHUNK)
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
         out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
@@ -270,7 +270,7 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     perm = _reversed_to_rowmajor(d, depth)
     g_rev = np.empty_like(g_row)
     g_rev[:, perm] = g_row
-    nchunks = _n_chunks(nb, n, _TARGET_UNITS, _MIN_CHUNK)
+    nchunks = _n_chunks(n, _MAX_CHUNKS, _MIN_CHUNK)
     units = _units(nb, n, nchunks)
     part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
