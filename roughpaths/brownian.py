@@ -156,26 +156,6 @@ def _seed_from_rng(rng) -> np.random.SeedSequence:
                     f"{type(rng).__name__}; pass rng=numpy.random.default_rng(seed).")
 
 
-# ---------------------------------------------------------------------------- kernels
-def _levy_area_from_substeps(w: np.ndarray, H: np.ndarray) -> np.ndarray:
-    r"""Chen-summed conditional-mean Lévy area of one step from its substeps.
-
-    Parameters
-    ----------
-    w, H : ndarray, shape ``(..., m, d)``
-        Substep increments and space-time Lévy areas.
-
-    Returns
-    -------
-    ndarray, shape ``(..., d, d)``
-        :math:`\sum_k (H_k\otimes w_k - w_k\otimes H_k) + \mathrm{Alt}\sum_{k<l} w_k\otimes w_l`
-        (antisymmetric, with the ½ convention).
-    """
-    s_excl = np.cumsum(w, axis=-2) - w
-    g = np.matmul(np.swapaxes(H + 0.5 * s_excl, -1, -2), w)
-    return g - np.swapaxes(g, -1, -2)
-
-
 # ---------------------------------------------------------------------------- public API
 def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy_area="davie",
                                   substeps=DEFAULT_SUBSTEPS, kind="stratonovich"):
