@@ -313,16 +313,14 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
     n_paths = check_positive_int(n_paths, "n_paths")
     n_steps, h = _coloured_grid(eps, T, h, nrm, n_paths)
     save_every = check_positive_int(save_every, "save_every")
-    check_memory(8.0 * 3 * n_paths * (n_steps // save_every + 1) * (len(systems) + 1),
-                 f"the saved states ({len(systems)} system(s) x {n_paths} paths x {n_steps // save_every + 1} "
-                 f"times x 3)", "save fewer times (a larger save_every) or use fewer paths")
+    K = n_steps // save_every + 1 + (n_steps % save_every > 0)   # every save_every-th step, and always T
+    check_memory(8.0 * 3 * n_paths * K * (len(systems) + 1),
+                 f"the saved states ({len(systems)} system(s) x {n_paths} paths x {K} times x 3)",
+                 "save fewer times (a larger save_every) or use fewer paths")
     method = _check_method(method)
     inertia = _check_inertia3(inertia)
     P0 = as_float_array(Pi0, "Pi0", ndim=1, last_dims=(3,))
-    saved_idx = np.arange(0, n_steps + 1, save_every)
-    if saved_idx[-1] != n_steps:                       # T is always saved (Solution.final is the state at T)
-        saved_idx = np.append(saved_idx, n_steps)
-    K = saved_idx.size
+    saved_idx = np.append(np.arange(0, n_steps + 1, save_every), n_steps)[:K]   # T is saved (Solution.final)
     M = wz.limit.scaling
     if wz.perturbation_B is not None:          # the limit's noise vectors σ M[:, k], driven by B
         lxi, ls, lmap = wz.limit_xi, wz.perturbation_B, None
