@@ -139,3 +139,19 @@ def test_anomaly_reduced():
 @pytest.mark.slow
 def test_anomaly_full():
     _check_anomaly((0.2, 0.1, 0.05, 0.025), 8000, 12)
+
+
+def test_saved_times_include_T_and_match_unsaved_runs():
+    """Each system comes back as a Solution whose times are every save_every-th grid time and T; the saved
+    states do not depend on save_every (same draws), and .final is the state at T."""
+    kw = dict(T=0.3, n_paths=3, systems=("coloured", "limit"))
+    a = simulate_wong_zakai_rigid_body(A, D, 0.2, SIGMA, rng=np.random.default_rng(4), save_every=7, **kw)
+    b = simulate_wong_zakai_rigid_body(A, D, 0.2, SIGMA, rng=np.random.default_rng(4), save_every=1, **kw)
+    n = b["coloured"].stats["n_steps"]
+    assert n % 7 != 0
+    for k in kw["systems"]:
+        assert a[k].times[-1] == b[k].times[-1] and abs(b[k].times[-1] - 0.3) < 1e-12
+        idx = np.r_[np.arange(0, n + 1, 7), n]
+        np.testing.assert_allclose(a[k].times, b[k].times[idx], rtol=0, atol=1e-15)
+        np.testing.assert_array_equal(a[k].states, b[k].states[:, idx])
+        np.testing.assert_array_equal(a[k].final, b[k].final)
