@@ -56,7 +56,8 @@ def _pade(A: np.ndarray, m: int) -> np.ndarray:
 def expm_batched(A) -> np.ndarray:
     r"""Matrix exponential of a batch ``A`` of shape ``(..., n, n)``, each member on its own.
 
-    Scaling and squaring with the diagonal Padé approximant of degree ``m ∈ {3, 5, 7, 9, 13}``
+    ``2 x 2`` members use the closed form :func:`_expm2` (compiled, one member at a time). Larger ones:
+    scaling and squaring with the diagonal Padé approximant of degree ``m ∈ {3, 5, 7, 9, 13}``
     (Higham 2005 thresholds, backward error below the float64 unit roundoff), with the degree and
     the number of squarings ``s`` chosen **per member** from its own 1-norm. Consequences a user can
     rely on:
