@@ -5,7 +5,8 @@ user: each member's Padé degree and number of squarings are chosen from that me
 so a member's result is bitwise the same whether it is computed alone or beside others, and a
 non-finite member gives NaN for itself only. The work is still vectorised: the members are grouped
 by degree (at most five groups), and the squarings run on the shrinking set of members that still
-need them.
+need them. ``2 x 2`` matrices (the planar and other two-dimensional linear fields) take a compiled
+closed form instead, member by member, more accurate than Padé and without the grouping.
 
 The small products :func:`matvec` and :func:`vecmat` serve the same promise for the linear vector
 fields: ``y @ A.T`` on a batch ``(B, e)`` is one BLAS matrix product whose summation order depends on
