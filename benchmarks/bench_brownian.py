@@ -35,7 +35,7 @@ import numpy as np
 
 from roughpaths import BrownianDriver
 from roughpaths._random import PathStreams, standard_normal_into
-from roughpaths.brownian import brownian_increments_and_areas
+from roughpaths import brownian_increments_and_areas
 
 from _timing import median_time as _median_time
 

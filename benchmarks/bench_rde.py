@@ -27,10 +27,10 @@ import time
 
 import numpy as np
 
-from roughpaths.brownian import BrownianDriver, brownian_rough_path
-from roughpaths.solve import solve
-from roughpaths.solvers import Davie, Euler, Heun, LogODE
-from roughpaths.vector_fields import LinearVectorFields
+from roughpaths import BrownianDriver, brownian_rough_path
+from roughpaths import solve
+from roughpaths import Davie, Euler, Heun, LogODE
+from roughpaths import LinearVectorFields
 
 TOL = 1e-3
 Y0 = np.array([1.0, 0.5, -0.3])

@@ -72,7 +72,7 @@ def interleaved_medians(fns, repeats: int) -> list:
 DEPTH10 = r"""
 import time, tracemalloc, numpy as np
 from roughpaths.signature import logsignature
-from roughpaths.tensor_algebra import logsigdim
+from roughpaths.algebra.tensor import logsigdim
 x = np.cumsum(np.random.default_rng(0).standard_normal((10, 3)), 0)
 t_start = time.perf_counter()
 logsignature(x[:3], 3)                     # load the compiled kernels (not the depth-10 map)
@@ -112,7 +112,7 @@ def main() -> None:
     import numba
     import pysiglib
 
-    from roughpaths.signature import logsignature, logsignature_vjp, signature, signature_vjp
+    from roughpaths import logsignature, logsignature_vjp, signature, signature_vjp
 
     rng = np.random.default_rng(12345)
     s = 10 if args.quick else 1

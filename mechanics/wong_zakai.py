@@ -49,8 +49,8 @@ import numpy as np
 
 from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_rng,
                                    check_work)
-from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
-from roughpaths.rough_path import RoughPath
+from roughpaths import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
+from roughpaths import RoughPath
 
 from roughpaths import Solution, solve
 

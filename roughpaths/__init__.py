@@ -24,7 +24,7 @@ from .integral import rough_integral
 from .io import load, load_metadata, register_format, save
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals, sample_levy_areas)
-from .level2 import level2_exp, level2_inv, level2_log, level2_mul
+from .algebra.level2 import level2_exp, level2_inv, level2_log, level2_mul
 from .norms import (
     area_holder_seminorm,
     area_p_variation,
@@ -46,7 +46,7 @@ from .signature import (logsignature, logsignature_vjp, rough_path_signature, ro
                         signature, signature_vjp)
 from .vector_fields import LinearDrift, VectorFields
 from .linear_fields import LinearVectorFields
-from .tensor_algebra import (
+from .algebra.tensor import (
     from_level2,
     from_lyndon_coordinates,
     logsigdim,

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .level2 import outer
+from .algebra.level2 import outer
 from .rough_path import RoughPath
 from .validation import check_memory, check_positive_int, check_rng
 

@@ -240,7 +240,7 @@ def piecewise_linear_lift(values, substeps: int, *, level: int = 2, times=None):
     t = np.linspace(0.0, 1.0, nf + 1) if times is None else check_times(times, "times", n=nf + 1)
     K, d = nf // m, v.shape[-1]
     if level > 2:
-        from .tensor_algebra import sigdim
+        from .algebra.tensor import sigdim
 
         try:
             size = sigdim(d, level)

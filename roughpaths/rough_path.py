@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .validation import as_float_array, check_antisymmetric, check_times
-from .level2 import outer
+from .algebra.level2 import outer
 
 __all__ = ["RoughPath", "chen_defect"]
 

@@ -2,7 +2,7 @@ r"""Geometric rough paths of any level ``N`` on a time grid: :class:`RoughPathN`
 
 A :class:`RoughPathN` stores, on a grid :math:`t_0 < \dots < t_K` shared by every path of a batch,
 the **step signatures** :math:`\mathbf{X}_{t_k, t_{k+1}} \in T^{(N)}(\mathbb{R}^d)`, truncated at
-level ``N``, in the flat layout of :mod:`roughpaths.tensor_algebra` (levels ``1..N`` concatenated,
+level ``N``, in the flat layout of :mod:`roughpaths.algebra.tensor` (levels ``1..N`` concatenated,
 row-major words, implicit scalar 1: the layout of ``iisignature.sig``). Every two-parameter
 quantity over grid times ``s < t`` follows by Chen's identity
 :math:`\mathbf{X}_{s,t} = \mathbf{X}_{s,u}\otimes\mathbf{X}_{u,t}`, so the object is Chen-consistent
@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from .rough_path import RoughPath
-from .tensor_algebra import (from_lyndon_coordinates, lyndon_coordinates, sigdim, tensor_exp,
+from .algebra.tensor import (from_lyndon_coordinates, lyndon_coordinates, sigdim, tensor_exp,
                              tensor_inverse, tensor_log, tensor_product)
 from .validation import as_float_array, check_antisymmetric, check_positive_int, check_times
 

@@ -1,12 +1,12 @@
 r"""Signatures and log-signatures of piecewise-linear paths and of level-2 geometric rough paths.
 
-Output layouts (see :mod:`roughpaths.tensor_algebra`):
+Output layouts (see :mod:`roughpaths.algebra.tensor`):
 
 * :func:`signature` — flat, levels ``1..depth`` concatenated, row-major words, no leading 1:
   the layout of ``iisignature.sig(path, depth)`` (and of ``esig.stream2sig`` minus its 1).
   Level 2 ``[i, j]`` is the area :math:`\int (X^i - X^i_s)\,dX^j` of ``docs/conventions.md``.
 * :func:`logsignature` — coordinates in the Lyndon basis (standard bracketing, ordered by
-  length then lexicographically; :func:`roughpaths.tensor_algebra.lyndon_basis` names them),
+  length then lexicographically; :func:`roughpaths.lyndon_basis` names them),
   the coordinates of ``iisignature.logsig(path, iisignature.prepare(d, depth))``. Level-2
   coordinate of ``[i,j]`` (``i < j``) is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`.
 
@@ -20,7 +20,7 @@ run side by side on groups of work units (paths, or chunks of a long path glued 
 identity). The split of the work depends on the input's size only, so results are bitwise
 identical for any number of threads; small inputs run on one thread. The log-signature takes the
 truncated logarithm by Horner's scheme and the Lyndon coordinates by forward substitution with a
-sparse triangular map (:mod:`roughpaths._lyndon`, cached under a byte budget); a request whose
+sparse triangular map (:mod:`roughpaths.algebra._lyndon`, cached under a byte budget); a request whose
 arrays would not fit in the available memory is refused with a ``ValueError`` before allocating.
 """
 
@@ -33,7 +33,7 @@ from . import _sig_level2 as _l2
 from . import _signature_kernels as _k
 from . import _signature_threads as _threads
 from .validation import as_float_array, check_memory, check_positive_int
-from .tensor_algebra import _log_flat, _lyndon_flat, _reversed_to_rowmajor, logsigdim, sigdim
+from .algebra.tensor import _log_flat, _lyndon_flat, _reversed_to_rowmajor, logsigdim, sigdim
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
@@ -206,7 +206,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     -------
     ndarray, shape ``(..., logsigdim(d, m))``
         Coordinates ``c`` with :math:`\log S(X) = \sum_w c_w P(w)` over Lyndon words ``w``, basis
-        :func:`roughpaths.tensor_algebra.lyndon_basis` (e.g. ``'1', '2', '[1,2]', ...``). The
+        :func:`roughpaths.lyndon_basis` (e.g. ``'1', '2', '[1,2]', ...``). The
         ``[i,j]`` coordinate is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`
         (with the ½). For the expanded (tensor) log use
         ``tensor_log(signature(paths, m), d)``.

@@ -16,7 +16,7 @@ from . import _sig_vjp as _vjp
 from . import _signature_threads as _threads
 from .signature import (_MAX_CHUNKS, _MIN_CHUNK, _check_depth, _check_fits, _check_paths, _n_chunks, _offsets,
                         _reversed_parts, _signature_flat, _units, rough_path_signature)
-from .tensor_algebra import _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim, sigdim
+from .algebra.tensor import _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim, sigdim
 from .validation import as_float_array
 
 __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]

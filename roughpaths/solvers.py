@@ -26,7 +26,7 @@ import numbers
 import numpy as np
 
 from ._linalg import expm_batched, matvec
-from .level2 import outer
+from .algebra.level2 import outer
 
 __all__ = ["Solver", "Euler", "Heun", "Davie", "LogODE", "SOLVERS"]
 

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from roughpaths.brownian import brownian_increments_and_areas, brownian_rough_path
+from roughpaths import brownian_increments_and_areas, brownian_rough_path
 
 
 def _levy(XX):

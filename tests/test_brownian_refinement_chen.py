@@ -20,8 +20,8 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths.brownian import brownian_rough_path, refine
-from roughpaths.rough_path import RoughPath, chen_defect
+from roughpaths import brownian_rough_path, refine
+from roughpaths import RoughPath, chen_defect
 
 
 def _levy(XX):

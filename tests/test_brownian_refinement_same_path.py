@@ -30,9 +30,9 @@ import pytest
 from scipy.special import polygamma
 
 from roughpaths import BrownianDriver, LinearVectorFields, LogODE, solve
-from roughpaths.brownian import brownian_rough_path, refine
+from roughpaths import brownian_rough_path, refine
 from roughpaths.brownian_refined import RefinedBrownianDriver
-from roughpaths.levy_area import levy_area_terms
+from roughpaths import levy_area_terms
 
 
 def _chen_product(w, XX):

@@ -17,7 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from _oracles import naive_area
-from roughpaths.rough_path import RoughPath
+from roughpaths import RoughPath
 
 iisignature = pytest.importorskip("iisignature")
 

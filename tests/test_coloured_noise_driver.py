@@ -17,7 +17,7 @@ import pytest
 import scipy.integrate as si
 import scipy.linalg as sla
 
-from roughpaths.coloured_noise import (ResolutionWarning, coloured_noise_limit, iter_coloured_noise,
+from roughpaths import (ResolutionWarning, coloured_noise_limit, iter_coloured_noise,
                                        ou_step_law, sample_coloured_noise)
 
 A2 = np.array([[1.0, 2.0], [-0.5, 1.5]])

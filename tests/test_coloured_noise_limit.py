@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from roughpaths.coloured_noise import (coloured_noise_limit, coloured_noise_limit_path, lift_area_rate,
+from roughpaths import (coloured_noise_limit, coloured_noise_limit_path, lift_area_rate,
                                        paper_coloured_noise_matrices, sample_coloured_noise)
 
 A2 = np.array([[1.0, 2.0], [-0.5, 1.5]])

@@ -20,9 +20,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from roughpaths import RoughPath
-from roughpaths.solve import solve
-from roughpaths.solvers import Davie, Euler, Heun, LogODE
-from roughpaths.vector_fields import LinearVectorFields, VectorFields
+from roughpaths import solve
+from roughpaths import Davie, Euler, Heun, LogODE
+from roughpaths import LinearVectorFields, VectorFields
 
 
 # ---------------------------------------------------------------------------- smooth driver

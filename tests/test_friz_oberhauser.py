@@ -28,9 +28,9 @@ from _oracles import rk4_flow
 import pytest
 
 from roughpaths import RoughPath
-from roughpaths.solve import solve
-from roughpaths.solvers import Davie, LogODE
-from roughpaths.vector_fields import LinearVectorFields, VectorFields
+from roughpaths import solve
+from roughpaths import Davie, LogODE
+from roughpaths import LinearVectorFields, VectorFields
 
 S2 = np.array([[0.0, 1.4], [-1.4, 0.0]])
 S3 = np.array([[0.0, 1.0, -0.6], [-1.0, 0.0, 0.8], [0.6, -0.8, 0.0]])

@@ -14,7 +14,7 @@ from mechanics.lie_algebra import sl2r
 from mechanics.lie_poisson import LiePoissonSystem
 from mechanics.rigid_body import rigid_body
 from roughpaths import RoughPath, solve
-from roughpaths.level2 import outer
+from roughpaths.algebra.level2 import outer
 
 SYSTEMS = {
     "rigid body (numba kernel)": lambda: rigid_body([1.0, 2.0, 3.0], sigma=0.5, theta=1.0),

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy.special import polygamma
 
-from roughpaths.levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals,
+from roughpaths import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals,
                                   levy_area_terms, levy_areas_from_normals, sample_levy_areas)
 
 

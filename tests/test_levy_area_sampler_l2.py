@@ -19,7 +19,7 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths.brownian import brownian_increments_and_areas
+from roughpaths import brownian_increments_and_areas
 
 
 def _levy_area_from_substeps(w, H):

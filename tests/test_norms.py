@@ -21,11 +21,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from roughpaths.norms import (area_holder_seminorm, area_p_variation, holder_distance,
+from roughpaths import (area_holder_seminorm, area_p_variation, holder_distance,
                               holder_seminorm, p_variation, rough_path_holder_norm,
                               rough_path_p_variation)
 from _oracles import naive_area
-from roughpaths.rough_path import RoughPath
+from roughpaths import RoughPath
 
 
 # ----------------------------------------------------------------------------- naive oracles

@@ -20,9 +20,9 @@ import numpy as np
 import scipy.linalg
 
 from roughpaths import RoughPath
-from roughpaths.solve import solve
-from roughpaths.solvers import Davie, LogODE
-from roughpaths.vector_fields import LinearVectorFields, VectorFields
+from roughpaths import solve
+from roughpaths import Davie, LogODE
+from roughpaths import LinearVectorFields, VectorFields
 
 
 def _pure_area(s, n, T=1.0):

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from roughpaths import RoughPath
-from roughpaths.integral import rough_integral
-from roughpaths.solve import solve
-from roughpaths.solvers import Davie, Euler, Heun, LogODE
-from roughpaths.vector_fields import LinearVectorFields, VectorFields
+from roughpaths import rough_integral
+from roughpaths import solve
+from roughpaths import Davie, Euler, Heun, LogODE
+from roughpaths import LinearVectorFields, VectorFields
 
 
 @pytest.fixture

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.integrate import quad
 
 from roughpaths import RoughPath
-from roughpaths.integral import rough_integral
+from roughpaths import rough_integral
 
 
 def _bm(rng, paths, n, d=1, T=1.0):

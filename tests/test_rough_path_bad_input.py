@@ -9,7 +9,7 @@ silent result, a NaN or a numpy-internal error.
 import numpy as np
 import pytest
 
-from roughpaths.rough_path import RoughPath, chen_defect
+from roughpaths import RoughPath, chen_defect
 
 N, D = 4, 2
 INC = np.arange(N * D, dtype=float).reshape(N, D) / 10

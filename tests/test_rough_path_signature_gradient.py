@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from roughpaths import RoughPath
-from roughpaths.signature import rough_path_signature, rough_path_signature_vjp, signature_vjp
+from roughpaths import rough_path_signature, rough_path_signature_vjp, signature_vjp
 
 
 def _rough(rng, n, d, batch=()):

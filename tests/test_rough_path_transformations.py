@@ -20,7 +20,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from _oracles import naive_area
-from roughpaths.rough_path import RoughPath, chen_defect
+from roughpaths import RoughPath, chen_defect
 
 iisignature = pytest.importorskip("iisignature")
 

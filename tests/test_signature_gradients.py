@@ -13,8 +13,8 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths.signature import logsignature, logsignature_vjp, signature_vjp
-from roughpaths.tensor_algebra import logsigdim, sigdim
+from roughpaths import logsignature, logsignature_vjp, signature_vjp
+from roughpaths import logsigdim, sigdim
 
 
 def _naive_sig(x, m):

@@ -11,7 +11,7 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths.signature import logsignature, signature
+from roughpaths import logsignature, signature
 
 
 def _path(rng, shape, n, d):

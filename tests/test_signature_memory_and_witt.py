@@ -16,9 +16,9 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths import _lyndon
-from roughpaths.signature import logsignature, signature
-from roughpaths.tensor_algebra import logsigdim
+from roughpaths.algebra import _lyndon
+from roughpaths import logsignature, signature
+from roughpaths import logsigdim
 
 
 def _naive_lyndon_count(d, m):

@@ -22,9 +22,10 @@ import numpy as np
 import pytest
 
 from roughpaths import RoughPath
-from roughpaths import _sig_lanes, _sig_level2
+from roughpaths import _sig_lanes
+from roughpaths import _sig_level2
 from roughpaths.signature import _units, logsignature, rough_path_signature, signature
-from roughpaths.tensor_algebra import (_reversed_to_rowmajor, lyndon_basis, sigdim, tensor_exp,
+from roughpaths.algebra.tensor import (_reversed_to_rowmajor, lyndon_basis, sigdim, tensor_exp,
                                        tensor_log, tensor_product)
 
 TOL = 1e-12

@@ -10,7 +10,7 @@ Property tests (hypothesis) on random elements of :math:`T^{(m)}(\\mathbb{R}^d)`
   expansion from Lyndon coordinates (which a non-Lie element does not);
 * the shuffle identity ``S^i S^j = S^{ij} + S^{ji}``, ``S^i S^{jk} = S^{ijk} + S^{jik} + S^{jki}``
   (an independent check that signatures are group-like, written with naive loops here);
-* the level-2 truncation agrees with :mod:`roughpaths.level2` (product, inverse, exp, log).
+* the level-2 truncation agrees with :mod:`roughpaths.algebra.level2` (product, inverse, exp, log).
 """
 
 import itertools
@@ -20,9 +20,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from roughpaths.level2 import level2_exp, level2_inv, level2_log, level2_mul
-from roughpaths.signature import signature
-from roughpaths.tensor_algebra import (from_level2, from_lyndon_coordinates, lyndon_coordinates,
+from roughpaths import level2_exp, level2_inv, level2_log, level2_mul
+from roughpaths import signature
+from roughpaths import (from_level2, from_lyndon_coordinates, lyndon_coordinates,
                                        sigdim, tensor_exp, tensor_inverse, tensor_log, tensor_product,
                                        to_level2)
 

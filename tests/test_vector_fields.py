@@ -21,7 +21,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from roughpaths import expm_batched
-from roughpaths.vector_fields import LinearDrift, LinearVectorFields, VectorFields
+from roughpaths import LinearDrift, LinearVectorFields, VectorFields
 
 E, D = 3, 2
 
@@ -172,8 +172,8 @@ def test_expm_batched_matches_scipy(log_scale, n):
 def test_linear_fast_paths_agree_with_generic_fields(rng):
     """Davie/LogODE use matrix shortcuts for LinearVectorFields; the generic callable path must agree."""
     from roughpaths import RoughPath
-    from roughpaths.solve import solve
-    from roughpaths.solvers import Davie, LogODE
+    from roughpaths import solve
+    from roughpaths import Davie, LogODE
 
     M = 0.5 * rng.standard_normal((3, E, E))
     A = 0.3 * rng.standard_normal((E, E))

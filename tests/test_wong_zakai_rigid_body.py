@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from roughpaths import solve
-from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_coloured_noise
+from roughpaths import paper_coloured_noise_matrices, sample_coloured_noise
 from mechanics.integrators import LieHeun
 from mechanics.lie_poisson import levy_velocity
 from mechanics.rigid_body import rigid_body

@@ -13,10 +13,10 @@ import os
 
 import numpy as np
 
-from roughpaths.brownian import brownian_rough_path
-from roughpaths.solve import solve
-from roughpaths.solvers import Davie, LogODE
-from roughpaths.vector_fields import LinearVectorFields
+from roughpaths import brownian_rough_path
+from roughpaths import solve
+from roughpaths import Davie, LogODE
+from roughpaths import LinearVectorFields
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")
 rng = np.random.default_rng(7)

@@ -20,7 +20,7 @@ from mechanics.gibbs import GibbsMeasure
 from mechanics.integrators import LieHeun
 from mechanics.rigid_body import rigid_body
 from roughpaths import BrownianDriver, solve
-from roughpaths.brownian import brownian_rough_path
+from roughpaths import brownian_rough_path
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")
 rng = np.random.default_rng(3)

@@ -17,7 +17,7 @@ import os
 
 import numpy as np
 
-from roughpaths.rough_path import RoughPath, chen_defect
+from roughpaths import RoughPath, chen_defect
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")
 rng = np.random.default_rng(2024)
@@ -76,7 +76,7 @@ assert np.allclose(coarse.area(0.0, 1.0), lhs, atol=1e-12)
 # Equivalently the level-2 logarithm `XX - ½ X⊗X` equals the Lévy area.
 
 # %%
-from roughpaths.level2 import level2_log
+from roughpaths import level2_log
 
 x, xx = X.increment(0.0, 1.0), X.area(0.0, 1.0)
 print("max |Sym(XX) - ½ X⊗X| =", np.max(np.abs(0.5 * (xx + xx.T) - 0.5 * np.outer(x, x))))

@@ -17,7 +17,7 @@ Conventions (``docs/conventions.md``):
 Examples
 --------
 >>> import numpy as np
->>> from roughpaths.level2 import level2_mul, level2_inv
+>>> from roughpaths.algebra.level2 import level2_mul, level2_inv
 >>> x, a = np.array([1.0, 2.0]), np.array([[0.5, 1.5], [0.5, 2.0]])
 >>> y, b = level2_mul(x, a, *level2_inv(x, a))
 >>> bool(np.allclose(y, 0) and np.allclose(b, 0))
@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import as_float_array
+from ..validation import as_float_array
 
 __all__ = ["level2_mul", "level2_inv", "level2_exp", "level2_log", "outer"]
 

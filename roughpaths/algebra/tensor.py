@@ -16,7 +16,7 @@ level is *implicit*:
 
 Level 2 is the area in the project's ordering: entry ``[i, j]`` is the word ``(i, j)``, i.e.
 :math:`\int (X^i - X^i_s)\,dX^j` for a signature (``docs/conventions.md``); :func:`to_level2` /
-:func:`from_level2` convert to and from the pair ``(x, a)`` of :mod:`roughpaths.level2`.
+:func:`from_level2` convert to and from the pair ``(x, a)`` of :mod:`roughpaths.algebra.level2`.
 
 Every function broadcasts over leading batch axes ``...``; the depth is read from the length of
 the last axis and ``dim``.
@@ -24,7 +24,7 @@ the last axis and ``dim``.
 Examples
 --------
 >>> import numpy as np
->>> from roughpaths.tensor_algebra import tensor_exp, tensor_log, tensor_product, tensor_inverse
+>>> from roughpaths.algebra.tensor import tensor_exp, tensor_log, tensor_product, tensor_inverse
 >>> z = np.array([1.0, 2.0, 0.0, 0.5, -0.5, 0.0])      # d = 2, depth 2: x = (1, 2), A12 = 0.5
 >>> g = tensor_exp(z, 2)
 >>> bool(np.allclose(tensor_log(g, 2), z))
@@ -39,11 +39,11 @@ from functools import lru_cache
 
 import numpy as np
 
-from . import _signature_kernels as _k
-from . import _signature_threads as _threads
+from .. import _signature_kernels as _k
+from .. import _signature_threads as _threads
 from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix, lyndon_projection,
                       lyndon_words)
-from .validation import as_float_array, check_memory, check_positive_int, check_same_batch
+from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
 
 __all__ = [
     "sigdim",
@@ -286,7 +286,7 @@ def tensor_log(a, dim: int) -> np.ndarray:
 
 # ------------------------------------------------------------------------------ level 2
 def to_level2(a, dim: int) -> tuple:
-    """Levels 1 and 2 of a flat element as the pair ``(x (..., d), a (..., d, d))`` of :mod:`roughpaths.level2`.
+    """Levels 1 and 2 of a flat element as the pair ``(x (..., d), a (..., d, d))`` of :mod:`roughpaths.algebra.level2`.
 
     Higher levels are dropped (truncation is a group morphism).
 
