@@ -20,7 +20,7 @@ from .coloured_noise import (
     paper_coloured_noise_matrices,
     sample_coloured_noise,
 )
-from .integral import rough_integral
+from .paths.integral import rough_integral
 from .io import load, load_metadata, register_format, save
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals, sample_levy_areas)
@@ -34,8 +34,8 @@ from .norms import (
     rough_path_holder_norm,
     rough_path_p_variation,
 )
-from .rough_path import RoughPath, chen_defect
-from .rough_path_n import RoughPathN
+from .paths.rough_path import RoughPath, chen_defect
+from .paths.rough_path_n import RoughPathN
 from .fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
 from .driver import Driver
 from .solve import NonFiniteStateError, Solution, solve

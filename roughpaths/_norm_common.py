@@ -11,7 +11,7 @@ import numbers
 import numpy as np
 
 from .validation import as_float_array, check_times
-from .rough_path import RoughPath
+from .paths.rough_path import RoughPath
 
 #: Default ``max_points``: paths with more grid points are refused (cost O(n²) pairs).
 _DEFAULT_MAX_POINTS = 100_001

@@ -100,7 +100,7 @@ from ._brownian_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
 from .levy_area import LEVY_AREA_METHODS, block_areas, step_plan
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
-from .rough_path import RoughPath
+from .paths.rough_path import RoughPath
 from .brownian_refine import refine  # noqa: F401  (its home is brownian_refine; kept importable here)
 
 __all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "DEFAULT_SUBSTEPS"]

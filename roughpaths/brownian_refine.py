@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .algebra.level2 import outer
-from .rough_path import RoughPath
+from .paths.rough_path import RoughPath
 from .validation import check_memory, check_positive_int, check_rng
 
 __all__ = ["refine"]
@@ -129,7 +129,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     --------
     >>> import numpy as np
     >>> from roughpaths import brownian_rough_path
-    >>> from roughpaths.rough_path import chen_defect
+    >>> from roughpaths.paths.rough_path import chen_defect
     >>> rng = np.random.default_rng(2)
     >>> X = brownian_rough_path(np.linspace(0, 1, 5), 2, rng, batch_shape=(10,))
     >>> Y = refine(X, 3, rng)

@@ -97,7 +97,7 @@ from ._refine_path import (GIBBS_SWEEPS, MODES_PER_SUBSTEP, _BridgePlan, _Fourie
                            _refine_fourier, _tail_zeta2)
 from .driver import Driver
 from .levy_area import LEVY_AREA_METHODS, step_plan
-from .rough_path import RoughPath
+from .paths.rough_path import RoughPath
 from .validation import check_positive_int
 
 __all__ = ["RefinedBrownianDriver", "GIBBS_SWEEPS", "MODES_PER_SUBSTEP"]
@@ -126,7 +126,7 @@ class RefinedBrownianDriver(Driver):
     --------
     >>> import numpy as np
     >>> from roughpaths import BrownianDriver
-    >>> from roughpaths.rough_path import chen_defect
+    >>> from roughpaths.paths.rough_path import chen_defect
     >>> drv = BrownianDriver(2, seed=3, dt=0.25, n_steps=4, batch_shape=(5,), levy_area="mrongowius-rossler")
     >>> fine = drv.refine(3)
     >>> fine.n_steps, fine.batch_shape

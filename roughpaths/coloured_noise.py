@@ -43,7 +43,7 @@ import numpy as np
 
 from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
                          check_rng, check_times, check_work)
-from .rough_path import RoughPath
+from .paths.rough_path import RoughPath
 from ._random import PathStreams
 from ._seeded import SeededDriver
 from ._coloured_noise_kernels import _ou_lift_kernel

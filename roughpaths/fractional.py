@@ -49,8 +49,8 @@ import numpy as np
 import scipy.fft
 import scipy.linalg
 
-from .rough_path import RoughPath
-from .rough_path_n import RoughPathN
+from .paths.rough_path import RoughPath
+from .paths.rough_path_n import RoughPathN
 from .signature import signature
 from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
                          check_times)

@@ -274,7 +274,7 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
     >>> bool(np.allclose(rough_path_signature(RoughPath.from_path(pts), 3), signature(pts, 3)))
     True
     """
-    from .rough_path import RoughPath
+    from .paths.rough_path import RoughPath
 
     if not isinstance(X, RoughPath):
         raise TypeError(f"X must be a RoughPath, got {type(X).__name__}; for sampled points use "

@@ -198,7 +198,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     array([[ 0. ,  0.5],
            [-0.5,  0. ]])
     """
-    from .rough_path import RoughPath
+    from .paths.rough_path import RoughPath
 
     if not isinstance(X, RoughPath):
         raise TypeError(f"X must be a RoughPath, got {type(X).__name__}.")

@@ -18,8 +18,8 @@ import numpy as np
 
 from .validation import as_float_array, check_memory, check_positive_int, check_same_batch
 from .driver import Driver
-from .rough_path import RoughPath
-from .rough_path_n import RoughPathN
+from .paths.rough_path import RoughPath
+from .paths.rough_path_n import RoughPathN
 from .solvers import SOLVERS, Davie, Solver
 
 __all__ = ["solve", "Solution", "NonFiniteStateError"]

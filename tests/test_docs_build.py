@@ -122,7 +122,7 @@ def test_api_reference_has_typeset_maths_and_links(site):
     page = (site / "api" / "roughpaths" / "index.html").read_text(encoding="utf-8")
     links = re.findall(r'<a class="autorefs autorefs-internal"[^>]*href="[^"]*#(roughpaths\.[\w.]+)"', page)
     assert len(links) >= 50, len(links)
-    assert "roughpaths.rough_path.RoughPath" in links
+    assert "roughpaths.RoughPath" in links
 
 
 def test_every_formula_is_valid_katex(site, docs_site):

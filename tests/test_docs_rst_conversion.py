@@ -36,9 +36,9 @@ def test_cross_references_resolve_to_canonical_paths():
     out = griffe_rst.convert(":class:`RoughPath`, :func:`~roughpaths.solve`, :meth:`RoughPath.increment`, "
                              ":class:`numpy.random.Generator`, :class:`Nowhere`", solve)
     assert out == (
-        '<autoref identifier="roughpaths.rough_path.RoughPath" optional><code>RoughPath</code></autoref>, '
+        '<autoref identifier="roughpaths.RoughPath" optional><code>RoughPath</code></autoref>, '
         '<autoref identifier="roughpaths.solve.solve" optional><code>solve()</code></autoref>, '
-        '<autoref identifier="roughpaths.rough_path.RoughPath.increment" optional>'
+        '<autoref identifier="roughpaths.RoughPath.increment" optional>'
         '<code>RoughPath.increment()</code></autoref>, '
         '<code>numpy.random.Generator</code>, <code>Nowhere</code>')
 

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import as_float_array, check_antisymmetric, check_times
-from .algebra.level2 import outer
+from ..validation import as_float_array, check_antisymmetric, check_times
+from ..algebra.level2 import outer
 
 __all__ = ["RoughPath", "chen_defect"]
 

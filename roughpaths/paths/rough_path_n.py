@@ -27,9 +27,9 @@ from __future__ import annotations
 import numpy as np
 
 from .rough_path import RoughPath
-from .algebra.tensor import (from_lyndon_coordinates, lyndon_coordinates, sigdim, tensor_exp,
+from ..algebra.tensor import (from_lyndon_coordinates, lyndon_coordinates, sigdim, tensor_exp,
                              tensor_inverse, tensor_log, tensor_product)
-from .validation import as_float_array, check_antisymmetric, check_positive_int, check_times
+from ..validation import as_float_array, check_antisymmetric, check_positive_int, check_times
 
 __all__ = ["RoughPathN"]
 

@@ -1,0 +1,1 @@
+"""Rough paths on a time grid: level 2 (RoughPath), level N (RoughPathN), and the rough integral."""
