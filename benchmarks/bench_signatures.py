@@ -19,7 +19,7 @@ kernel, same loaded machine), bitwise equality of results with 1 and 2 threads, 
 gradient (vector-Jacobian product) at depth 4 on (b).
 
 Our depth >= 3 kernel runs 8 work units side by side in packed SIMD registers
-(``roughpaths/_sig_lanes.py``); its results are bitwise those of the one-unit-at-a-time loop.
+(``roughpaths/signatures/_lanes.py``); its results are bitwise those of the one-unit-at-a-time loop.
 
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick]``
 """

@@ -42,7 +42,7 @@ from .solve import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
 from .solvers_level3 import Davie3, LogODE3
-from .signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
+from .signatures.signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
                         signature, signature_vjp)
 from .vector_fields import LinearDrift, VectorFields
 from .linear_fields import LinearVectorFields

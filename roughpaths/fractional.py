@@ -51,7 +51,7 @@ import scipy.linalg
 
 from .paths.rough_path import RoughPath
 from .paths.rough_path_n import RoughPathN
-from .signature import signature
+from .signatures.signature import signature
 from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
                          check_times)
 

@@ -12,8 +12,8 @@ import numba
 import numpy as np
 import pytest
 
-from roughpaths import _sig_lanes as kern
-from roughpaths.signature import _offsets, _units, logsignature, signature, signature_vjp
+from roughpaths.signatures import _lanes as kern
+from roughpaths.signatures.signature import _offsets, _units, logsignature, signature, signature_vjp
 
 
 def _path(shape, seed=3):
@@ -88,8 +88,8 @@ def test_gradients_one_thread_equals_two_threads():
 @pytest.mark.parametrize("nchunks", [1, 5])
 @pytest.mark.parametrize("d,m", [(2, 4), (3, 3), (4, 3)])
 def test_gradient_lanes_equal_one_unit_at_a_time(nchunks, d, m):
-    from roughpaths import _sig_vjp
-    from roughpaths.signature import _reversed_parts
+    from roughpaths.signatures import _vjp as _sig_vjp
+    from roughpaths.signatures.signature import _reversed_parts
 
     x = _path((9, 300, d))
     x[2] *= 1e6

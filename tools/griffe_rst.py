@@ -159,7 +159,7 @@ def _canonical(path: str, module: bool = False) -> str | None:
             pass
     parts = path.split(".")
     # Attribute by attribute from the top-level package first, then from the longest importable
-    # module prefix (``roughpaths.signature.logsignature``: the package exports a function
+    # module prefix (``roughpaths.logsignature``: the package exports a function
     # ``signature`` that hides the submodule).
     for k in (1, *range(len(parts), 1, -1)):
         try:

@@ -39,8 +39,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .. import _signature_kernels as _k
-from .. import _signature_threads as _threads
+from ..signatures import _kernels as _k
+from .. import _threads
 from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix, lyndon_projection,
                       lyndon_words)
 from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
@@ -323,7 +323,7 @@ def lyndon_basis(dim: int, depth: int) -> list:
     """The Lyndon basis as bracket strings, e.g. ``'[1,[1,2]]'``, in ``iisignature.basis`` order.
 
     Letters are printed 1-based, as ``iisignature`` does. Coordinate ``i`` of
-    :func:`lyndon_coordinates` (and of :func:`roughpaths.signature.logsignature`) multiplies
+    :func:`lyndon_coordinates` (and of :func:`roughpaths.logsignature`) multiplies
     basis element ``i``.
 
     >>> lyndon_basis(2, 3)

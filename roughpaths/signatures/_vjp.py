@@ -1,4 +1,4 @@
-"""Vector–Jacobian products of the signature kernels (private; called by :mod:`roughpaths.signature`).
+"""Vector–Jacobian products of the signature kernels (private; called by :mod:`roughpaths.signatures.signature`).
 
 Reversed layout (word (i_1..i_k) at sum_j i_j d^(j-1)), so that a word u w splits as
 index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._sig_lanes import BLOCK, _horner_step, _lane_step_d, mul_inplace
+from ._lanes import BLOCK, _horner_step, _lane_step_d, mul_inplace
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
-from ._signature_kernels import _exp_lie2
+from ._kernels import _exp_lie2
 
 _NOGIL = dict(cache=True, nogil=True)
 
@@ -306,7 +306,7 @@ def rough_vjp_rows(inc, lev, s, g, m, offsets, lo, hi, ginc, glev):
 
 
 # ---------------------------------------------------------------------------------- lanes
-# The backward pass on LANES units side by side (rows of LANES values, roughpaths._simd), the
+# The backward pass on LANES units side by side (rows of LANES values, roughpaths.signatures._simd), the
 # operations of _unit_vjp / _step_vjp on every lane; the sums over p are per lane, in the same
 # order, so the results are bitwise those of sig_vjp_units. Units are aligned at their last
 # segment: step tau handles segment uhi - tau of every unit that has it; the others get zero

@@ -11,10 +11,10 @@ Output layouts (see :mod:`roughpaths.algebra.tensor`):
   coordinate of ``[i,j]`` (``i < j``) is the Lévy area :math:`\tfrac12(\mathbb{X}^{ij} - \mathbb{X}^{ji})`.
 
 Gradients (vector–Jacobian products, the quantities of ``iisignature.sigbackprop`` /
-``logsigbackprop``) are in :mod:`roughpaths.signature_grad`; their names are importable from here too.
+``logsigbackprop``) are in :mod:`roughpaths.signatures.gradients`; their names are importable from here too.
 
-Kernels are numba-compiled and cached (:mod:`roughpaths._sig_level2`, :mod:`roughpaths._sig_lanes`,
-:mod:`roughpaths._signature_kernels`; the backward pass :mod:`roughpaths._sig_vjp`): level 2 is a fused
+Kernels are numba-compiled and cached (:mod:`roughpaths.signatures._level2`, :mod:`roughpaths.signatures._lanes`,
+:mod:`roughpaths.signatures._kernels`; the backward pass :mod:`roughpaths.signatures._vjp`): level 2 is a fused
 one-pass kernel (increment and shoelace Lévy area), depth >= 3 a Horner–Chen update per segment,
 run side by side on groups of work units (paths, or chunks of a long path glued by Chen's
 identity). The split of the work depends on the input's size only, so results are bitwise
@@ -28,12 +28,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _sig_lanes as _lanes
-from . import _sig_level2 as _l2
-from . import _signature_kernels as _k
-from . import _signature_threads as _threads
-from .validation import as_float_array, check_memory, check_positive_int
-from .algebra.tensor import _log_flat, _lyndon_flat, _reversed_to_rowmajor, logsigdim, sigdim
+from . import _lanes
+from . import _level2 as _l2
+from . import _kernels as _k
+from .. import _threads
+from ..validation import as_float_array, check_memory, check_positive_int
+from ..algebra.tensor import _log_flat, _lyndon_flat, _reversed_to_rowmajor, logsigdim, sigdim
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
@@ -274,7 +274,7 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
     >>> bool(np.allclose(rough_path_signature(RoughPath.from_path(pts), 3), signature(pts, 3)))
     True
     """
-    from .paths.rough_path import RoughPath
+    from ..paths.rough_path import RoughPath
 
     if not isinstance(X, RoughPath):
         raise TypeError(f"X must be a RoughPath, got {type(X).__name__}; for sampled points use "
@@ -298,4 +298,4 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
 
 
 # the gradients live in their own module; imported last (it builds on the helpers above)
-from .signature_grad import logsignature_vjp, rough_path_signature_vjp, signature_vjp  # noqa: E402, F401
+from .gradients import logsignature_vjp, rough_path_signature_vjp, signature_vjp  # noqa: E402, F401

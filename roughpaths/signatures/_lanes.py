@@ -1,6 +1,6 @@
 """Depth >= 3 signature kernels: the Horner–Chen update, run on lanes (private).
 
-Called by :mod:`roughpaths.signature`. Internally level k is stored in *reversed* word order:
+Called by :mod:`roughpaths.signatures.signature`. Internally level k is stored in *reversed* word order:
 word (i_1..i_k) at ``sum_j i_j d^(j-1)``, so that a tensor product ``a_j ⊗ b_l`` is
 ``out[p + d^j q] = a[p] b[q]``; the Python wrapper permutes to iisignature's order at the end.
 ``offsets[k]`` is the start of level k (``offsets[1] = 0``, ``offsets[m + 1] = sigdim``).
@@ -12,9 +12,9 @@ level by level from the top (Horner's scheme for the segment exponential):
 
 then ``S_1 <- S_1 + D``. Every product is rounded, then every sum (no fused multiply-add).
 
-*Lanes.* :data:`~roughpaths._simd.LANES` work units (a path, or a chunk of a long path) advance
+*Lanes.* :data:`~roughpaths.signatures._simd.LANES` work units (a path, or a chunk of a long path) advance
 together, one segment per step; every array holds ``(entries, LANES)`` flattened, and every
-operation is one packed instruction on a row of LANES values (:mod:`roughpaths._simd`). A lane
+operation is one packed instruction on a row of LANES values (:mod:`roughpaths.signatures._simd`). A lane
 does exactly the scalar operations of :func:`_horner_step` on its own unit, so a unit's result
 does not depend on its lane, its neighbours, the grouping or the thread (:func:`scalar_units`
 is the one-unit-at-a-time kernel with the same bits). A unit's signature is copied out at its

@@ -1,9 +1,9 @@
 """Numba kernels of the tensor algebra behind the signatures (private).
 
 Truncated logarithm, Lyndon coordinates (and the transpose of their projection), and the
-exponential of a level-2 Lie element for :func:`roughpaths.signature.rough_path_signature`.
-The signature kernels themselves live in :mod:`roughpaths._sig_level2` (level 2),
-:mod:`roughpaths._sig_lanes` (depth >= 3, the lane kernel) and :mod:`roughpaths._sig_vjp`
+exponential of a level-2 Lie element for :func:`roughpaths.rough_path_signature`.
+The signature kernels themselves live in :mod:`roughpaths.signatures._level2` (level 2),
+:mod:`roughpaths.signatures._lanes` (depth >= 3, the lane kernel) and :mod:`roughpaths.signatures._vjp`
 (gradients).
 
 Layout: a truncated signature of a path in ``R^d`` at depth ``m`` is a flat float64 vector of
@@ -13,7 +13,7 @@ word order: ``(a_i ⊗ b_j)[p * d^j + q] = a_i[p] b_j[q]``; *reversed* order (th
 internal one): word ``(i_1..i_k)`` at ``sum_j i_j d^(j-1)``.
 
 Kernels named without a leading underscore are serial, release the GIL and take a range of rows
-``lo..hi-1``; :mod:`roughpaths._signature_threads` shares the ranges between threads.
+``lo..hi-1``; :mod:`roughpaths._threads` shares the ranges between threads.
 Precision: no ``fastmath``.
 """
 
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._sig_lanes import mul_inplace
+from ._lanes import mul_inplace
 
 _NOGIL = dict(cache=True, nogil=True)
 

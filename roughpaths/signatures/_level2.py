@@ -1,4 +1,4 @@
-"""Level-2 signature kernels (private; called by :mod:`roughpaths.signature`).
+"""Level-2 signature kernels (private; called by :mod:`roughpaths.signatures.signature`).
 
 The level-2 signature of a piecewise-linear path y (y_0 = 0) has symmetric part ½ X⊗X (X the
 total increment) and antisymmetric part ½ Σ_k y_{k-1} ∧ y_k (the Lévy area, shoelace formula).

@@ -2,22 +2,22 @@ r"""Gradients of the signature maps: vector–Jacobian products (the quantities 
 
 :func:`signature_vjp` and :func:`logsignature_vjp` are taken with respect to the path points,
 :func:`rough_path_signature_vjp` with respect to the step increments and areas of a level-2 rough
-path; layouts and conventions as in :mod:`roughpaths.signature` (which re-exports these three).
+path; layouts and conventions as in :mod:`roughpaths.signatures.signature` (which re-exports these three).
 The backward pass runs on the same work units as the forward kernels
-(:mod:`roughpaths._sig_vjp`), so it is bitwise independent of the thread count and of the batch.
+(:mod:`roughpaths.signatures._vjp`), so it is bitwise independent of the thread count and of the batch.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import _sig_lanes as _lanes
-from . import _sig_vjp as _vjp
-from . import _signature_threads as _threads
+from . import _lanes
+from . import _vjp
+from .. import _threads
 from .signature import (_MAX_CHUNKS, _MIN_CHUNK, _check_depth, _check_fits, _check_paths, _n_chunks, _offsets,
                         _reversed_parts, _signature_flat, _units, rough_path_signature)
-from .algebra.tensor import _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim, sigdim
-from .validation import as_float_array
+from ..algebra.tensor import _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim, sigdim
+from ..validation import as_float_array
 
 __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]
 
@@ -198,7 +198,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     array([[ 0. ,  0.5],
            [-0.5,  0. ]])
     """
-    from .paths.rough_path import RoughPath
+    from ..paths.rough_path import RoughPath
 
     if not isinstance(X, RoughPath):
         raise TypeError(f"X must be a RoughPath, got {type(X).__name__}.")
