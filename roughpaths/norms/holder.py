@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _norm_kernels as _k
-from ._norm_common import (_DEFAULT_MAX_POINTS, _check_alpha, _check_max_points, _dilate, _dummy_areas,
+from . import _kernels as _k
+from ._common import (_DEFAULT_MAX_POINTS, _check_alpha, _check_max_points, _dilate, _dummy_areas,
                            _lag_weights, _level1_data, _level2_data, _member_scale, _shape, _time_scale)
-from .validation import check_same_batch
+from ..validation import check_same_batch
 
 __all__ = ["holder_seminorm", "area_holder_seminorm", "rough_path_holder_norm", "holder_distance"]
 

@@ -1,6 +1,6 @@
 """Shared checks, data extraction and exact power-of-two rescaling of the norms (private).
 
-Used by :mod:`roughpaths.holder` and :mod:`roughpaths.p_variation`; see :mod:`roughpaths.norms` for
+Used by :mod:`roughpaths.norms.holder` and :mod:`roughpaths.norms.p_variation`; see :mod:`roughpaths.norms` for
 the definitions, the tensor norms and why every quantity is computed on a rescaled copy.
 """
 
@@ -10,8 +10,8 @@ import numbers
 
 import numpy as np
 
-from .validation import as_float_array, check_times
-from .paths.rough_path import RoughPath
+from ..validation import as_float_array, check_times
+from ..paths.rough_path import RoughPath
 
 #: Default ``max_points``: paths with more grid points are refused (cost O(n²) pairs).
 _DEFAULT_MAX_POINTS = 100_001

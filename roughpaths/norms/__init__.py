@@ -1,6 +1,6 @@
 r"""Hölder and p-variation norms of rough paths on a grid, and the rough-path distance.
 
-The Hölder quantities live in :mod:`roughpaths.holder`, the p-variation in :mod:`roughpaths.p_variation`;
+The Hölder quantities live in :mod:`roughpaths.norms.holder`, the p-variation in :mod:`roughpaths.norms.p_variation`;
 this module gathers them and states what they share.
 
 All quantities are computed **exactly over the grid**: the suprema run over every pair of grid

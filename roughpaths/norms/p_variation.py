@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _norm_kernels as _k
-from ._norm_common import (_DEFAULT_MAX_POINTS, _check_max_points, _check_p, _dilate, _level1_data,
+from . import _kernels as _k
+from ._common import (_DEFAULT_MAX_POINTS, _check_max_points, _check_p, _dilate, _level1_data,
                            _level2_data, _member_scale, _shape)
 
 __all__ = ["p_variation", "area_p_variation", "rough_path_p_variation"]
