@@ -3,8 +3,8 @@
 Two tables, same run, medians of ``--repeats`` calls (the machine is shared: read the ratios):
 
 1. **normals** (ns per normal): numpy's ``Generator.standard_normal(out=...)``; the raw-word
-   ziggurat ``roughpaths._random.standard_normal_into`` (same numbers, one generator); the
-   per-path streams ``roughpaths._random.PathStreams`` (numba ``SeedSequence`` + ``PCG64`` +
+   ziggurat ``roughpaths.drivers._random.standard_normal_into`` (same numbers, one generator); the
+   per-path streams ``roughpaths.drivers._random.PathStreams`` (numba ``SeedSequence`` + ``PCG64`` +
    ziggurat, one stream per path, the driver's generator), seeding included.
 2. **sampling** (ns per path-step, ``paths x steps``, d = 3), for increments only and with
    areas (davie m = 1, foster m = 1, davie m = 8):
@@ -34,7 +34,7 @@ import argparse
 import numpy as np
 
 from roughpaths import BrownianDriver
-from roughpaths._random import PathStreams, standard_normal_into
+from roughpaths.drivers._random import PathStreams, standard_normal_into
 from roughpaths import brownian_increments_and_areas
 
 from _timing import median_time as _median_time

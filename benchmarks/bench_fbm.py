@@ -1,4 +1,4 @@
-"""Benchmark: fractional Brownian motion sampling and its level-3 lift (``roughpaths.fractional``).
+"""Benchmark: fractional Brownian motion sampling and its level-3 lift (``roughpaths.drivers.fractional``).
 
 Times, as medians of several repeats:
 

@@ -6,7 +6,7 @@
 
    (``M_i``: rotation generators cycled over the noises plus a random shear; seeded). Strong error = RMS
    over paths of ``|Y_T - Y_T^ref|``, where the reference is ``LogODE`` on ``driver.refine(F)``: the same
-   Brownian path, ``F`` times finer (``roughpaths.brownian_refined``). Methods: ``Heun`` (no area; its
+   Brownian path, ``F`` times finer (``roughpaths.drivers.refinement``). Methods: ``Heun`` (no area; its
    error is measured on the same increments), ``Davie`` with Davie's areas (``levy_area="davie"``, one
    sub-step: not the area of the path), and ``Davie`` / ``LogODE`` with Mrongowius–Rößler areas of error
    ``h^1.5`` per step. For each, the step count ``N*`` reaching strong error ``1e-3`` is interpolated

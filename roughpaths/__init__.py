@@ -5,8 +5,8 @@ Conventions are fixed once, in ``docs/conventions.md`` of the project: the area 
 Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """
 
-from .brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path, refine
-from .coloured_noise import (
+from .drivers.brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path, refine
+from .drivers.coloured_noise import (
     ColouredNoiseDriver,
     ColouredNoiseLimit,
     ColouredNoiseSample,
@@ -22,7 +22,7 @@ from .coloured_noise import (
 )
 from .paths.integral import rough_integral
 from .io import load, load_metadata, register_format, save
-from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
+from .drivers.levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals, sample_levy_areas)
 from .algebra.level2 import level2_exp, level2_inv, level2_log, level2_mul
 from .norms import (
@@ -36,8 +36,8 @@ from .norms import (
 )
 from .paths.rough_path import RoughPath, chen_defect
 from .paths.rough_path_n import RoughPathN
-from .fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
-from .driver import Driver
+from .drivers.fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
+from .drivers.base import Driver
 from .solve import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
 from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver

@@ -1,7 +1,7 @@
 r"""The entry point :func:`solve` for rough differential equations, and its result :class:`Solution`.
 
 Solves :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i` on the grid of a :class:`~roughpaths.RoughPath`
-(or of a :class:`~roughpaths.driver.Driver`, consumed block by block) with a one-step solver that
+(or of a :class:`~roughpaths.Driver`, consumed block by block) with a one-step solver that
 follows the contract of :class:`roughpaths.solvers.Solver`. The time loop runs over steps in Python
 (or inside a solver's compiled block kernel); every step is vectorised over the batch (the driver's
 batch axes broadcast against those of ``y0``), so no Python loop runs per path. Batch members never
@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .validation import as_float_array, check_memory, check_positive_int, check_same_batch
-from .driver import Driver
+from .drivers.base import Driver
 from .paths.rough_path import RoughPath
 from .paths.rough_path_n import RoughPathN
 from .solvers import SOLVERS, Davie, Solver
@@ -135,7 +135,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         :math:`V_{i+1}` of the maths; the maths' :math:`V_0` is the drift. The object must have
         ``dim_state`` (``e``) and ``dim_noise`` (``d``).
     driver : RoughPath, RoughPathN or Driver
-        Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.driver.Driver` is
+        Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.Driver` is
         consumed block by block (memory for one block). Level 2 for level-2 solvers, a
         :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``).
         Convention: area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
@@ -155,7 +155,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         ``Solution.failed_step`` marking the failed ones (their states are NaN from the failure on).
         Either way a healthy member's result is the one it has when solved alone.
     block_steps : int, optional
-        Steps per block requested from a :class:`~roughpaths.driver.Driver` (its default if ``None``);
+        Steps per block requested from a :class:`~roughpaths.Driver` (its default if ``None``);
         it changes memory use, never the numbers.
     executor : concurrent.futures.Executor, optional
         Split the (flattened) batch into ``chunks`` contiguous groups of members and solve each on

@@ -53,7 +53,7 @@ class Solver:
     5. ``check_fields(fields)``: return the object to integrate, or raise ``TypeError`` naming what
        this solver accepts. The default accepts :class:`~roughpaths.vector_fields.VectorFields`.
     6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath``, ``RoughPathN`` or a
-       :class:`~roughpaths.driver.Driver`) cannot drive this scheme. The default checks the level.
+       :class:`~roughpaths.Driver`) cannot drive this scheme. The default checks the level.
     7. ``step(fields, y, t, dt, dX, dXX)``: one step from ``y`` (``(..., e)``) over ``[t, t + dt]``
        with the increments ``dX`` (``(..., d)``) and areas ``dXX`` (``(..., d, d)``, ``None`` for a
        level-1 solver; for a level-3 solver the tuple ``(XX, XXX)`` of the step's level-2 and level-3

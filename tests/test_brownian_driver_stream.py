@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from roughpaths import BrownianDriver, RoughPath, solve
-from roughpaths._random import PathStreams, standard_normal_into
+from roughpaths.drivers._random import PathStreams, standard_normal_into
 
 
 def _gen(seed, key):
@@ -195,7 +195,7 @@ def test_sizes_are_checked_before_allocating():
 
 @pytest.mark.parametrize("method, m", [("davie", 2), (None, 1)])
 def test_numpy_fallback_driver_gives_the_same_bits(monkeypatch, method, m):
-    import roughpaths._random as rnd
+    import roughpaths.drivers._random as rnd
     kw = dict(seed=12, dt=0.1, n_steps=9, batch_shape=(3,), levy_area=method, substeps=m)
     fast = BrownianDriver(2, **kw).rough_path()
     monkeypatch.setattr(rnd, "_FAST_OK", [False])

@@ -1,4 +1,4 @@
-r"""Law of the Brownian rough path sampler (``roughpaths.brownian``).
+r"""Law of the Brownian rough path sampler (``roughpaths.drivers.brownian``).
 
 Claims tested:
 

@@ -1,4 +1,4 @@
-r"""Chen-consistent refinement of a Brownian rough path (``roughpaths.brownian.refine``).
+r"""Chen-consistent refinement of a Brownian rough path (``roughpaths.refine``).
 
 Claims tested:
 

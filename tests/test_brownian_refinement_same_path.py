@@ -9,7 +9,7 @@ Statements tested (conventions of ``docs/conventions.md``: ``XX = ∫(X - X_s)�
 * **law, no inflation**: the fine Lévy areas of Brownian motion over a step δ have
   :math:`E[A_{ij}^2] = \delta^2/4` and :math:`E[A_{ij}^4] = 5\delta^4/16`; the refinement reproduces both
   within 4 standard errors, d = 2 and 3, factors 2, 3, 8, 64 (full set ``slow``), while the sequential
-  halvings of ``roughpaths.brownian.refine`` (+21 % variance at factor 8) are rejected by the same check,
+  halvings of ``roughpaths.refine`` (+21 % variance at factor 8) are rejected by the same check,
   and ``refine(X, 8, rng)`` in one go (the same construction from ``(W, L)`` only) passes it;
 * **davie / foster**: the fine path is the Gaussian bridge given the coarse increments and space-time
   areas ``H`` (regenerated here from the documented stream): for factor 2 the midpoint deviation
@@ -31,7 +31,7 @@ from scipy.special import polygamma
 
 from roughpaths import BrownianDriver, LinearVectorFields, LogODE, solve
 from roughpaths import brownian_rough_path, refine
-from roughpaths.brownian_refined import RefinedBrownianDriver
+from roughpaths.drivers.refinement import RefinedBrownianDriver
 from roughpaths import levy_area_terms
 
 

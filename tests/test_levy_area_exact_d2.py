@@ -18,9 +18,9 @@ import pytest
 from scipy import integrate, stats
 
 from roughpaths import BrownianDriver
-from roughpaths._brownian_kernels import _exact_areas_d2
-from roughpaths._random import PathStreams
-from roughpaths.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
+from roughpaths.drivers._area_kernels import _exact_areas_d2
+from roughpaths.drivers._random import PathStreams
+from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
 
 
 def _cf(lam, h, w2):

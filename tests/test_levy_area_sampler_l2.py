@@ -1,4 +1,4 @@
-r"""Strong L² error of the Lévy-area sampler (``roughpaths.brownian``).
+r"""Strong L² error of the Lévy-area sampler (``roughpaths.drivers.brownian``).
 
 Claims tested:
 

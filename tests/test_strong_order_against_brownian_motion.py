@@ -6,7 +6,7 @@ driven by ``BrownianDriver(levy_area="mrongowius-rossler")`` (per-step area erro
 default) converge with strong order 1.0 ± 0.1 at ``T = 1``, measured against a reference solved (``LogODE``,
 exact exponential per step) on ``driver.refine(F)``: the same Brownian path, ``F`` times finer, whose
 areas restrict exactly (Chen) to the driver's. With ``levy_area="davie"`` the coarse area is not the
-area of the refined path (``roughpaths.brownian_refined``), and the order against the same kind of
+area of the refined path (``roughpaths.drivers.refinement``), and the order against the same kind of
 reference falls to about ½ (asserted: below 0.7).
 
 Strong error: root mean square over paths of :math:`|Y_T - Y_T^{\text{ref}}|`; order: slope of

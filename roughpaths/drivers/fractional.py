@@ -49,10 +49,10 @@ import numpy as np
 import scipy.fft
 import scipy.linalg
 
-from .paths.rough_path import RoughPath
-from .paths.rough_path_n import RoughPathN
-from .signatures.signature import signature
-from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
+from ..paths.rough_path import RoughPath
+from ..paths.rough_path_n import RoughPathN
+from ..signatures.signature import signature
+from ..validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
                          check_times)
 
 __all__ = ["fbm", "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift"]
@@ -240,7 +240,7 @@ def piecewise_linear_lift(values, substeps: int, *, level: int = 2, times=None):
     t = np.linspace(0.0, 1.0, nf + 1) if times is None else check_times(times, "times", n=nf + 1)
     K, d = nf // m, v.shape[-1]
     if level > 2:
-        from .algebra.tensor import sigdim
+        from ..algebra.tensor import sigdim
 
         try:
             size = sigdim(d, level)

@@ -13,8 +13,8 @@ import os
 
 import numpy as np
 
-from .driver import Driver
-from .validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_times
+from .base import Driver
+from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_times
 
 
 def check_seed(seed) -> np.random.SeedSequence:

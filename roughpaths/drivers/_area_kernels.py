@@ -1,4 +1,4 @@
-r"""Numba kernel for the Brownian step areas (private; called by :mod:`roughpaths.brownian`).
+r"""Numba kernel for the Brownian step areas (private; called by :mod:`roughpaths.drivers.brownian`).
 
 One call turns pre-drawn standard normals into the level-2 step areas of a block of
 path-steps:
@@ -14,7 +14,7 @@ path-steps:
   in ``numpy.triu_indices`` order);
 * the symmetric part ``½ W⊗W`` and, for Itô, ``-½ h I``.
 
-Conventions as in :mod:`roughpaths.brownian`: ``XX[i, j] = ∫ (W^i - W^i_s) ∘dW^j``, Lévy area
+Conventions as in :mod:`roughpaths.drivers.brownian`: ``XX[i, j] = ∫ (W^i - W^i_s) ∘dW^j``, Lévy area
 with the ½. The random numbers are drawn by the caller (the driver's per-path streams); the
 kernel is deterministic. No temporary larger than ``O(d)``.
 
@@ -50,7 +50,7 @@ def _path_normals(states, p, zrows, words):
     """Path ``p``'s normals for the whole block (a row of ``zrows (2, n)``), in stream order.
 
     Called for ``p = 0, 1, 2, ...`` in turn: at even ``p`` the streams of ``p`` and ``p + 1`` are
-    drawn together (:func:`roughpaths._random._pcg64_fill2`) into the two rows.
+    drawn together (:func:`roughpaths.drivers._random._pcg64_fill2`) into the two rows.
     """
     if p % 2 == 0:
         if p + 1 < states.shape[0]:
@@ -120,7 +120,7 @@ def _block_areas(dW, h, buf, states, m, davie, ito, out):
         Standard normals, ``n_area = (m d if m > 1 else 0) + m d + (d(d-1)/2 if davie else 0)``;
         ignored (any shape ``(1, 1, n_area)``) with ``states``.
     states : (P, 4) uint64 or (0, 4)
-        If not empty, the PCG64 states of the paths' area streams (:mod:`roughpaths._random`):
+        If not empty, the PCG64 states of the paths' area streams (:mod:`roughpaths.drivers._random`):
         each path's ``K n_area`` normals of the block are drawn into a scratch row of the kernel,
         in stream order, instead of read from ``buf`` (same numbers as drawing the block first,
         without a ``(P, K, n_area)`` buffer). The states advance in place.
@@ -203,7 +203,7 @@ def _exact_areas_d2(dW, h, states, n_terms, t1, t2, ito, out):
     For a step of size ``h`` with increment ``w`` and ``μ = |w|²/h``, the Lévy area is
     ``A = h (L + √V Z)`` with ``L`` logistic of scale ``1/(2π)`` (``L = log(E₁/E₂)/(2π)``),
     ``Z ~ N(0, 1)`` and ``V = Σ_{k≥1} Γ_k/(2π²k²)``, ``Γ_k ~ Gamma(N_k)`` (0 if ``N_k = 0``),
-    ``N_k ~ Poisson(μ)`` (derivation in :mod:`roughpaths.brownian`). The first ``n_terms``
+    ``N_k ~ Poisson(μ)`` (derivation in :mod:`roughpaths.drivers.brownian`). The first ``n_terms``
     terms are drawn exactly (``N_k`` by exponential arrivals, ``Γ_k`` as ``½ χ²_{2N_k}``), the
     tail ``Σ_{k>n_terms}`` by a Gamma variable with its exact mean ``μ t1`` and variance
     ``2 μ t2`` (Marsaglia–Tsang). Draw order per step: ``Z``; ``E₁, E₂`` (2 normals each);

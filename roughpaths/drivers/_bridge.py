@@ -1,4 +1,4 @@
-r"""The mathematics of :meth:`roughpaths.BrownianDriver.refine` (private; see :mod:`roughpaths.brownian_refined`).
+r"""The mathematics of :meth:`roughpaths.BrownianDriver.refine` (private; see :mod:`roughpaths.drivers.refinement`).
 
 Per coarse step length: a plan of constants (:class:`_FourierPlan`, :class:`_BridgePlan`); per batch of
 coarse steps (rows), deterministic functions of the coarse data and a row block of standard normals

@@ -2,16 +2,16 @@ r"""Refinement of a Brownian rough path: split every step into equal substeps, C
 
 :func:`refine` conditions new grid points and areas on a coarse Brownian rough path (e.g. from
 :func:`roughpaths.brownian_rough_path` or :class:`roughpaths.BrownianDriver`); conventions as in
-:mod:`roughpaths.brownian`.
+:mod:`roughpaths.drivers.brownian`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .algebra.level2 import outer
-from .paths.rough_path import RoughPath
-from .validation import check_memory, check_positive_int, check_rng
+from ..algebra.level2 import outer
+from ..paths.rough_path import RoughPath
+from ..validation import check_memory, check_positive_int, check_rng
 
 __all__ = ["refine"]
 
@@ -114,7 +114,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
       area, as in the true conditional law given ``(W, L)``, which is not Gaussian either);
     * higher moments (the fine Lévy areas are lighter-tailed than Brownian ones);
     * for ``factor > 2`` the steps are refined in one go by the construction of
-      ``roughpaths.brownian_refined`` for a step whose only data are ``(W, L)`` (as for
+      ``roughpaths.drivers.refinement`` for a step whose only data are ``(W, L)`` (as for
       ``levy_area="exact"``: Fourier terms drawn given the area by Gibbs sweeps of exact Gaussian
       updates, fine areas conditioned on Chen's identity the same way), which keeps the fine Lévy-area
       variance and fourth moment Brownian within sampling error
@@ -189,12 +189,12 @@ def _assemble(dw, A, fine_t, X, d):
 
 
 def _refine_by_fourier_path(W, L, h, m, rng):
-    """``factor > 2``: the construction of ``roughpaths.brownian_refined`` with no stored Fourier terms.
+    """``factor > 2``: the construction of ``roughpaths.drivers.refinement`` with no stored Fourier terms.
 
     Rows ``W (R, d)``, Lévy areas ``L (R, d, d)``, step lengths ``h (R,)``; returns ``(R, m, d)`` increments
     and ``(R, m, d, d)`` Lévy areas. The normals are drawn from ``rng`` per distinct step length, in row order.
     """
-    from ._refine_path import _FourierPlan, _refine_fourier
+    from ._bridge import _FourierPlan, _refine_fourier
     from .levy_area import step_plan
 
     R, d = W.shape

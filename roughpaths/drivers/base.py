@@ -41,7 +41,7 @@ class Driver:
         """The whole driver as one ``RoughPath`` (its blocks concatenated)."""
         import numpy as np
 
-        from .paths.rough_path import RoughPath
+        from ..paths.rough_path import RoughPath
 
         blocks = list(self.blocks())
         inc = np.concatenate([b.increments for b in blocks], axis=-2)

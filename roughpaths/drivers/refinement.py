@@ -3,7 +3,7 @@ r"""One Brownian path behind every grid: :meth:`BrownianDriver.refine` (a driver
 ``BrownianDriver(...).refine(F)`` is a lazy, per-path seeded driver on the grid whose every step is split
 into ``F`` equal sub-steps (any integer ``F >= 1``), whose path is the *same* Brownian path as the coarse
 driver's: its increments sum (to round-off) to the coarse ones, and the coarse numbers are never
-redrawn. Conventions as in :mod:`roughpaths.brownian` (Lévy area with the ½; Chen:
+redrawn. Conventions as in :mod:`roughpaths.drivers.brownian` (Lévy area with the ½; Chen:
 :math:`A_{0,h} = \sum_l A_l + \tfrac12\sum_{l<l'} w_l\wedge w_{l'}`).
 
 The Brownian path inside a coarse step
@@ -15,7 +15,7 @@ On a step of length ``h`` with increment ``W``, with ``u = t/h``, the path is (K
 
 with independent standard normal vectors :math:`\alpha_k, \beta_k` (``d`` components each), and its Lévy
 area is :math:`A = \sum_k \frac{h}{2\pi k}\alpha_k\wedge\beta_k - S\wedge W` with
-:math:`S = \sum_k\sigma_k\alpha_k`. The Fourier samplers of :mod:`roughpaths.levy_area` draw exactly
+:math:`S = \sum_k\sigma_k\alpha_k`. The Fourier samplers of :mod:`roughpaths.drivers.levy_area` draw exactly
 these: their ``ξ_k, η_k`` are :math:`-\alpha_k, -\beta_k` for the ``n`` retained terms, their ``ψ`` is
 the tail sum :math:`\sum_{k>n}\sigma_k\alpha_k` scaled to unit variance, and their pair Gaussian the
 tail's own area :math:`\sum_{k>n}\frac{h}{2\pi k}\alpha_k\wedge\beta_k` (replaced by a Gaussian of the
@@ -93,12 +93,12 @@ import math
 import numpy as np
 
 from ._random import PathStreams
-from ._refine_path import (GIBBS_SWEEPS, MODES_PER_SUBSTEP, _BridgePlan, _FourierPlan, _refine_bridge,  # noqa: F401
+from ._bridge import (GIBBS_SWEEPS, MODES_PER_SUBSTEP, _BridgePlan, _FourierPlan, _refine_bridge,  # noqa: F401
                            _refine_fourier, _tail_zeta2)
-from .driver import Driver
+from .base import Driver
 from .levy_area import LEVY_AREA_METHODS, step_plan
-from .paths.rough_path import RoughPath
-from .validation import check_positive_int
+from ..paths.rough_path import RoughPath
+from ..validation import check_positive_int
 
 __all__ = ["RefinedBrownianDriver", "GIBBS_SWEEPS", "MODES_PER_SUBSTEP"]
 
@@ -110,7 +110,7 @@ _ROWS = 1024           # coarse path-steps refined at once (bounds the temporari
 class RefinedBrownianDriver(Driver):
     r"""A :class:`~roughpaths.BrownianDriver` on a grid ``factor`` times finer, carrying the same Brownian path.
 
-    Built by :meth:`roughpaths.BrownianDriver.refine`; see :mod:`roughpaths.brownian_refined` for what is
+    Built by :meth:`roughpaths.BrownianDriver.refine`; see :mod:`roughpaths.drivers.refinement` for what is
     exact and what is approximate for each ``levy_area`` method. Lazy (time blocks), per-path seeded:
     a path's numbers depend only on the coarse driver's seed, the path's index, ``factor`` and the
     method, never on the block size, :meth:`select` or the executor.

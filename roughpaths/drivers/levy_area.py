@@ -56,7 +56,7 @@ import numbers
 
 import numpy as np
 
-from .validation import as_float_array, check_positive_int, check_rng
+from ..validation import as_float_array, check_positive_int, check_rng
 
 __all__ = ["LEVY_AREA_METHODS", "levy_area_terms", "levy_area_normals", "choose_levy_area_method",
            "levy_areas_from_normals", "sample_levy_areas"]

@@ -11,7 +11,7 @@ with ``A`` (n×n) whose eigenvalues have positive real part and ``D`` (n×m), ``
 Brownian motion. ``y`` has the ε-independent stationary covariance ``Σ``, ``AΣ + ΣAᵀ = DDᵀ``.
 
 Its law, the exact ε → 0 limit and the exact transitions (derivation) are in
-:mod:`roughpaths.coloured_noise_law`; the names defined there are re-exported here.
+:mod:`roughpaths.drivers.coloured_noise_law`; the names defined there are re-exported here.
 
 Area of the smooth path (accuracy). On each step ``B^ε`` is C¹, so its area is not determined by
 the step's endpoint data. Each grid step is split into ``m`` sub-steps of fast length ``δ`` sampled
@@ -41,12 +41,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
+from ..validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
                          check_rng, check_times, check_work)
-from .paths.rough_path import RoughPath
+from ..paths.rough_path import RoughPath
 from ._random import PathStreams
 from ._seeded import SeededDriver
-from ._coloured_noise_kernels import _ou_lift_kernel
+from ._coloured_kernels import _ou_lift_kernel
 from .coloured_noise_law import (ColouredNoiseLimit, _check_AD, _check_eps, _substep_factor, coloured_noise_limit,
                                  expected_area_rate, lift_area_rate, ou_step_law, paper_coloured_noise_matrices)
 
@@ -173,7 +173,7 @@ def sample_coloured_noise(A, D, eps, times, *, rng, batch_shape=(), y0="stationa
     Examples
     --------
     >>> import numpy as np
-    >>> from roughpaths.coloured_noise import sample_coloured_noise
+    >>> from roughpaths.drivers.coloured_noise import sample_coloured_noise
     >>> A = np.array([[1.0, 1.0], [-1.0, 1.0]])
     >>> s = sample_coloured_noise(A, np.eye(2), 0.1, np.linspace(0, 1, 11), rng=np.random.default_rng(0),
     ...                           batch_shape=(4,))

@@ -1,4 +1,4 @@
-"""Numba kernel of the coloured-noise sampler (private; called by :mod:`roughpaths.coloured_noise`)."""
+"""Numba kernel of the coloured-noise sampler (private; called by :mod:`roughpaths.drivers.coloured_noise`)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-r"""numpy's ziggurat for standard normals over raw 64-bit words (private; see :mod:`roughpaths._random`).
+r"""numpy's ziggurat for standard normals over raw 64-bit words (private; see :mod:`roughpaths.drivers._random`).
 
 * :func:`_ziggurat_fill`: normals from a buffer of raw words, exactly as numpy's
   ``random_standard_normal`` (256 layers, ``distributions.c``) turns its bit generator's words into

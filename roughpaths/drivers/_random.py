@@ -4,7 +4,7 @@ Two services, both reproducing numpy **bit for bit** (so that the stream of a se
 plain numpy calls and can be checked against them):
 
 * :func:`standard_normal_into` ``(rng, out)``: ``rng.standard_normal(out=out)`` for a
-  ``numpy.random.Generator``, same values and end state, faster (:mod:`roughpaths._ziggurat`).
+  ``numpy.random.Generator``, same values and end state, faster (:mod:`roughpaths.drivers._ziggurat`).
 * :class:`PathStreams`: one independent stream per path for many paths at once, the stream of
   key ``k`` (a tuple of ints) being::
 
@@ -24,7 +24,7 @@ plain numpy calls and can be checked against them):
   changing an algorithm) the streams fall back to one numpy ``Generator`` per path, same
   numbers, slower.
 
-The ziggurat (numpy's tables and algorithm over raw words) is :mod:`roughpaths._ziggurat`.
+The ziggurat (numpy's tables and algorithm over raw words) is :mod:`roughpaths.drivers._ziggurat`.
 """
 
 from __future__ import annotations
