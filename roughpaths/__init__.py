@@ -38,14 +38,14 @@ from .paths.rough_path import RoughPath, chen_defect
 from .paths.rough_path_n import RoughPathN
 from .drivers.fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
 from .drivers.base import Driver
-from .solve import NonFiniteStateError, Solution, solve
+from .rde.integrate import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
-from .solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
-from .solvers_level3 import Davie3, LogODE3
+from .rde.solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
+from .rde.solvers_level3 import Davie3, LogODE3
 from .signatures.signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
                         signature, signature_vjp)
-from .vector_fields import LinearDrift, VectorFields
-from .linear_fields import LinearVectorFields
+from .rde.vector_fields import LinearDrift, VectorFields
+from .rde.linear_fields import LinearVectorFields
 from .algebra.tensor import (
     from_level2,
     from_lyndon_coordinates,

@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from .paths.rough_path import RoughPath
-from .solve import Solution
+from .rde.integrate import Solution
 
 __all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "FORMAT", "FORMAT_VERSION"]
 

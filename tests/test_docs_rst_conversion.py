@@ -37,7 +37,7 @@ def test_cross_references_resolve_to_canonical_paths():
                              ":class:`numpy.random.Generator`, :class:`Nowhere`", solve)
     assert out == (
         '<autoref identifier="roughpaths.RoughPath" optional><code>RoughPath</code></autoref>, '
-        '<autoref identifier="roughpaths.solve.solve" optional><code>solve()</code></autoref>, '
+        '<autoref identifier="roughpaths.solve" optional><code>solve()</code></autoref>, '
         '<autoref identifier="roughpaths.RoughPath.increment" optional>'
         '<code>RoughPath.increment()</code></autoref>, '
         '<code>numpy.random.Generator</code>, <code>Nowhere</code>')

@@ -2,7 +2,7 @@ r"""The entry point :func:`solve` for rough differential equations, and its resu
 
 Solves :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i` on the grid of a :class:`~roughpaths.RoughPath`
 (or of a :class:`~roughpaths.Driver`, consumed block by block) with a one-step solver that
-follows the contract of :class:`roughpaths.solvers.Solver`. The time loop runs over steps in Python
+follows the contract of :class:`roughpaths.Solver`. The time loop runs over steps in Python
 (or inside a solver's compiled block kernel); every step is vectorised over the batch (the driver's
 batch axes broadcast against those of ``y0``), so no Python loop runs per path. Batch members never
 affect each other: a member that becomes non-finite is reported by its index and step, and with
@@ -16,10 +16,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .validation import as_float_array, check_memory, check_positive_int, check_same_batch
-from .drivers.base import Driver
-from .paths.rough_path import RoughPath
-from .paths.rough_path_n import RoughPathN
+from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
+from ..drivers.base import Driver
+from ..paths.rough_path import RoughPath
+from ..paths.rough_path_n import RoughPathN
 from .solvers import SOLVERS, Davie, Solver
 
 __all__ = ["solve", "Solution", "NonFiniteStateError"]
@@ -129,8 +129,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     Parameters
     ----------
     fields : VectorFields or another object the solver accepts
-        The family :math:`(V_0; V_1..V_d)` (:class:`~roughpaths.vector_fields.LinearVectorFields` or
-        :class:`~roughpaths.vector_fields.VectorFields`); coadjoint solvers of :mod:`mechanics`
+        The family :math:`(V_0; V_1..V_d)` (:class:`~roughpaths.LinearVectorFields` or
+        :class:`~roughpaths.VectorFields`); coadjoint solvers of :mod:`mechanics`
         accept a ``LiePoissonSystem``. Driving field ``i`` of the API (``0``-based) is
         :math:`V_{i+1}` of the maths; the maths' :math:`V_0` is the drift. The object must have
         ``dim_state`` (``e``) and ``dim_noise`` (``d``).
@@ -143,7 +143,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         Initial condition(s); the batch ``B_y`` broadcasts against ``B_X``.
     solver : Solver instance or str, optional
         ``Davie()`` (default), ``LogODE()``, ``Heun()``, ``Euler()``, or one of the names
-        ``"davie", "logode", "heun", "euler"``; any object following the :class:`~roughpaths.solvers.Solver`
+        ``"davie", "logode", "heun", "euler"``; any object following the :class:`~roughpaths.Solver`
         contract.
     drift : callable, matrix ``(e, e)`` or LinearDrift, optional
         Extra drift added to :math:`V_0`, e.g. ``fields.friz_oberhauser_drift(s)`` (vector fields only).
@@ -320,7 +320,7 @@ def _chunk_of(driver, batch, lo, hi):
 def _solve_split(fields, driver, y0, solver, executor, chunks, **kw):
     import os
 
-    from .validation import check_positive_int
+    from ..validation import check_positive_int
 
     if not hasattr(executor, "submit"):
         raise TypeError(f"executor must be a concurrent.futures.Executor (e.g. ProcessPoolExecutor(), or a "

@@ -1,4 +1,4 @@
-"""Picklable callables behind :class:`roughpaths.vector_fields.VectorFields` (private).
+"""Picklable callables behind :class:`roughpaths.VectorFields` (private).
 
 Small classes instead of closures and lambdas, so that a family built from module-level functions
 pickles (and so runs in a process pool or on a cluster). Every stored field callable takes

@@ -21,9 +21,9 @@ A family is one object; every method is vectorised over leading batch axes of ``
 
 Three ways to build a family:
 
-* :class:`~roughpaths.linear_fields.LinearVectorFields` (:mod:`roughpaths.linear_fields`) from matrices
+* :class:`~roughpaths.LinearVectorFields` (:mod:`roughpaths.rde.linear_fields`) from matrices
   ``M`` (shape ``(d, e, e)``) and an optional drift matrix; Jacobians and brackets are exact, and
-  :class:`~roughpaths.solvers.LogODE` uses an exact matrix exponential.
+  :class:`~roughpaths.LogODE` uses an exact matrix exponential.
 * :class:`VectorFields` from callables with a user Jacobian (exact).
 * :class:`VectorFields` from callables without a Jacobian: it is computed by central differences
   with step :math:`h_b = \varepsilon^{1/3}\max(1, |y_b|)` (:math:`\varepsilon` = float64 machine
@@ -40,8 +40,8 @@ import numpy as np
 
 from ._field_callables import (_Autonomous, _Bracket, _Frozen, _FrizOberhauserDrift, _signature_hint,
                               _Stack, _Sum)
-from ._linalg import matvec
-from .validation import as_float_array, check_antisymmetric
+from .._linalg import matvec
+from ..validation import as_float_array, check_antisymmetric
 
 __all__ = ["VectorFields", "LinearDrift", "FD_STEP"]
 
@@ -125,7 +125,7 @@ class VectorFields:
     A rotation field and a radial field on the plane (they commute, so the bracket vanishes):
 
     >>> import numpy as np
-    >>> from roughpaths.vector_fields import VectorFields
+    >>> from roughpaths.rde.vector_fields import VectorFields
     >>> rot = lambda y: np.stack([-y[..., 1], y[..., 0]], axis=-1)
     >>> rad = lambda y: y
     >>> V = VectorFields([rot, rad], dim_state=2, dim_noise=2)
@@ -148,7 +148,7 @@ class VectorFields:
 
     def __init__(self, fields, jacobians=None, *, drift=None, drift_jacobian=None,
                  dim_state=None, dim_noise=None, time_dependent=False):
-        from .validation import check_positive_int
+        from ..validation import check_positive_int
         if dim_state is None or dim_noise is None:
             raise TypeError("dim_state (e) and dim_noise (d) are required for callable vector fields, "
                             "e.g. VectorFields(f, dim_state=3, dim_noise=2).")
@@ -156,7 +156,7 @@ class VectorFields:
             raise TypeError(f"time_dependent must be True or False, got {time_dependent!r}.")
         self.dim_state = check_positive_int(dim_state, "dim_state")
         self.dim_noise = check_positive_int(dim_noise, "dim_noise")
-        from .validation import check_memory
+        from ..validation import check_memory
         check_memory(8.0 * 64 * self.dim_state * self.dim_state * self.dim_noise,
                      f"probing fields with dim_state={self.dim_state} and dim_noise={self.dim_noise} (Jacobians "
                      f"of shape (dim_noise, dim_state, dim_state) on a small batch)", "check dim_state and dim_noise")
@@ -395,6 +395,6 @@ def _central_jacobian(f, y):
     return np.stack(cols, axis=-1)
 
 
-# LinearVectorFields (a subclass of VectorFields) lives in roughpaths.linear_fields; importable from here
+# LinearVectorFields (a subclass of VectorFields) lives in roughpaths.rde.linear_fields; importable from here
 # as before. Imported last: linear_fields needs the names above.
 from .linear_fields import LinearVectorFields  # noqa: E402

@@ -1,6 +1,6 @@
 r"""One-step RDE solvers that consume level-3 step signatures (rough paths with :math:`p\in[3, 4)`).
 
-They follow the contract of :class:`roughpaths.solvers.Solver` with ``increment_level = 3``:
+They follow the contract of :class:`roughpaths.Solver` with ``increment_level = 3``:
 :func:`roughpaths.solve` passes each step's level-2 and level-3 components as the tuple
 ``dXX = (XX, XXX)``, of shapes ``(..., d, d)`` and ``(..., d, d, d)`` (word ``(i, j, k)`` at
 ``XXX[..., i, j, k]``), from a :class:`~roughpaths.RoughPathN` driver of level >= 3.
@@ -47,7 +47,7 @@ import numbers
 
 import numpy as np
 
-from ._linalg import expm_batched, matvec, vecmat
+from .._linalg import expm_batched, matvec, vecmat
 from .solvers import Solver, _second_order
 
 __all__ = ["LogODE3", "Davie3"]

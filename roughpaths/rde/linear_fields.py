@@ -1,9 +1,9 @@
 r"""Linear vector fields :math:`V_i(y) = M_i y` with a linear (or general) drift: :class:`LinearVectorFields`.
 
-A :class:`~roughpaths.vector_fields.VectorFields` family whose Jacobians and brackets are exact
+A :class:`~roughpaths.VectorFields` family whose Jacobians and brackets are exact
 (:math:`[V_i, V_j](y) = (M_j M_i - M_i M_j)\,y`, ``docs/conventions.md``) and whose step
-generators the solvers use directly: :class:`~roughpaths.solvers.Davie` in closed form and
-:class:`~roughpaths.solvers.LogODE` through an exact matrix exponential of
+generators the solvers use directly: :class:`~roughpaths.Davie` in closed form and
+:class:`~roughpaths.LogODE` through an exact matrix exponential of
 :math:`G = A_0 h + \sum_i x^i M_i + \sum_{ij} L^{ij} M_j M_i`.
 """
 
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._linalg import vecmat
-from .validation import as_float_array, check_antisymmetric
+from .._linalg import vecmat
+from ..validation import as_float_array, check_antisymmetric
 from .vector_fields import LinearDrift, VectorFields, _linear_part, _parse_drift
 
 __all__ = ["LinearVectorFields"]

@@ -1,9 +1,9 @@
-r"""One-step RDE solvers for :func:`roughpaths.solve.solve`.
+r"""One-step RDE solvers for :func:`roughpaths.solve`.
 
 Each solver is a small class following the numbered contract of :class:`Solver` (what level of
 increment a step consumes, its declared orders, its calculus, the invariants it preserves, and the
 ``step`` / ``integrate`` methods). The solvers below integrate
-:class:`~roughpaths.vector_fields.VectorFields`; :mod:`mechanics` adds coadjoint solvers for
+:class:`~roughpaths.VectorFields`; :mod:`mechanics` adds coadjoint solvers for
 Lie–Poisson systems under the same contract, so that one :func:`roughpaths.solve` integrates both.
 
 Conventions (``docs/conventions.md``): area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`, bracket
@@ -25,8 +25,8 @@ import numbers
 
 import numpy as np
 
-from ._linalg import expm_batched, matvec
-from .algebra.level2 import outer
+from .._linalg import expm_batched, matvec
+from ..algebra.level2 import outer
 
 __all__ = ["Solver", "Euler", "Heun", "Davie", "LogODE", "SOLVERS"]
 
@@ -39,7 +39,7 @@ class Solver:
 
     1. ``increment_level`` (class attribute, 1, 2 or 3): what a step consumes, the increment
        :math:`X_{s,t}` alone (1), also the area :math:`\mathbb{X}_{s,t}` (2), or also the level-3 step
-       signature (3, :mod:`roughpaths.solvers_level3`). ``solve`` refuses a driver of lower level; a
+       signature (3, :mod:`roughpaths.rde.solvers_level3`). ``solve`` refuses a driver of lower level; a
        level-1 solver never sees the areas of a level-2 driver; the level-1/2 solvers here refuse a
        level-3 driver (:class:`~roughpaths.RoughPathN`) rather than drop its level 3 silently.
     2. ``order`` and ``smooth_order`` (class attributes): the declared strong order on Brownian rough
@@ -51,7 +51,7 @@ class Solver:
     4. ``preserves`` (class attribute, tuple of str): invariants kept to round-off by construction,
        e.g. ``("casimirs",)`` for coadjoint schemes; empty for the generic schemes.
     5. ``check_fields(fields)``: return the object to integrate, or raise ``TypeError`` naming what
-       this solver accepts. The default accepts :class:`~roughpaths.vector_fields.VectorFields`.
+       this solver accepts. The default accepts :class:`~roughpaths.VectorFields`.
     6. ``check_driver(driver)``: raise ``ValueError`` if the driver (a ``RoughPath``, ``RoughPathN`` or a
        :class:`~roughpaths.Driver`) cannot drive this scheme. The default checks the level.
     7. ``step(fields, y, t, dt, dX, dXX)``: one step from ``y`` (``(..., e)``) over ``[t, t + dt]``
@@ -268,7 +268,7 @@ class LogODE(Solver):
     with :math:`[V, W] = DW\cdot V - DV\cdot W`. (The symmetric part of ``L``, non-zero for an Itô lift,
     :math:`-\tfrac12 h I`, gives the Itô–Stratonovich correction.)
 
-    * :class:`~roughpaths.vector_fields.LinearVectorFields` with a linear drift: the flow is exact,
+    * :class:`~roughpaths.LinearVectorFields` with a linear drift: the flow is exact,
       :math:`Y' = \exp(G) Y` with :math:`G = A_0 h + M_i x^i + \sum_{ij} L^{ij} M_j M_i`, computed by a
       batched scaling-and-squaring Padé exponential (:func:`expm_batched`).
     * otherwise: ``inner_steps`` classical RK4 steps of the autonomous ODE :math:`z' = W(z)` on ``[0, 1]``;
@@ -323,5 +323,5 @@ class LogODE(Solver):
         return z
 
 
-#: Solver names accepted by :func:`~roughpaths.solve.solve` as strings (default instances).
+#: Solver names accepted by :func:`~roughpaths.solve` as strings (default instances).
 SOLVERS = {"euler": Euler, "heun": Heun, "davie": Davie, "logode": LogODE}
