@@ -118,7 +118,7 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
     --------
     The paper's case ``A = kI + Λ`` (``Λ13 = 1``), ``k = 0.05``, ``σ = 0.05``:
 
-    >>> from roughpaths.drivers.coloured_noise import paper_coloured_noise_matrices
+    >>> from roughpaths import paper_coloured_noise_matrices
     >>> wz = rigid_body_wong_zakai_limit(*paper_coloured_noise_matrices(0.05), 0.05)
     >>> wz.torque.round(6)                       # σ² (N23, -N13, N12)
     array([ 0.      , -0.024938,  0.      ])

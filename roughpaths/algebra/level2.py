@@ -17,7 +17,7 @@ Conventions (``docs/conventions.md``):
 Examples
 --------
 >>> import numpy as np
->>> from roughpaths.algebra.level2 import level2_mul, level2_inv
+>>> from roughpaths import level2_mul, level2_inv
 >>> x, a = np.array([1.0, 2.0]), np.array([[0.5, 1.5], [0.5, 2.0]])
 >>> y, b = level2_mul(x, a, *level2_inv(x, a))
 >>> bool(np.allclose(y, 0) and np.allclose(b, 0))

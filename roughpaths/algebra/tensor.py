@@ -24,7 +24,7 @@ the last axis and ``dim``.
 Examples
 --------
 >>> import numpy as np
->>> from roughpaths.algebra.tensor import tensor_exp, tensor_log, tensor_product, tensor_inverse
+>>> from roughpaths import tensor_exp, tensor_log, tensor_product, tensor_inverse
 >>> z = np.array([1.0, 2.0, 0.0, 0.5, -0.5, 0.0])      # d = 2, depth 2: x = (1, 2), A12 = 0.5
 >>> g = tensor_exp(z, 2)
 >>> bool(np.allclose(tensor_log(g, 2), z))

@@ -129,7 +129,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
     --------
     >>> import numpy as np
     >>> from roughpaths import brownian_rough_path
-    >>> from roughpaths.paths.rough_path import chen_defect
+    >>> from roughpaths import chen_defect
     >>> rng = np.random.default_rng(2)
     >>> X = brownian_rough_path(np.linspace(0, 1, 5), 2, rng, batch_shape=(10,))
     >>> Y = refine(X, 3, rng)

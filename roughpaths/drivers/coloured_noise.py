@@ -173,7 +173,7 @@ def sample_coloured_noise(A, D, eps, times, *, rng, batch_shape=(), y0="stationa
     Examples
     --------
     >>> import numpy as np
-    >>> from roughpaths.drivers.coloured_noise import sample_coloured_noise
+    >>> from roughpaths import sample_coloured_noise
     >>> A = np.array([[1.0, 1.0], [-1.0, 1.0]])
     >>> s = sample_coloured_noise(A, np.eye(2), 0.1, np.linspace(0, 1, 11), rng=np.random.default_rng(0),
     ...                           batch_shape=(4,))

@@ -181,7 +181,7 @@ def coloured_noise_limit(A, D) -> ColouredNoiseLimit:
     The paper's rigid-body example ``A = kI + Λ`` (``Λ13 = 1 = −Λ31``), ``D = I``, ``k = 0.05``:
     the paper's "s13 ≈ 19.95" is ``2 N13``.
 
-    >>> from roughpaths.drivers.coloured_noise import coloured_noise_limit, paper_coloured_noise_matrices
+    >>> from roughpaths import coloured_noise_limit, paper_coloured_noise_matrices
     >>> lim = coloured_noise_limit(*paper_coloured_noise_matrices(k=0.05))
     >>> round(float(lim.N[0, 2]), 4), round(float(lim.unnormalised_area_rate[0, 2]), 3)
     (9.9751, 19.95)
@@ -259,7 +259,7 @@ def ou_step_law(A, D, eps, h):
     Scalar OU (``A = a``, ``D = 1``, ``ε = 1``): ``Var(y_h) = (1 − e^{−2ah})/(2a)``.
 
     >>> import numpy as np
-    >>> from roughpaths.drivers.coloured_noise import ou_step_law
+    >>> from roughpaths import ou_step_law
     >>> T, Q = ou_step_law([[2.0]], [[1.0]], 1.0, 0.3)
     >>> bool(np.isclose(Q[0, 0], (1 - np.exp(-1.2)) / 4))
     True

@@ -126,7 +126,7 @@ class RefinedBrownianDriver(Driver):
     --------
     >>> import numpy as np
     >>> from roughpaths import BrownianDriver
-    >>> from roughpaths.paths.rough_path import chen_defect
+    >>> from roughpaths import chen_defect
     >>> drv = BrownianDriver(2, seed=3, dt=0.25, n_steps=4, batch_shape=(5,), levy_area="mrongowius-rossler")
     >>> fine = drv.refine(3)
     >>> fine.n_steps, fine.batch_shape

@@ -85,7 +85,7 @@ def area_holder_seminorm(X, alpha, *, max_points=_DEFAULT_MAX_POINTS):
     Examples
     --------
     >>> import numpy as np
-    >>> from roughpaths.paths.rough_path import RoughPath
+    >>> from roughpaths import RoughPath
     >>> X = RoughPath.from_path(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), times=[0.0, 1.0, 2.0])
     >>> float(area_holder_seminorm(X, 0.5))   # |XX_{0,2}| / 2 = |[[.5, 1], [0, .5]]|_F / 2
     0.6123724356957945
@@ -144,7 +144,7 @@ def holder_distance(X, Y, alpha, *, max_points=_DEFAULT_MAX_POINTS):
     Examples
     --------
     >>> import numpy as np
-    >>> from roughpaths.paths.rough_path import RoughPath
+    >>> from roughpaths import RoughPath
     >>> X = RoughPath.from_path(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), times=[0.0, 1.0, 2.0])
     >>> s = np.array([[0.0, 1.0], [-1.0, 0.0]])
     >>> round(float(holder_distance(X, X.perturb(s), 0.25)), 12)   # |s|_F · T^(1 - 2α) = √2 · √2

@@ -138,7 +138,7 @@ def rough_path_p_variation(X, p, *, max_points=_DEFAULT_MAX_POINTS):
     Examples
     --------
     >>> import numpy as np
-    >>> from roughpaths.paths.rough_path import RoughPath
+    >>> from roughpaths import RoughPath
     >>> X = RoughPath.from_path(np.array([[0.0], [1.0]]))   # XX = ½: ‖X‖ + ‖XX‖^½ = 1 + √½
     >>> round(float(rough_path_p_variation(X, 2.5)), 12)
     1.707106781187

@@ -47,7 +47,7 @@ def rough_integral(Y, Y_prime, X: RoughPath, *, cumulative: bool = False) -> np.
 
     >>> import numpy as np
     >>> from roughpaths import RoughPath
-    >>> from roughpaths.paths.integral import rough_integral
+    >>> from roughpaths import rough_integral
     >>> W = np.concatenate([[0.0], np.cumsum(np.random.default_rng(1).normal(0, 0.1, 100))])[:, None]
     >>> X = RoughPath.from_path(W)
     >>> I = rough_integral(W, np.ones((101, 1, 1)), X)

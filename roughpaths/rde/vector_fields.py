@@ -125,7 +125,7 @@ class VectorFields:
     A rotation field and a radial field on the plane (they commute, so the bracket vanishes):
 
     >>> import numpy as np
-    >>> from roughpaths.rde.vector_fields import VectorFields
+    >>> from roughpaths import VectorFields
     >>> rot = lambda y: np.stack([-y[..., 1], y[..., 0]], axis=-1)
     >>> rad = lambda y: y
     >>> V = VectorFields([rot, rad], dim_state=2, dim_noise=2)
