@@ -5,7 +5,7 @@ Conventions are fixed once, in ``docs/conventions.md`` of the project: the area 
 Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 """
 
-from .drivers.brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path, refine
+from .drivers.brownian import DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path
 from .drivers.coloured_noise import (
     ColouredNoiseDriver,
     ColouredNoiseLimit,
@@ -38,12 +38,16 @@ from .paths.rough_path import RoughPath, chen_defect
 from .paths.rough_path_n import RoughPathN
 from .drivers.fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
 from .drivers.base import Driver
+from .drivers.refinement import refine
 from .rde.integrate import NonFiniteStateError, Solution, solve
 from ._linalg import expm_batched
-from .rde.solvers import SOLVERS, Davie, Euler, Heun, LogODE, Solver
-from .rde.solvers_level3 import Davie3, LogODE3
-from .signatures.signature import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp,
-                        signature, signature_vjp)
+from .rde.integrate import SOLVERS
+from .rde.base import Solver
+from .rde.davie import Davie, Davie3
+from .rde.euler import Euler, Heun
+from .rde.logode import LogODE, LogODE3
+from .signatures.signature import logsignature, rough_path_signature, signature
+from .signatures.gradients import logsignature_vjp, rough_path_signature_vjp, signature_vjp
 from .rde.vector_fields import LinearDrift, VectorFields
 from .rde.linear_fields import LinearVectorFields
 from .algebra.tensor import (

@@ -56,8 +56,8 @@ def test_pathwise_identity(method, rng):
 
 
 def test_pathwise_identity_generic_solver(rng):
-    solve_mod = importlib.import_module("roughpaths.rde.integrate")
-    solvers = importlib.import_module("roughpaths.rde.solvers")
+    solve_mod = importlib.import_module("roughpaths")
+    solvers = importlib.import_module("roughpaths")
     rb = rigid_body([1.0, 2.0, 3.0], sigma=0.4, s=S, theta=0.0)
     u = girsanov_shift(rb)
     vals, t = _path(rng, n=2000)

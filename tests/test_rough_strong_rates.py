@@ -21,7 +21,7 @@ Davie3 sits below ``4H - 1/2``, above the pathwise ``4H - 1`` (full size, 256 pa
 0.62, 0.46 at ``H = 0.45, 0.4, 0.35, 0.3`` against ``4H - 1`` = 0.8, 0.6, 0.4, 0.2, while LogODE3 gives
 1.26, 1.07, 0.89, 0.70): its local error is the level-4 signature, whose even words have non-zero mean
 and add up coherently over the steps (asymptotic rate ``4H - 1``), while the log-ODE's is the level-4
-log-signature, of mean zero because fBM is reversible in law (see :mod:`roughpaths.rde.solvers_level3`).
+log-signature, of mean zero because fBM is reversible in law (see :mod:`roughpaths.rde.logode`).
 Its level-3 terms are right: on smooth drivers it has order 3 (``tests/test_level3_solvers.py``).
 """
 

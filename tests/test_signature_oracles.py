@@ -21,12 +21,11 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths import RoughPath
+from roughpaths import (RoughPath, logsignature, lyndon_basis, rough_path_signature, sigdim, signature,
+                        tensor_exp, tensor_log, tensor_product)
 from roughpaths.signatures import _lanes as _sig_lanes
 from roughpaths.signatures import _level2 as _sig_level2
-from roughpaths.signatures.signature import _units, logsignature, rough_path_signature, signature
-from roughpaths.algebra.tensor import (_reversed_to_rowmajor, lyndon_basis, sigdim, tensor_exp,
-                                       tensor_log, tensor_product)
+from roughpaths.signatures._engine import _reversed_to_rowmajor, _units
 
 TOL = 1e-12
 

@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 from roughpaths.signatures import _lanes as kern
-from roughpaths.signatures.signature import _offsets, _units, logsignature, signature, signature_vjp
+from roughpaths import logsignature, signature, signature_vjp
+from roughpaths.algebra.flat import level_offsets as _offsets
+from roughpaths.signatures._engine import _units
 
 
 def _path(shape, seed=3):
@@ -89,7 +91,7 @@ def test_gradients_one_thread_equals_two_threads():
 @pytest.mark.parametrize("d,m", [(2, 4), (3, 3), (4, 3)])
 def test_gradient_lanes_equal_one_unit_at_a_time(nchunks, d, m):
     from roughpaths.signatures import _vjp as _sig_vjp
-    from roughpaths.signatures.signature import _reversed_parts
+    from roughpaths.signatures._engine import _reversed_parts
 
     x = _path((9, 300, d))
     x[2] *= 1e6

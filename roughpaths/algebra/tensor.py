@@ -35,13 +35,10 @@ True
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
-from ..signatures import _kernels as _k
-from .. import _threads
-from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix, lyndon_projection,
+from .flat import log_flat, lyndon_flat
+from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix,
                       lyndon_words)
 from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
 
@@ -106,48 +103,6 @@ def logsigdim(dim: int, depth: int) -> int:
     dim = check_positive_int(dim, "dim")
     depth = _check_count_size(dim, check_positive_int(depth, "depth"))
     return sum(count_lyndon_words(dim, k) for k in range(1, depth + 1))
-
-
-def _offsets(dim: int, depth: int) -> np.ndarray:
-    """Start of each level in the flat layout: ``off[k]`` for ``k = 1..depth+1`` (``off[1] = 0``)."""
-    off = np.zeros(depth + 2, dtype=np.int64)
-    for k in range(1, depth + 1):
-        off[k + 1] = off[k] + dim ** k
-    return off
-
-
-def _log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
-    """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
-    off = _offsets(dim, depth)
-    out = np.empty_like(a)
-    _threads.run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
-                 _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
-    return out
-
-
-def _lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
-    """Cotangent ``(B, sigdim)`` (row-major) of the Lie element, given that of its Lyndon coordinates."""
-    off = _offsets(dim, depth)
-    gz = np.zeros((gc.shape[0], int(off[depth + 1])))
-    start = 0
-    for k in range(1, depth + 1):
-        lidx, indptr, indices, data = lyndon_projection(dim, k)
-        _k.lyndon_vjp(gc, start, lidx, indptr, indices, data, gz, off[k])
-        start += lidx.shape[0]
-    return gz
-
-
-def _lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
-    """Lyndon coordinates of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
-    off = _offsets(dim, depth)
-    out = np.empty((z.shape[0], logsigdim(dim, depth)))
-    start = 0
-    for k in range(1, depth + 1):
-        lidx, indptr, indices, data = lyndon_projection(dim, k)
-        _threads.run(lambda lo, hi: _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, start, lo, hi),
-                     _threads.ranges(z.shape[0], float(lidx.shape[0] + indices.shape[0])))
-        start += lidx.shape[0]
-    return out
 
 
 # ------------------------------------------------------------------------------ internals
@@ -281,7 +236,7 @@ def tensor_log(a, dim: int) -> np.ndarray:
     """
     a, dim, depth = _check_element(a, "a", dim)
     flat = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
-    return _log_flat(flat, dim, depth).reshape(a.shape)
+    return log_flat(flat, dim, depth).reshape(a.shape)
 
 
 # ------------------------------------------------------------------------------ level 2
@@ -356,7 +311,7 @@ def lyndon_coordinates(z, dim: int) -> np.ndarray:
     """
     z, dim, depth = _check_element(z, "z", dim)
     flat = np.ascontiguousarray(z.reshape(-1, z.shape[-1]))
-    return _lyndon_flat(flat, dim, depth).reshape(z.shape[:-1] + (-1,))
+    return lyndon_flat(flat, dim, depth).reshape(z.shape[:-1] + (-1,))
 
 
 def from_lyndon_coordinates(c, dim: int, depth: int) -> np.ndarray:
@@ -382,17 +337,3 @@ def from_lyndon_coordinates(c, dim: int, depth: int) -> np.ndarray:
         out.append(np.asarray((e.T @ flat[:, start:start + e.shape[0]].T).T))
         start += e.shape[0]
     return np.concatenate(out, axis=-1).reshape(c.shape[:-1] + (-1,))
-
-
-@lru_cache(maxsize=None)
-def _reversed_to_rowmajor(dim: int, depth: int) -> np.ndarray:
-    """Gather index: ``rowmajor = reversed[..., perm]`` (kernels store words with the first letter fastest)."""
-    parts, start = [], 0
-    for k in range(1, depth + 1):
-        words = np.indices((dim,) * k).reshape(k, -1)          # row-major enumeration of words
-        rev = np.zeros(words.shape[1], dtype=np.intp)
-        for j in range(k):
-            rev += words[j] * dim ** j
-        parts.append(start + rev)
-        start += dim ** k
-    return np.concatenate(parts)

@@ -1,4 +1,6 @@
-r"""The mathematics of :meth:`roughpaths.BrownianDriver.refine` (private; see :mod:`roughpaths.drivers.refinement`).
+r"""The mathematics of refinement (private; see :mod:`roughpaths.drivers.refinement`).
+
+:meth:`roughpaths.BrownianDriver.refine` and :func:`roughpaths.refine` share it.
 
 Per coarse step length: a plan of constants (:class:`_FourierPlan`, :class:`_BridgePlan`); per batch of
 coarse steps (rows), deterministic functions of the coarse data and a row block of standard normals
@@ -12,16 +14,14 @@ import math
 
 import numpy as np
 
+from ..algebra.level2 import outer
+from ..paths.rough_path import RoughPath
+from .levy_area import _tail_zeta2, step_plan
+
 #: Gibbs sweeps that condition the explicit tail terms on the coarse area.
 GIBBS_SWEEPS = 3
 #: Explicit Fourier terms beyond the retained ones, per fine sub-step (``K = n + MODES_PER_SUBSTEP F``).
 MODES_PER_SUBSTEP = 4
-
-
-def _tail_zeta2(n: int) -> float:
-    from scipy.special import polygamma
-
-    return float(polygamma(1, n + 1))
 
 
 # ------------------------------------------------------------------ antisymmetric (pair) algebra
@@ -347,4 +347,77 @@ def _refine_bridge(plan, Wsub, Hsub, z):
         lam = np.zeros((R, F, d, d))
         lam[:, :, iu, ju] = z[:, (2 * F - 1) * d:].reshape(R, F, p) * (plan.h / F / math.sqrt(12.0))
         A = A + lam - np.swapaxes(lam, -1, -2)
+    return w, A
+
+
+# ------------------------------------------------------------------ refine(X, factor, rng): a given sample
+def _antisym_normal(rng: np.random.Generator, shape: tuple, d: int) -> np.ndarray:
+    """Antisymmetric ``(..., d, d)`` with iid N(0, 1) entries above the diagonal."""
+    iu = np.triu_indices(d, 1)
+    out = np.zeros(shape + (d, d))
+    if iu[0].size:
+        z = rng.standard_normal(shape + (iu[0].size,))
+        out[..., iu[0], iu[1]] = z
+        out[..., iu[1], iu[0]] = -z
+    return out
+
+
+def _split(rng, W, L, h, rho, with_area: bool):
+    r"""Split steps ``(W, L)`` of length ``h`` into a first part of length ``rho h`` and the rest.
+
+    ``W (R, d)``, ``L (R, d, d)`` (Lévy areas) or None, ``h (R,)``. Returns
+    ``(w1, L1, w2, L2)`` with ``w1 + w2 = W`` and ``L1 + L2 + ½ (w1 ∧ w2 ... ) = L`` exactly
+    (the cross term of the split is ``Alt(w1 ⊗ w2) = ½ b ∧ W`` with ``b = w1 - rho W``).
+    """
+    R, d = W.shape
+    q = rho * (1.0 - rho)
+    hc = h[:, None]
+    b = rng.standard_normal((R, d)) * np.sqrt(q * hc)
+    if not with_area:
+        return rho * W + b, None, (1.0 - rho) * W - b, None
+    h1, h2 = rho * h, (1.0 - rho) * h
+    # prior: Davie-type pieces built on the prior increments (exact conditional second moments)
+    w1, w2 = rho * W + b, (1.0 - rho) * W - b
+    H1 = rng.standard_normal((R, d)) * np.sqrt(h1 / 12.0)[:, None]
+    H2 = rng.standard_normal((R, d)) * np.sqrt(h2 / 12.0)[:, None]
+    L1 = _wedge(H1, w1) + _antisym_normal(rng, (R,), d) * (h1 / np.sqrt(12.0))[:, None, None]
+    L2 = _wedge(H2, w2) + _antisym_normal(rng, (R,), d) * (h2 / np.sqrt(12.0))[:, None, None]
+    # Matheron update: Y <- Y + Cov(Y, Z | W) Var(Z | W)^{-1} (L - Z(Y)), Z(Y) = L1 + L2 + ½ b∧W
+    r = L - (L1 + L2 + 0.5 * _wedge(b, W))
+    hh = h[:, None, None]
+    u = np.einsum("...ij,...j->...i", r, W)
+    norm2 = np.einsum("...i,...i->...", W, W)[:, None, None]
+    v = (12.0 / hh ** 2) * (r - _wedge(u, W) / (hh + norm2))       # Var(Z|W)^{-1} r
+    vW = np.einsum("...ij,...j->...i", v, W)
+    T = _wedge(vW, W)                                                # v N + N v, N = W Wᵀ
+    b = b + 0.5 * q * hc * vW
+    L1 = L1 + (h1[:, None, None] ** 2 / 12.0) * v + (h1[:, None, None] / 12.0) * (rho ** 2 * T + 2 * q * hh * v)
+    L2 = L2 + (h2[:, None, None] ** 2 / 12.0) * v + (h2[:, None, None] / 12.0) * ((1 - rho) ** 2 * T + 2 * q * hh * v)
+    return rho * W + b, L1, (1.0 - rho) * W - b, L2
+
+
+def _assemble(dw, A, fine_t, X, d):
+    areas = A + 0.5 * outer(dw, dw)
+    if X.kind == "ito":
+        fine_h = np.diff(fine_t)
+        areas[..., np.arange(d), np.arange(d)] -= 0.5 * fine_h[:, None]
+    return RoughPath(dw, areas, times=fine_t, x0=X.x0, kind=X.kind, check=False)
+
+
+def _refine_by_fourier_path(W, L, h, m, rng):
+    """``factor > 2``: the construction of ``roughpaths.drivers.refinement`` with no stored Fourier terms.
+
+    Rows ``W (R, d)``, Lévy areas ``L (R, d, d)``, step lengths ``h (R,)``; returns ``(R, m, d)`` increments
+    and ``(R, m, d, d)`` Lévy areas. The normals are drawn from ``rng`` per distinct step length, in row order.
+    """
+    R, d = W.shape
+    w = np.empty((R, m, d))
+    A = np.empty((R, m, d, d))
+    for hv in np.unique(h):
+        idx = np.flatnonzero(h == hv)
+        delta = float(hv) / m
+        fine = step_plan("auto", d, [delta])[delta] if d > 1 else ("fourier", 1, 0)
+        plan = _FourierPlan(float(hv), m, d, "exact", 0, False, fine)
+        z = rng.standard_normal((idx.size, plan.width))
+        w[idx], A[idx] = _refine_fourier(plan, W[idx], L[idx], None, None, None, z)
     return w, A

@@ -101,7 +101,7 @@ from ._random import PathStreams
 from .levy_area import LEVY_AREA_METHODS, block_areas, step_plan
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from ..paths.rough_path import RoughPath
-from ._refine_rough_path import refine  # noqa: F401  (its home is brownian_refine; kept importable here)
+from .refinement import RefinedBrownianDriver
 
 __all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "DEFAULT_SUBSTEPS"]
 
@@ -423,7 +423,6 @@ class BrownianDriver(SeededDriver):
     def refine(self, factor):
         """The same Brownian path with every step split into ``factor`` equal sub-steps: a lazy driver whose
         exactness, per ``levy_area``, is stated in ``roughpaths.drivers.refinement`` (own per-path streams)."""
-        from .refinement import RefinedBrownianDriver
         return RefinedBrownianDriver(self, factor)
 
     # ------------------------------------------------------------------ generation

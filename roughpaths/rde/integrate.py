@@ -20,9 +20,16 @@ from ..validation import as_float_array, check_memory, check_positive_int, check
 from ..drivers.base import Driver
 from ..paths.rough_path import RoughPath
 from ..paths.rough_path_n import RoughPathN
-from .solvers import SOLVERS, Davie, Solver
+from .base import Solver
+from .davie import Davie
+from .euler import Euler, Heun
+from .logode import LogODE
 
 __all__ = ["solve", "Solution", "NonFiniteStateError"]
+
+
+#: Solver names accepted by :func:`~roughpaths.solve` as strings (default instances).
+SOLVERS = {"euler": Euler, "heun": Heun, "davie": Davie, "logode": LogODE}
 
 
 class NonFiniteStateError(ValueError):

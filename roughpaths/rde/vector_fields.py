@@ -394,7 +394,3 @@ def _central_jacobian(f, y):
         cols.append((fp - fm) / (2.0 * hb))
     return np.stack(cols, axis=-1)
 
-
-# LinearVectorFields (a subclass of VectorFields) lives in roughpaths.rde.linear_fields; importable from here
-# as before. Imported last: linear_fields needs the names above.
-from .linear_fields import LinearVectorFields  # noqa: E402

@@ -1,7 +1,8 @@
-"""Numba kernels of the tensor algebra behind the signatures (private).
+"""Numba kernels of the signature of a level-2 rough path (private).
 
-Truncated logarithm, Lyndon coordinates (and the transpose of their projection), and the
-exponential of a level-2 Lie element for :func:`roughpaths.rough_path_signature`.
+The exponential of a level-2 Lie element and the product of the step exponentials, for
+:func:`roughpaths.rough_path_signature` (the truncated logarithm and the Lyndon coordinates are the
+tensor algebra's: :mod:`roughpaths.algebra.flat`).
 The signature kernels themselves live in :mod:`roughpaths.signatures._level2` (level 2),
 :mod:`roughpaths.signatures._lanes` (depth >= 3, the lane kernel) and :mod:`roughpaths.signatures._vjp`
 (gradients).
@@ -71,76 +72,6 @@ def _exp_lie2(x, a, d, m, offsets, out, p, q):
         for r in range(dim):
             p[r] = q[r]
             out[r] += q[r]
-
-
-@njit(cache=True)
-def _log_one(a, d, m, offsets, r, t):
-    """``r <- log(1 + a)`` (row-major, truncated at ``m``) by Horner, ``t`` scratch of the same size.
-
-    ``log(1+a) = a (c_1 + a (c_2 + ... a (c_{m-1} + c_m a)))``, ``c_n = (-1)^(n+1)/n``, written
-    with ``a`` on the right: ``r_m = c_m a``, ``r_n = (c_n + r_{n+1}) ⊗ a``. ``r_n`` is multiplied
-    by ``a`` ``n - 1`` more times, so only its levels ``<= m - n + 1`` are formed.
-    """
-    for u in range(offsets[2]):
-        r[u] = a[u] * ((-1.0) ** (m + 1) / m)
-    for n in range(m - 1, 0, -1):
-        c = (-1.0) ** (n + 1) / n
-        kmax = m - n + 1
-        for k in range(1, kmax + 1):
-            ok = offsets[k]
-            for u in range(d ** k):
-                t[ok + u] = c * a[ok + u]
-            for i in range(1, k):
-                oi = offsets[i]
-                oj = offsets[k - i]
-                nj = d ** (k - i)
-                for p in range(d ** i):
-                    rp = r[oi + p]
-                    base = ok + p * nj
-                    for q in range(nj):
-                        t[base + q] += rp * a[oj + q]
-        for u in range(offsets[kmax + 1]):
-            r[u] = t[u]
-
-
-@njit(cache=True)
-def _lyndon_one(z, lev_off, lidx, indptr, indices, data, out, out_off):
-    for i in range(lidx.shape[0]):
-        v = z[lev_off + lidx[i]]
-        for t in range(indptr[i], indptr[i + 1]):
-            v -= data[t] * out[out_off + indices[t]]
-        out[out_off + i] = v
-
-
-@njit(cache=True)
-def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
-    """Transpose of one level of the Lyndon projection: ``gz[lidx] = M^{-T} gc`` (back substitution)."""
-    n = lidx.shape[0]
-    y = np.empty(n)
-    for b in range(gc.shape[0]):
-        for i in range(n):
-            y[i] = gc[b, out_off + i]
-        for r in range(n - 1, -1, -1):
-            yr = y[r]
-            for t in range(indptr[r], indptr[r + 1]):
-                y[indices[t]] -= data[t] * yr
-        for i in range(n):
-            gz[b, lev_off + lidx[i]] = y[i]
-
-
-@njit(**_NOGIL)
-def log_rows(a, d, m, offsets, lo, hi, out):
-    """Row-major ``log(1 + a)`` of rows ``lo..hi-1`` of ``a`` (B, sigdim) into ``out``."""
-    t = np.empty(a.shape[1])
-    for b in range(lo, hi):
-        _log_one(a[b], d, m, offsets, out[b], t)
-
-
-@njit(**_NOGIL)
-def lyndon_rows(z, lev_off, lidx, indptr, indices, data, out, out_off, lo, hi):
-    """Lyndon coordinates of one level (forward substitution with the sparse ``M``), rows ``lo..hi-1``."""
-    for b in range(lo, hi):
-        _lyndon_one(z[b], lev_off, lidx, indptr, indices, data, out[b], out_off)
 
 
 @njit(**_NOGIL)

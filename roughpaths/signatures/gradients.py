@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _threads
+from ..algebra.flat import level_offsets, lyndon_flat_vjp
+from ..algebra.tensor import logsigdim, sigdim
+from ..validation import as_float_array
 from . import _lanes
 from . import _vjp
-from .. import _threads
-from .signature import (_MAX_CHUNKS, _MIN_CHUNK, _check_depth, _check_fits, _check_paths, _n_chunks, _offsets,
-                        _reversed_parts, _signature_flat, _units, rough_path_signature)
-from ..algebra.tensor import _lyndon_flat_vjp, _reversed_to_rowmajor, logsigdim, sigdim
-from ..validation import as_float_array
+from ._engine import (_MAX_CHUNKS, _MIN_CHUNK, _check_depth, _check_fits, _check_paths, _n_chunks,
+                      _reversed_parts, _reversed_to_rowmajor, _signature_flat, _units)
+from .signature import rough_path_signature
 
 __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]
 
@@ -48,7 +50,7 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
         gx[:, -1] += g_row
         gx[:, 0] -= g_row
         return gx
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
     g_rev = np.empty_like(g_row)
     g_rev[:, perm] = g_row
@@ -149,10 +151,10 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
         g_sig[:, :d] = g
         return _signature_vjp_flat(flat, depth, g_sig).reshape(x.shape)
     _check_fits(flat.shape[0], d, depth, log=True)
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
     sig = _signature_flat(flat, depth)
-    g_log_row = _lyndon_flat_vjp(g, d, depth)
+    g_log_row = lyndon_flat_vjp(g, d, depth)
     sig_rev = np.empty_like(sig)
     sig_rev[:, perm] = sig
     g_log_rev = np.empty_like(g_log_row)
@@ -215,7 +217,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     _threads.run(lambda lo, hi: _vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
                  _threads.ranges(inc.shape[0], 4 * n * depth * depth * sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))

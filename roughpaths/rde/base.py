@@ -1,4 +1,4 @@
-r"""One-step RDE solvers for :func:`roughpaths.solve`.
+r"""The one-step solver contract of :func:`roughpaths.solve` (:class:`Solver`) and the helpers the schemes share.
 
 Each solver is a small class following the numbered contract of :class:`Solver` (what level of
 increment a step consumes, its declared orders, its calculus, the invariants it preserves, and the
@@ -16,19 +16,21 @@ solver        level  order (BM, RP)  smooth order  note
 ``Heun``      1      1/2             2             Stratonovich Heun; order 1 only for commuting fields
 ``Davie``     2      1               2             Milstein/Davie step with the area
 ``LogODE``    2      1               2             flow of the step's log-signature vector field
+``Davie3``    3      1               3             third-order Taylor (Davie-type) step
+``LogODE3``   3      1.5             3             flow of the level-3 log-signature field
 ============  =====  ==============  ============  ==================================================
+
+One file per scheme family: :mod:`roughpaths.rde.euler` (``Euler``, ``Heun``),
+:mod:`roughpaths.rde.davie` (``Davie``, ``Davie3``), :mod:`roughpaths.rde.logode` (``LogODE``,
+``LogODE3``); the level-3 machinery they share is in ``roughpaths/rde/_level3.py``.
 """
 
 from __future__ import annotations
 
-import numbers
-
 import numpy as np
 
-from .._linalg import expm_batched, matvec
-from ..algebra.level2 import outer
 
-__all__ = ["Solver", "Euler", "Heun", "Davie", "LogODE", "SOLVERS"]
+__all__ = ["Solver"]
 
 
 class Solver:
@@ -39,7 +41,7 @@ class Solver:
 
     1. ``increment_level`` (class attribute, 1, 2 or 3): what a step consumes, the increment
        :math:`X_{s,t}` alone (1), also the area :math:`\mathbb{X}_{s,t}` (2), or also the level-3 step
-       signature (3, :mod:`roughpaths.rde.solvers_level3`). ``solve`` refuses a driver of lower level; a
+       signature (3, :mod:`roughpaths.rde.logode`, :mod:`roughpaths.rde.davie`). ``solve`` refuses a driver of lower level; a
        level-1 solver never sees the areas of a level-2 driver; the level-1/2 solvers here refuse a
        level-3 driver (:class:`~roughpaths.RoughPathN`) rather than drop its level 3 silently.
     2. ``order`` and ``smooth_order`` (class attributes): the declared strong order on Brownian rough
@@ -158,170 +160,18 @@ def _drift_part(fields, y, t, dt):
     return fields.drift(y, t) * dt if fields.has_drift else 0.0
 
 
-class Euler(Solver):
-    r"""Explicit Euler, :math:`Y + V_0(Y)h + V_i(Y)X^i_{s,t}` (level 1).
+def _unit_time_flow(W, y, n_steps):
+    """``n_steps`` classical RK4 steps of the autonomous ODE ``z' = W(z)`` on ``[0, 1]`` from ``z = y``.
 
-    Order 1 on smooth drivers. On a Brownian driver it converges (strong order ½) to the **Itô**
-    solution, whatever the area of the driver: it evaluates the fields at the left point only
-    (time-dependent fields at the step's start time ``t``).
+    The inner integrator of the log-ODE schemes (:class:`~roughpaths.LogODE`,
+    :class:`~roughpaths.LogODE3`) for non-linear fields.
     """
-
-    increment_level = 1
-    order = 0.5
-    smooth_order = 1.0
-    calculus = "ito"
-
-    def step(self, fields, y, t, dt, dX, dXX):
-        V = fields.fields(y, t)
-        return y + _drift_part(fields, y, t, dt) + (V @ dX[..., None])[..., 0]
-
-
-class Heun(Solver):
-    r"""Stratonovich Heun (trapezoidal predictor–corrector, level 1).
-
-    :math:`\tilde Y = Y + V_0(Y)h + V(Y)X_{s,t}`,
-    :math:`Y' = Y + \tfrac12(V_0(Y) + V_0(\tilde Y))h + \tfrac12(V(Y) + V(\tilde Y))X_{s,t}`.
-    Order 2 on smooth drivers; strong order ½ towards the Stratonovich solution for non-commuting
-    fields (it cannot see the Lévy area), order 1 for commuting fields. Time-dependent fields are
-    evaluated at ``t`` in the predictor and at ``t + h`` at the predicted point.
-    """
-
-    increment_level = 1
-    order = 0.5
-    smooth_order = 2.0
-
-    def step(self, fields, y, t, dt, dX, dXX):
-        V = fields.fields(y, t)
-        dx = dX[..., None]
-        f0 = fields.drift(y, t) if fields.has_drift else None
-        pred = y + (V @ dx)[..., 0]
-        if f0 is not None:
-            pred = pred + f0 * dt
-        V2 = fields.fields(pred, t + dt)
-        out = y + 0.5 * ((V + V2) @ dx)[..., 0]
-        if f0 is not None:
-            out = out + 0.5 * dt * (f0 + fields.drift(pred, t + dt))
-        return out
-
-
-class Davie(Solver):
-    r"""Davie's scheme (level 2): :math:`Y + V_0 h + V_i X^i_{s,t} + (DV_j\cdot V_i)\,\mathbb{X}^{ij}_{s,t}`.
-
-    With a drift, the time direction is treated as a path component so that the scheme stays of
-    order 2 on smooth drivers: the drift is integrated by the trapezoidal rule at the Euler predictor
-    :math:`\tilde Y = Y + V_0 h + V_i X^i` (this adds :math:`\tfrac12 h\,DV_0\cdot(V_0 h + V_i X^i)`),
-    and the cross term :math:`\tfrac12 h\,X^i\,DV_i\cdot V_0` is added (the space–time area
-    :math:`\int (r - s)\,dX^i` approximated by :math:`\tfrac12 h X^i`, exact to :math:`O(h^3)` on
-    smooth paths and to a mean-zero :math:`O(h^{3/2})` on Brownian ones).
-
-    Time-dependent fields: the driving fields and their Jacobians are evaluated at the midpoint
-    time :math:`t + h/2` (this contributes the :math:`\tfrac12 h\,\partial_t V_i\,X^i` term that keeps
-    order 2 on smooth drivers), the drift at ``t`` and, at the predictor, at ``t + h``.
-
-    Declared orders: strong order 1 on Brownian rough paths (Stratonovich lift with the Lévy area;
-    with an Itô lift it solves the Itô equation), order 2 on smooth drivers with exact areas.
-    """
-
-    increment_level = 2
-    order = 1.0
-    smooth_order = 2.0
-
-    def step(self, fields, y, t, dt, dX, dXX):
-        if getattr(fields, "is_linear", False):
-            return self._linear_step(fields, y, dt, dX, dXX)
-        tm = t + 0.5 * dt
-        V = fields.fields(y, tm)
-        J = fields.jacobians(y, tm)
-        noise = (V @ dX[..., None])[..., 0]
-        second = _second_order(J, V, dXX)                          # Σ_ij DV_j·V_i XX^{ij}
-        if not fields.has_drift:
-            return y + noise + second
-        f0 = fields.drift(y, t)
-        f1 = fields.drift(y + f0 * dt + noise, t + dt)
-        cross = _second_order(J, f0[..., None], dX[..., None, :])  # Σ_i X^i DV_i·V_0
-        return y + 0.5 * dt * (f0 + f1) + noise + second + 0.5 * dt * cross
-
-    @staticmethod
-    def _linear_step(fields, y, dt, dX, dXX):
-        # same formula for V_i(y) = M_i y, V_0(y) = A y: DV_j·V_i = M_j M_i y, DV_i·V_0 = M_i A y
-        Mx, G2 = fields._linear_parts(dX, dXX)                     # Σ x^i M_i, Σ XX^{ij} M_j M_i
-        noise = (Mx @ y[..., None])[..., 0]
-        out = y + noise + (G2 @ y[..., None])[..., 0]
-        A = fields.drift_matrix
-        if fields.has_drift:
-            f0 = matvec(A, y)
-            f1 = matvec(A, y + f0 * dt + noise)
-            out = out + 0.5 * dt * (f0 + f1) + 0.5 * dt * (Mx @ f0[..., None])[..., 0]
-        return out
-
-
-class LogODE(Solver):
-    r"""The log-ODE method (level 2).
-
-    Each step replaces the driver by its step log-signature :math:`(h, x, L)` with
-    :math:`x = X_{s,t}` and :math:`L = \mathbb{X}_{s,t} - \tfrac12 x\otimes x` (for a geometric driver
-    :math:`L = A`, the Lévy area with its ½), and follows for unit time the flow of the vector field
-
-    .. math:: W = V_0 h + V_i x^i + \sum_{i,j} L^{ij}\,DV_j\cdot V_i
-              \;\overset{L = A}{=}\; V_0 h + V_i x^i + \tfrac12\sum_{i,j} A^{ij}[V_i, V_j],
-
-    with :math:`[V, W] = DW\cdot V - DV\cdot W`. (The symmetric part of ``L``, non-zero for an Itô lift,
-    :math:`-\tfrac12 h I`, gives the Itô–Stratonovich correction.)
-
-    * :class:`~roughpaths.LinearVectorFields` with a linear drift: the flow is exact,
-      :math:`Y' = \exp(G) Y` with :math:`G = A_0 h + M_i x^i + \sum_{ij} L^{ij} M_j M_i`, computed by a
-      batched scaling-and-squaring Padé exponential (:func:`expm_batched`).
-    * otherwise: ``inner_steps`` classical RK4 steps of the autonomous ODE :math:`z' = W(z)` on ``[0, 1]``;
-      time-dependent fields are frozen at the midpoint time :math:`t + h/2` of the step.
-
-    Declared orders: strong order 1 on Brownian rough paths, order 2 on smooth drivers with exact
-    areas (the level-3 terms of the step signature are :math:`O(h^3)` there).
-
-    Parameters
-    ----------
-    inner_steps : int
-        RK4 sub-steps per step for non-linear fields (default 1).
-    """
-
-    increment_level = 2
-    order = 1.0
-    smooth_order = 2.0
-
-    def __init__(self, inner_steps: int = 1):
-        if isinstance(inner_steps, bool) or not isinstance(inner_steps, numbers.Integral) or inner_steps < 1:
-            raise ValueError(f"inner_steps must be a positive integer, got {inner_steps!r}.")
-        self.inner_steps = int(inner_steps)
-
-    def __repr__(self) -> str:
-        return f"LogODE(inner_steps={self.inner_steps})"
-
-    def step(self, fields, y, t, dt, dX, dXX):
-        L = dXX - 0.5 * outer(dX, dX)
-        if getattr(fields, "is_linear", False):
-            G = fields._logode_generator(dt, dX, L)
-            return (expm_batched(G) @ y[..., None])[..., 0]
-
-        tm = t + 0.5 * dt
-
-        def W(z):
-            V = fields.fields(z, tm)
-            J = fields.jacobians(z, tm)
-            w = (V @ dX[..., None])[..., 0] + _second_order(J, V, L)
-            if fields.has_drift:
-                w = w + fields.drift(z, tm) * dt
-            return w
-
-        n = self.inner_steps
-        u = 1.0 / n
-        z = y
-        for _ in range(n):
-            k1 = W(z)
-            k2 = W(z + 0.5 * u * k1)
-            k3 = W(z + 0.5 * u * k2)
-            k4 = W(z + u * k3)
-            z = z + (u / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        return z
-
-
-#: Solver names accepted by :func:`~roughpaths.solve` as strings (default instances).
-SOLVERS = {"euler": Euler, "heun": Heun, "davie": Davie, "logode": LogODE}
+    u = 1.0 / n_steps
+    z = y
+    for _ in range(n_steps):
+        k1 = W(z)
+        k2 = W(z + 0.5 * u * k1)
+        k3 = W(z + 0.5 * u * k2)
+        k4 = W(z + u * k3)
+        z = z + (u / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    return z

@@ -1,4 +1,4 @@
-r"""One-step RDE solvers that consume level-3 step signatures (rough paths with :math:`p\in[3, 4)`).
+r"""What the level-3 solvers share (private): step signatures of rough paths with :math:`p\in[3, 4)`.
 
 They follow the contract of :class:`roughpaths.Solver` with ``increment_level = 3``:
 :func:`roughpaths.solve` passes each step's level-2 and level-3 components as the tuple
@@ -43,18 +43,11 @@ rates are in ``tests/test_rough_strong_rates.py`` (pre-asymptotically Davie3 fit
 
 from __future__ import annotations
 
-import numbers
-
 import numpy as np
 
-from .._linalg import expm_batched, matvec, vecmat
-from .solvers import Solver, _second_order
-
-__all__ = ["LogODE3", "Davie3"]
-
-#: Relative step of the central differences of the Jacobians (about the cube root of the float64 epsilon).
-FD_STEP = 6e-6
-
+from .._linalg import vecmat
+from .base import Solver, _second_order
+from .vector_fields import FD_STEP
 
 def _split_levels(dXX, name):
     if not (isinstance(dXX, tuple) and len(dXX) == 2):
@@ -150,125 +143,3 @@ class _Level3(Solver):
         G = vecmat(x, M1) + vecmat(c2.reshape(c2.shape[:-2] + (d * d,)), M2) \
             + vecmat(c3.reshape(c3.shape[:-3] + (d ** 3,)), M3)
         return G.reshape(G.shape[:-1] + (e, e))
-
-
-class LogODE3(_Level3):
-    r"""The log-ODE method at depth 3: the flow of the step's level-3 log-signature vector field.
-
-    With :math:`\ell = \log \mathbf{X}_{s,t} = x + \ell_2 + \ell_3` (truncated at level 3), one step
-    follows for unit time the flow of
-
-    .. math:: W = V_0 h + \sum_i x^i V_i + \sum_{ij}\ell_2^{ij} V_{(i,j)} + \sum_{ijk}\ell_3^{ijk} V_{(i,j,k)},
-
-    Since :math:`\ell` is a Lie element this is a bracket expansion: the level-2 part is
-    :math:`\tfrac12\sum A^{ij}[V_i, V_j]` and the level-3 part a combination of the brackets of brackets
-    :math:`[V_i, [V_j, V_k]]` (the Lyndon coordinates of :math:`\ell_3` times the brackets of their
-    words); the :math:`D^2V` parts of the word operators cancel in that sum. They are still computed, so
-    that a slightly non-geometric input is integrated consistently.
-
-    * :class:`~roughpaths.LinearVectorFields` with a linear drift: exact flow
-      :math:`Y' = \exp(G)Y`, :math:`G = A_0h + \sum x^iM_i + \sum\ell_2^{ij}M_jM_i + \sum\ell_3^{ijk}M_kM_jM_i`.
-    * otherwise ``inner_steps`` RK4 steps of :math:`z' = W(z)` on ``[0, 1]``.
-
-    Parameters
-    ----------
-    inner_steps : int
-        RK4 sub-steps per step for non-linear fields (default 1).
-    hessians : callable, optional
-        ``y -> (..., d, e, e, e)``, :math:`\partial_b\partial_c V_k^a` at ``[..., k, a, b, c]``; central
-        differences of the Jacobians if omitted.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from roughpaths import LinearVectorFields, LogODE3, fbm_rough_path, solve
-    >>> V = LinearVectorFields(0.5 * np.random.default_rng(0).standard_normal((2, 3, 3)))
-    >>> X = fbm_rough_path(32, 0.3, rng=1, substeps=16, level=3, batch_shape=(4,))
-    >>> solve(V, X, np.ones(3), LogODE3()).final.shape
-    (4, 3)
-    """
-
-    order = 1.5
-    smooth_order = 3.0
-
-    def __init__(self, inner_steps: int = 1, hessians=None):
-        super().__init__(hessians)
-        if isinstance(inner_steps, bool) or not isinstance(inner_steps, numbers.Integral) or inner_steps < 1:
-            raise ValueError(f"inner_steps must be a positive integer, got {inner_steps!r}.")
-        self.inner_steps = int(inner_steps)
-
-    def __repr__(self) -> str:
-        h = "" if self.hessians is None else ", hessians=..."
-        return f"LogODE3(inner_steps={self.inner_steps}{h})"
-
-    def step(self, fields, y, t, dt, dX, dXX):
-        XX, XXX = _split_levels(dXX, "LogODE3")
-        l2, l3 = _log3(dX, XX, XXX)
-        if getattr(fields, "is_linear", False):
-            G = self._linear_generator(fields, dX, l2, l3)
-            if fields.has_drift:
-                G = G + dt * fields.drift_matrix
-            return matvec(expm_batched(G), y)
-
-        def W(z):
-            V = fields.fields(z)
-            J = fields.jacobians(z)
-            w = (V @ dX[..., None])[..., 0] + _second_order(J, V, l2) + self._third(fields, z, V, J, l3)
-            if fields.has_drift:
-                w = w + fields.drift(z) * dt
-            return w
-
-        u = 1.0 / self.inner_steps
-        z = y
-        for _ in range(self.inner_steps):
-            k1 = W(z)
-            k2 = W(z + 0.5 * u * k1)
-            k3 = W(z + 0.5 * u * k2)
-            k4 = W(z + u * k3)
-            z = z + (u / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        return z
-
-
-class Davie3(_Level3):
-    r"""Third-order Davie-type (Taylor) step: :math:`Y + \sum_{1\le|w|\le3}\mathbf{X}^w_{s,t}V_w(Y)`.
-
-    .. math:: Y' = Y + V_i x^i + (DV_j\cdot V_i)\,\mathbb{X}^{ij}
-              + \big(D^2V_k[V_j, V_i] + DV_k\cdot DV_j\cdot V_i\big)\,\mathbb{X}^{ijk}
-
-    with the full (not log) step signature. A drift is treated as in :class:`~roughpaths.Davie`
-    (trapezoidal rule at the Euler predictor and the cross term :math:`\tfrac12 h x^i DV_i\cdot V_0`).
-
-    Parameters
-    ----------
-    hessians : callable, optional
-        As for :class:`LogODE3`.
-    """
-
-    order = 1.0
-    smooth_order = 3.0
-
-    def step(self, fields, y, t, dt, dX, dXX):
-        XX, XXX = _split_levels(dXX, "Davie3")
-        if getattr(fields, "is_linear", False):
-            G = self._linear_generator(fields, dX, XX, XXX)
-            noise_and_more = matvec(G, y)
-            out = y + noise_and_more
-            if fields.has_drift:
-                A = fields.drift_matrix
-                M1 = self._linear_products(fields)[0]
-                e = fields.dim_state
-                Mx = vecmat(dX, M1).reshape(dX.shape[:-1] + (e, e))
-                f0 = matvec(A, y)
-                f1 = matvec(A, y + f0 * dt + matvec(Mx, y))
-                out = out + 0.5 * dt * (f0 + f1) + 0.5 * dt * matvec(Mx, f0)
-            return out
-        V = fields.fields(y)
-        J = fields.jacobians(y)
-        noise = (V @ dX[..., None])[..., 0]
-        out = y + noise + _second_order(J, V, XX) + self._third(fields, y, V, J, XXX)
-        if not fields.has_drift:
-            return out
-        f0 = fields.drift(y)
-        f1 = fields.drift(y + f0 * dt + noise)
-        cross = _second_order(J, f0[..., None], dX[..., None, :])
-        return out + 0.5 * dt * (f0 + f1) + 0.5 * dt * cross

@@ -1,0 +1,68 @@
+r"""Flat truncated tensors: the layout shared by the tensor algebra and the signature engine.
+
+An element of the truncated tensor algebra :math:`T^m(\mathbb{R}^d)` without its scalar is a flat
+float64 vector of length ``sigdim(d, m) = d + d**2 + ... + d**m``: levels ``1..m`` concatenated,
+row-major words (iisignature's layout). ``level_offsets(d, m)[k]`` is the start of level ``k``.
+
+The functions here take C-contiguous ``(B, sigdim)`` batches that the caller has validated, run the
+compiled kernels (private to :mod:`roughpaths.algebra`) split over threads by
+:mod:`roughpaths._threads`, and return new arrays. They are the low-level door that
+:mod:`roughpaths.signatures` uses; users call :func:`roughpaths.tensor_log` and
+:func:`roughpaths.lyndon_coordinates`, which check their input first.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _threads
+from . import _kernels as _k
+from ._lyndon import lyndon_projection
+
+__all__ = ["level_offsets", "log_flat", "lyndon_flat", "lyndon_flat_vjp"]
+
+
+def level_offsets(dim: int, depth: int) -> np.ndarray:
+    """Start of each level in the flat layout: ``off[k]`` for ``k = 1..depth+1`` (``off[1] = 0``).
+
+    >>> level_offsets(2, 3)[1:]
+    array([ 0,  2,  6, 14])
+    """
+    off = np.zeros(depth + 2, dtype=np.int64)
+    for k in range(1, depth + 1):
+        off[k + 1] = off[k] + dim ** k
+    return off
+
+
+def log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
+    off = level_offsets(dim, depth)
+    out = np.empty_like(a)
+    _threads.run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
+                 _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
+    return out
+
+
+def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Lyndon coordinates ``(B, logsigdim)`` of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
+    off = level_offsets(dim, depth)
+    projections = [lyndon_projection(dim, k) for k in range(1, depth + 1)]
+    out = np.empty((z.shape[0], sum(p[0].shape[0] for p in projections)))
+    start = 0
+    for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
+        _threads.run(lambda lo, hi: _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, start, lo, hi),
+                     _threads.ranges(z.shape[0], float(lidx.shape[0] + indices.shape[0])))
+        start += lidx.shape[0]
+    return out
+
+
+def lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Cotangent ``(B, sigdim)`` (row-major) of the Lie element, given that of its Lyndon coordinates."""
+    off = level_offsets(dim, depth)
+    gz = np.zeros((gc.shape[0], int(off[depth + 1])))
+    start = 0
+    for k in range(1, depth + 1):
+        lidx, indptr, indices, data = lyndon_projection(dim, k)
+        _k.lyndon_vjp(gc, start, lidx, indptr, indices, data, gz, off[k])
+        start += lidx.shape[0]
+    return gz
