@@ -91,7 +91,7 @@ def register_format(name: str, cls: type, encode, decode) -> None:
 
 
 def _package_version() -> str:
-    from . import __version__
+    from ._version import __version__
 
     return __version__
 

@@ -47,19 +47,12 @@ from ..paths.rough_path import RoughPath
 from ._random import PathStreams
 from ._seeded import SeededDriver
 from ._coloured_kernels import _ou_lift_kernel
-from .coloured_noise_law import (ColouredNoiseLimit, _check_AD, _check_eps, _substep_factor, coloured_noise_limit,
-                                 expected_area_rate, lift_area_rate, ou_step_law, paper_coloured_noise_matrices)
+from .coloured_noise_law import ColouredNoiseLimit, _check_AD, _check_eps, _substep_factor, coloured_noise_limit
 
 __all__ = [
     "ColouredNoiseDriver",
     "ResolutionWarning",
-    "ColouredNoiseLimit",
     "ColouredNoiseSample",
-    "coloured_noise_limit",
-    "paper_coloured_noise_matrices",
-    "ou_step_law",
-    "lift_area_rate",
-    "expected_area_rate",
     "sample_coloured_noise",
     "coloured_noise_limit_path",
     "iter_coloured_noise",

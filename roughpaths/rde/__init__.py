@@ -1,1 +1,21 @@
-"""Rough differential equations: one entry point (solve), the Solver contract, the schemes, and vector fields."""
+"""Rough differential equations: one entry point (:func:`solve`), the :class:`Solver` contract, the schemes, vector fields.
+
+* :mod:`~roughpaths.rde.integrate`: :func:`solve`, its :class:`Solution`.
+* :mod:`~roughpaths.rde.base`: the numbered solver contract; one file per scheme family:
+  :mod:`~roughpaths.rde.euler` (Euler, Heun), :mod:`~roughpaths.rde.davie` (Davie, Davie3),
+  :mod:`~roughpaths.rde.logode` (LogODE, LogODE3).
+* :mod:`~roughpaths.rde.vector_fields` and :mod:`~roughpaths.rde.linear_fields`: the fields.
+"""
+
+from .base import Solver
+from .davie import Davie, Davie3
+from .euler import Euler, Heun
+from .integrate import SOLVERS, NonFiniteStateError, Solution, solve
+from .linear_fields import LinearVectorFields
+from .logode import LogODE, LogODE3
+from .vector_fields import LinearDrift, VectorFields
+
+__all__ = [
+    "Solver", "Davie", "Davie3", "Euler", "Heun", "SOLVERS", "NonFiniteStateError", "Solution", "solve",
+    "LinearVectorFields", "LogODE", "LogODE3", "LinearDrift", "VectorFields",
+]

@@ -1,1 +1,14 @@
-"""Signatures and log-signatures of paths and rough paths, at any depth, with their gradients."""
+"""Signatures and log-signatures of paths and rough paths at any depth, and their gradients.
+
+:mod:`~roughpaths.signatures.signature` (forward) and :mod:`~roughpaths.signatures.gradients`
+(vector–Jacobian products) share one engine (``_engine``: checks, the split of the work); the compiled
+kernels (``_level2``, ``_lanes``, ``_simd``, ``_vjp``, ``_kernels``) are private to this subpackage.
+"""
+
+from .gradients import logsignature_vjp, rough_path_signature_vjp, signature_vjp
+from .signature import logsignature, rough_path_signature, signature
+
+__all__ = [
+    "logsignature_vjp", "rough_path_signature_vjp", "signature_vjp", "logsignature", "rough_path_signature",
+    "signature",
+]
