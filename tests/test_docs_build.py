@@ -31,6 +31,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+#: One API page per subpackage (docs/api/<package>/<subpackage>.md), each a folder of the built site.
+API_PAGES = ["roughpaths"] + [f"roughpaths/{p}" for p in ("algebra", "paths", "signatures", "norms", "drivers",
+                                                            "rde", "io")]
 KATEX = ROOT / "docs" / "assets" / "vendor" / "katex" / "katex.min.js"
 
 RAW_ROLE = re.compile(r":(?:py:)?(?:math|class|func|meth|attr|mod|data|exc|obj|const|ref|eq|cite|term|doc)"
@@ -82,7 +85,8 @@ def site(docs_site):
 
 def test_mkdocs_build_strict(site):
     assert (site / "index.html").exists()
-    assert (site / "api" / "roughpaths" / "index.html").exists()
+    for page in API_PAGES:
+        assert (site / "api" / page / "index.html").exists(), page
 
 def test_katex_is_part_of_the_site(site, docs_site):
     if docs_site.katex_missing:
@@ -119,10 +123,13 @@ def test_api_reference_has_typeset_maths_and_links(site):
     # The docstrings hold ~430 inline formulas and ~20 display blocks; all must reach the page.
     assert len(api) >= 400, len(api)
     assert sum(display for *_, display in api) >= 15
-    page = (site / "api" / "roughpaths" / "index.html").read_text(encoding="utf-8")
-    links = re.findall(r'<a class="autorefs autorefs-internal"[^>]*href="[^"]*#(roughpaths\.[\w.]+)"', page)
+    links = []
+    for page in API_PAGES:
+        if page.startswith("roughpaths"):
+            text = (site / "api" / page / "index.html").read_text(encoding="utf-8")
+            links += re.findall(r'<a class="autorefs autorefs-[a-z]+"[^>]*href="[^"]*#(roughpaths\.[\w.]+)"', text)
     assert len(links) >= 50, len(links)
-    assert "roughpaths.RoughPath" in links
+    assert "roughpaths.paths.rough_path.RoughPath" in links
 
 
 def test_every_formula_is_valid_katex(site, docs_site):

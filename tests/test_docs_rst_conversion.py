@@ -32,13 +32,13 @@ def test_multiline_equation_gets_aligned():
 
 def test_cross_references_resolve_to_canonical_paths():
     pkg = griffe.load("roughpaths", search_paths=[str(Path(__file__).resolve().parents[1])])
-    solve = pkg["solve"]  # the re-exported function; its scope imports RoughPath from .rough_path
+    solve = pkg["solve"]  # the re-exported function; its scope imports RoughPath from ..paths.rough_path
     out = griffe_rst.convert(":class:`RoughPath`, :func:`~roughpaths.solve`, :meth:`RoughPath.increment`, "
                              ":class:`numpy.random.Generator`, :class:`Nowhere`", solve)
     assert out == (
-        '<autoref identifier="roughpaths.RoughPath" optional><code>RoughPath</code></autoref>, '
-        '<autoref identifier="roughpaths.solve" optional><code>solve()</code></autoref>, '
-        '<autoref identifier="roughpaths.RoughPath.increment" optional>'
+        '<autoref identifier="roughpaths.paths.rough_path.RoughPath" optional><code>RoughPath</code></autoref>, '
+        '<autoref identifier="roughpaths.rde.integrate.solve" optional><code>solve()</code></autoref>, '
+        '<autoref identifier="roughpaths.paths.rough_path.RoughPath.increment" optional>'
         '<code>RoughPath.increment()</code></autoref>, '
         '<code>numpy.random.Generator</code>, <code>Nowhere</code>')
 
