@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Set up the environment (first run only) and run the test suite. Extra arguments go to pytest,
-# e.g. ./test.sh -m slow  (the long statistical runs), ./test.sh -x -q tests/test_chen_identity.py
+# e.g. ./test.sh -m slow  (the long statistical runs), ./test.sh -x -q tests/roughpaths/paths/test_chen_identity.py
 set -euo pipefail
 cd "$(dirname "$0")"
 PY="$(tools/setup_env.sh test,docs | tail -n 1)"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Make sure headless Chromium (Debian's `chromium` package) is installed for the browser test
-# (tests/test_browser.py). Idempotent and instant when it is already there. Installs with apt-get when
+# (tests/docs/test_browser.py). Idempotent and instant when it is already there. Installs with apt-get when
 # run as root (as CI is); otherwise says how. Never downloads a browser build of its own.
 set -euo pipefail
 if command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1; then

@@ -21,7 +21,7 @@ kernel is deterministic. No temporary larger than ``O(d)``.
 Serial on purpose: the cost is dominated by drawing the normals (d = 3, m = 1: the kernel takes
 about 20 of 120 ns per path-step), and the machine is shared. ``nogil=True`` lets callers
 overlap it with other work. No ``fastmath``: round-off matches a naive per-step numpy
-reimplementation to ~1e-16 relative (``tests/test_brownian_driver_stream.py``).
+reimplementation to ~1e-16 relative (``tests/roughpaths/drivers/test_brownian_driver_stream.py``).
 """
 
 from __future__ import annotations

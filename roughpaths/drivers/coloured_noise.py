@@ -27,7 +27,7 @@ expected area rate is known exactly (:func:`lift_area_rate`): the relative bias 
 rate is ``O((δ‖A‖)²)`` with the piecewise-linear lift (e.g. 0.4 % at ``δ‖A‖ = 0.25`` for the paper's
 ``A``) and ``O(10⁻⁵)`` with the Hermite correction (see :func:`lift_area_rate`). Pathwise, the
 Lévy-area error is a mean-zero fluctuation of order ``ε² δ^{5/2}`` per sub-step, i.e. an L² error
-``≈ c δ²`` per unit of fast time (measured in ``tests/test_coloured_noise_driver.py`` for a
+``≈ c δ²`` per unit of fast time (measured in ``tests/roughpaths/drivers/test_coloured_noise_driver.py`` for a
 non-normal 2×2 ``A``: ``c ≈ 0.3`` with the Hermite correction, ``≈ 1`` for the chord lift). A
 :class:`ResolutionWarning` (stating ``h/ε²``) is issued when a sub-step exceeds ``max_substep``
 in units of ``ε²/‖A‖``.

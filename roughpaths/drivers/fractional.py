@@ -33,7 +33,7 @@ What is exact and what is approximate:
   (Friz–Victoir, Multidimensional Stochastic Processes as Rough Paths, Ch. 15). The Lévy area over a
   coarse step misses the Lévy areas inside the fine steps, whose sum has :math:`L^2` size of order
   :math:`\delta^{2H - 1/2}\sqrt{h}` (mean zero): for ``H = 0.4`` that is :math:`\delta^{0.3}`, for
-  ``H = 0.3`` only :math:`\delta^{0.1}` (measured in ``tests/test_fbm_levy_area_convergence.py``).
+  ``H = 0.3`` only :math:`\delta^{0.1}` (measured in ``tests/roughpaths/drivers/test_fbm_levy_area_convergence.py``).
   No lift exists for :math:`H \le 1/4` (the areas diverge); :func:`fbm_rough_path` refuses it.
 
 Seeds: every function takes an explicit ``numpy.random.Generator`` or an integer seed; the same seed

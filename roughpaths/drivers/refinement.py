@@ -57,7 +57,7 @@ What is approximate, and why: the coarse tail area is a Gaussian (the method's o
 terms beyond ``K`` enter the conditioning as a Gaussian slack (the path they add at the sub-grid points is
 exact given their sum); the Gibbs sweeps are finite; the fine areas have the fine method's law error. So
 the joint law of the fine increments and areas is the Brownian one up to the coarse and fine methods'
-stated errors. Measured (``tests/test_brownian_refinement_same_path.py``, 1–2·10⁵ fine areas per case,
+stated errors. Measured (``tests/roughpaths/drivers/test_brownian_refinement_same_path.py``, 1–2·10⁵ fine areas per case,
 coarse error :math:`h^{3/2}/4`): the fine Lévy areas' variance :math:`\delta^2/4` and fourth moment
 :math:`5\delta^4/16` are reproduced within 4 standard errors (about 1 % and 3 % of the values) for
 factors 2, 3, 8 and 64, ``d = 2, 3``, where the former sequential splits of ``refine(X, F, rng)`` (which
@@ -157,7 +157,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
       ``levy_area="exact"``: Fourier terms drawn given the area by Gibbs sweeps of exact Gaussian
       updates, fine areas conditioned on Chen's identity the same way), which keeps the fine Lévy-area
       variance and fourth moment Brownian within sampling error
-      (``tests/test_brownian_refinement_same_path.py``); the former sequential splits inflated the
+      (``tests/roughpaths/drivers/test_brownian_refinement_same_path.py``); the former sequential splits inflated the
       variance by 7 % (factor 3) to 18 % (factor 8). Repeated halving (``refine`` by 2, again and
       again) still compounds the factor-2 split's approximation: +12 % at 4, +21 % at 8; refine by the
       whole factor at once instead.

@@ -36,7 +36,7 @@ even words have non-zero mean (``E[X^4]/24`` for ``d = 1``: the scalar ``dY = Y�
 ``h²/8`` per step in ``log Y``), which adds up coherently: rate ``4H − 1``, i.e. 1 for Brownian motion.
 That is the pathwise rate ``(N+1)/p − 1`` of a step-``N`` scheme with exact step signatures
 (Friz–Victoir, Thm 10.30, ``N = 3``, ``p`` just above ``1/H``), which both schemes satisfy. Measured
-rates are in ``tests/test_rough_strong_rates.py`` (pre-asymptotically Davie3 fits 0.15–0.25 above
+rates are in ``tests/roughpaths/rde/test_rough_strong_rates.py`` (pre-asymptotically Davie3 fits 0.15–0.25 above
 ``4H − 1``). With a drift the space–time iterated integrals are approximated (as in
 :class:`~roughpaths.Davie`), which limits the smooth order to 2.
 """

@@ -29,7 +29,7 @@ Three ways to build a family:
   with step :math:`h_b = \varepsilon^{1/3}\max(1, |y_b|)` (:math:`\varepsilon` = float64 machine
   epsilon, so :math:`h_b \approx 6\cdot10^{-6}`), costing ``2 e`` evaluations of the fields. The error
   is :math:`\approx h^2 |D^3 V|/6 + \varepsilon |V| / h`, i.e. about ``1e-10`` relative for fields
-  with moderate third derivatives (measured in ``tests/test_vector_fields.py``).
+  with moderate third derivatives (measured in ``tests/roughpaths/rde/test_vector_fields.py``).
 """
 
 from __future__ import annotations

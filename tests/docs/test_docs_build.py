@@ -30,7 +30,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 #: One API page per subpackage (docs/api/<package>/<subpackage>.md), each a folder of the built site.
 API_PAGES = ["roughpaths"] + [f"roughpaths/{p}" for p in ("algebra", "paths", "signatures", "norms", "drivers",
                                                             "rde", "io")]

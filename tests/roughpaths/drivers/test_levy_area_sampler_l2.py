@@ -12,7 +12,7 @@ Claims tested:
   against the true area), fitted order ``-1/2`` in ``m``; dropping the cross term fails;
 * the public sampler's variances: ``foster`` gives :math:`h^2/4 - h^2/(12m)`, ``davie`` :math:`h^2/4`.
 (The draw order and the kernel against a naive per-step reimplementation:
-``tests/test_brownian_driver_stream.py``.)
+``tests/roughpaths/drivers/test_brownian_driver_stream.py``.)
 """
 
 import iisignature

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 griffe = pytest.importorskip("griffe", reason="griffe comes with the docs extra (mkdocstrings[python])")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 import griffe_rst  # noqa: E402
 
 
@@ -31,7 +31,7 @@ def test_multiline_equation_gets_aligned():
 
 
 def test_cross_references_resolve_to_canonical_paths():
-    pkg = griffe.load("roughpaths", search_paths=[str(Path(__file__).resolve().parents[1])])
+    pkg = griffe.load("roughpaths", search_paths=[str(Path(__file__).resolve().parents[2])])
     solve = pkg["solve"]  # the re-exported function; its scope imports RoughPath from ..paths.rough_path
     out = griffe_rst.convert(":class:`RoughPath`, :func:`~roughpaths.solve`, :meth:`RoughPath.increment`, "
                              ":class:`numpy.random.Generator`, :class:`Nowhere`", solve)

@@ -22,7 +22,7 @@ Davie3 sits below ``4H - 1/2``, above the pathwise ``4H - 1`` (full size, 256 pa
 1.26, 1.07, 0.89, 0.70): its local error is the level-4 signature, whose even words have non-zero mean
 and add up coherently over the steps (asymptotic rate ``4H - 1``), while the log-ODE's is the level-4
 log-signature, of mean zero because fBM is reversible in law (see :mod:`roughpaths.rde.logode`).
-Its level-3 terms are right: on smooth drivers it has order 3 (``tests/test_level3_solvers.py``).
+Its level-3 terms are right: on smooth drivers it has order 3 (``tests/roughpaths/rde/test_level3_solvers.py``).
 """
 
 import numpy as np

@@ -26,7 +26,7 @@ import pytest
 
 from _browser import Chromium, StaticServer, find_chromium
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ARTIFACTS = ROOT / "test-artifacts" / "browser"
 
 PAGE_STATE = r"""
