@@ -9,7 +9,7 @@ velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``
 paper's printed signs are available as ``convention="paper"``.
 """
 
-from .ensemble import EnsembleResult, path_generator, run_ensemble
+from .ensemble import EnsembleResult, run_ensemble
 from .statistics import RunningMoments, moment_observable, split_moment_features
 from .equilibria import (
     Equilibrium,
@@ -30,9 +30,6 @@ from .integrators import (
     LieEuler,
     LieHeun,
     check_on_orbit,
-    coadjoint_step,
-    simulate,
-    simulate_brownian,
 )
 from .lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra, hat, se3, sl2r, so3, su2, vee
 from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
@@ -40,8 +37,6 @@ from .lie_poisson import LiePoissonSystem, girsanov_shift, levy_velocity
 from .rigid_body import RigidBody, isotropic_xi, rigid_body
 from .wong_zakai import (
     RigidBodyWongZakai,
-    integrate_rigid_body,
-    levy_torque,
     rigid_body_wong_zakai_limit,
     simulate_wong_zakai_rigid_body,
 )
@@ -56,16 +51,13 @@ __all__ = [
     "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     # integrators
-    "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
-    "simulate", "simulate_brownian", "check_on_orbit",
+    "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "check_on_orbit",
     # equilibria, phase portraits, Gibbs measures
     "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",
     "modified_hamiltonian", "rigid_body_vector_field", "lagrange_top_sleeping_stability",
     "GibbsMeasure", "gibbs_beta", "gibbs_moments",
     # ensembles
     "run_ensemble", "EnsembleResult", "RunningMoments", "moment_observable", "split_moment_features",
-    "path_generator",
     # coloured noise and the Wong–Zakai anomaly
-    "levy_torque", "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "integrate_rigid_body",
-    "simulate_wong_zakai_rigid_body", "PlanarExample", "planar_example", "planar_limit_moments",
+    "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "simulate_wong_zakai_rigid_body", "PlanarExample", "planar_example", "planar_limit_moments",
 ]

@@ -33,7 +33,6 @@ pools and clusters (a module-level function, not a lambda, as ``observable``).
 from __future__ import annotations
 
 import copy
-import warnings
 from dataclasses import dataclass
 from typing import Callable
 
@@ -54,22 +53,7 @@ from .statistics import (
     split_moment_features,
 )
 
-__all__ = ["RunningMoments", "EnsembleResult", "moment_observable", "split_moment_features",
-           "path_generator", "run_ensemble"]
-
-
-def path_generator(seed: int, index: int) -> np.random.Generator:
-    """Deprecated (no longer the ensemble's stream): ``PCG64(SeedSequence(seed, spawn_key=(index,)))``.
-
-    The ensemble's paths come from ``roughpaths.BrownianDriver(..., seed=seed)``; path ``i`` of it
-    is ``driver.select([i])``.
-    """
-    warnings.warn("path_generator is deprecated: run_ensemble draws its paths from roughpaths.BrownianDriver "
-                  "(path i is BrownianDriver(..., seed=seed, batch_shape=(n_paths,)).select([i])).",
-                  DeprecationWarning, stacklevel=2)
-    seed = check_positive_int(seed, "seed", minimum=0)
-    index = check_positive_int(index, "index", minimum=0)
-    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(index,))))
+__all__ = ["RunningMoments", "EnsembleResult", "moment_observable", "split_moment_features", "run_ensemble"]
 
 
 # ------------------------------------------------------------------------------ results

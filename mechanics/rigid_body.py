@@ -62,15 +62,6 @@ class RigidBody(LiePoissonSystem):
         self.inertia = inertia
         self.inertia.setflags(write=False)
 
-    @property
-    def levy_torque_vector(self) -> np.ndarray:
-        r"""Deprecated alias of :attr:`levy_velocity` (:math:`c = \tfrac12\mathsf s^{ij}\xi_i\times\xi_j`)."""
-        import warnings
-
-        warnings.warn("RigidBody.levy_torque_vector is deprecated; use .levy_velocity.", DeprecationWarning,
-                      stacklevel=2)
-        return self.levy_velocity
-
     def angular_velocity(self, Pi) -> np.ndarray:  # noqa: N803
         r""":math:`\Omega = \mathbb I^{-1}\Pi`, shape ``(..., 3)``."""
         return self.hamiltonian.gradient(self._mu(Pi))

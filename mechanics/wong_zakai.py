@@ -55,25 +55,14 @@ from roughpaths.rough_path import RoughPath
 from roughpaths import Solution, solve
 
 from .integrators import CoadjointSolver, LieHeun
-from .lie_algebra import so3
-from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia, levy_velocity
+from .lie_poisson import check_inertia, levy_velocity
 from .rigid_body import rigid_body
 
 __all__ = [
-    "levy_torque",
     "RigidBodyWongZakai",
     "rigid_body_wong_zakai_limit",
-    "integrate_rigid_body",
     "simulate_wong_zakai_rigid_body",
 ]
-
-
-def levy_torque(s, xi) -> np.ndarray:
-    r"""Deprecated alias of :func:`mechanics.lie_poisson.levy_velocity` (so(3)): :math:`c = \tfrac12\sum_{i,j}s^{ij}\,\xi_i\times\xi_j`."""
-    import warnings
-
-    warnings.warn("levy_torque is deprecated; use mechanics.levy_velocity(s, xi).", DeprecationWarning, stacklevel=2)
-    return levy_velocity(s, xi)
 
 
 @dataclass(frozen=True)
@@ -142,101 +131,9 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
     return RigidBodyWongZakai(limit=lim, sigma=sg, coloured_xi=cxi, limit_xi=lxi, torque=c, perturbation_B=sB)
 
 
-# ------------------------------------------------------------------------------- shared integrators
+# ------------------------------------------------------------------------------- input checks
 def _check_inertia3(inertia):
     return check_inertia(inertia, "inertia", dim=3)
-
-
-def _vec3(v, name):
-    if v is None:
-        return np.zeros(3)
-    return as_float_array(v, name, ndim=1, last_dims=(3,))
-
-
-def _perturbation_for(xi, v, name):
-    """Antisymmetric ``s`` with ``½ Σ s^{ij} ξ_i×ξ_j = v`` (least squares; ``None`` for ``v = 0``)."""
-    if not np.any(v):
-        return None
-    m = xi.shape[0]
-    pi, pj = np.triu_indices(m, 1)
-    if pi.size == 0:
-        raise ValueError(f"{name} = {v} needs at least two noise vectors xi (the Lévy torque is ½ s^ij xi_i × "
-                         f"xi_j), got {m}.")
-    basis = np.cross(xi[pi], xi[pj]).T                                   # (3, npair): Σ_{i<j} s^{ij} ξ_i×ξ_j
-    coef, *_ = np.linalg.lstsq(basis, v, rcond=None)
-    resid = float(np.max(np.abs(basis @ coef - v)))
-    if resid > 1e-12 * max(1.0, float(np.max(np.abs(v)))):
-        raise ValueError(f"{name} = {v} is not a combination ½ s^ij xi_i × xi_j of the noise vectors' brackets "
-                         f"(residual {resid:.3g}); with these xi only torques in their span can be represented.")
-    s = np.zeros((m, m))
-    s[pi, pj], s[pj, pi] = coef, -coef
-    return s
-
-
-def _rigid_system(inertia, xi, theta, torque, dissipation_shift):
-    r"""so(3) system ``dΠ = Π×(Ω + c)dt + θΠ×(Π×(Ω + c_d))dt + Σ Π×ξ_i dX^i`` for the shared integrators.
-
-    ``h = ½Π·I⁻¹Π + c_d·Π`` and the Lévy velocity ``ℓ = c − c_d`` (via ``s``) in the conservative
-    term only (``levy_in_dissipation=False``).
-    """
-    I = _check_inertia3(inertia)
-    c, cd = _vec3(torque, "torque"), _vec3(dissipation_shift, "dissipation_shift")
-    s = _perturbation_for(xi, c - cd, "torque - dissipation_shift")
-    ham = QuadraticHamiltonian(np.linalg.inv(I), cd if np.any(cd) else None)
-    return LiePoissonSystem(so3(), ham, xi, s=s, theta=float(theta), levy_in_dissipation=False)
-
-
-def integrate_rigid_body(driver: RoughPath, Pi0, inertia, xi, theta=0.0, *, torque=None, dissipation_shift=None,
-                         save_every: int = 1, method=None):
-    r"""Integrate ``dΠ = Π×(Ω + c)dt + θΠ×(Π×(Ω + c_d))dt + Σ Π×ξ_i dX^i`` on a level-2 rough path.
-
-    With ``torque = dissipation_shift = c`` this is the rough-path-correct (srblevy) model; with
-    ``dissipation_shift = 0`` it is the limit of (srbcoloured). Runs the shared coadjoint integrators
-    (:func:`roughpaths.solve`, Lie–Heun by default, compiled so(3) kernel) on the
-    system ``h = ½Π·I⁻¹Π + c_d·Π`` with the Lévy velocity ``c − c_d`` in the conservative term only
-    (``levy_in_dissipation=False``); ``|Π|`` is conserved to round-off.
-
-    Parameters
-    ----------
-    driver : RoughPath
-        Level-2 geometric path, dimension ``m``, batch ``(...)``.
-    Pi0 : array_like ``(3,)`` or ``(..., 3)``
-    inertia : array_like ``(3,)`` principal moments or ``(3, 3)`` symmetric positive definite
-    xi : array_like ``(m, 3)``
-    theta : float
-    torque, dissipation_shift : array_like ``(3,)``, optional
-        ``c`` in the conservative and ``c_d`` in the dissipative term (default 0). ``c − c_d`` must
-        be a combination of the brackets ``ξ_i×ξ_j`` (always so for three independent ``ξ``).
-    save_every : int
-    method : LieEuler() | LieHeun() | ImplicitMidpoint(...), optional
-        Default ``LieHeun()``.
-
-    Returns
-    -------
-    times : ndarray ``(K,)``
-    states : ndarray ``(..., K, 3)``
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from roughpaths import RoughPath
-    >>> X = RoughPath.from_path(np.zeros((11, 3)), times=np.linspace(0, 1, 11))
-    >>> t, Pi = integrate_rigid_body(X, [0.0, 0.0, 1.0], [1.0, 2.0, 3.0], np.eye(3), 1.0)
-    >>> Pi[..., -1, :]                      # e3 is an equilibrium
-    array([0., 0., 1.])
-    """
-    import warnings
-
-    warnings.warn("integrate_rigid_body is deprecated; build the system with rigid_body(inertia, xi, s, theta, "
-                  "levy_in_dissipation=False) and call roughpaths.solve(system, X, Pi0, LieHeun()).",
-                  DeprecationWarning, stacklevel=2)
-    if not isinstance(driver, RoughPath) or driver.level != 2:
-        raise TypeError("driver must be a level-2 roughpaths.RoughPath (its step Lévy areas are used).")
-    xi = as_float_array(xi, "xi", ndim=2, last_dims=(driver.dim, 3))
-    system = _rigid_system(inertia, xi, theta, torque, dissipation_shift)
-    sol = solve(system, driver, Pi0, _check_method(method), save_at=driver.times[::check_positive_int(
-        save_every, "save_every")])
-    return sol.times, sol.states
 
 
 def _check_method(method):

@@ -3,9 +3,7 @@
 Covers: non-symmetric / non-positive inertia, wrong ξ shapes, s not antisymmetric or of the wrong size,
 θ < 0 (and non-finite, non-numeric), unknown convention, states off the orbit for a Casimir-preserving
 run (``check_on_orbit``), a chord iteration that fails to converge (the message names the step), level-1
-or non-geometric drivers, dimension mismatches, bad seed / dt / n_steps / save_at. (The validation of the
-deprecated wrappers ``simulate`` / ``simulate_brownian`` / ``coadjoint_step`` is in
-``test_deprecated_wrappers.py``.)
+or non-geometric drivers, dimension mismatches, bad seed / dt / n_steps / save_at.
 """
 
 import numpy as np

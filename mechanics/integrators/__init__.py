@@ -6,7 +6,6 @@ schemes). Compiled so(3) and se(3) kernels are chosen inside the solvers by the 
 """
 
 from .base import ChordConvergenceError, CoadjointSolver, ImplicitMidpoint, LieEuler, LieHeun, check_on_orbit
-from .legacy import coadjoint_step, simulate, simulate_brownian
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
-           "check_on_orbit", "simulate", "simulate_brownian", "coadjoint_step"]
+           "check_on_orbit"]
