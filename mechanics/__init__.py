@@ -22,7 +22,6 @@ from .equilibria import (
     rigid_body_vector_field,
 )
 from .gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
-from .heavy_top import HeavyTop, heavy_top
 from .integrators import (
     ChordConvergenceError,
     CoadjointSolver,
@@ -31,10 +30,28 @@ from .integrators import (
     LieHeun,
     check_on_orbit,
 )
-from .lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra, hat, se3, sl2r, so3, su2, vee
-from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
-from .lie_poisson import LiePoissonSystem, girsanov_shift, levy_velocity
-from .rigid_body import RigidBody, isotropic_xi, rigid_body
+from .systems import (
+    Hamiltonian,
+    HeavyTop,
+    LieAlgebra,
+    LiePoissonSystem,
+    QuadraticHamiltonian,
+    RigidBody,
+    SE3Algebra,
+    SO3Algebra,
+    check_inertia,
+    girsanov_shift,
+    hat,
+    heavy_top,
+    isotropic_xi,
+    levy_velocity,
+    rigid_body,
+    se3,
+    sl2r,
+    so3,
+    su2,
+    vee,
+)
 from .wong_zakai import (
     RigidBodyWongZakai,
     rigid_body_wong_zakai_limit,

@@ -1,7 +1,7 @@
 r"""Ensembles of stochastic Lie–Poisson paths: one entry point, :func:`run_ensemble`, on top of :func:`roughpaths.solve`.
 
 :func:`run_ensemble` simulates ``n_paths`` independent paths of a
-:class:`~mechanics.lie_poisson.LiePoissonSystem` driven by a :class:`roughpaths.BrownianDriver`
+:class:`~mechanics.systems.lie_poisson.LiePoissonSystem` driven by a :class:`roughpaths.BrownianDriver`
 (Stratonovich Brownian motion, with a sampled Lévy area or level-1 driving) and returns streaming
 statistics (memory independent of ``n_steps``; ``O(chunk_size)`` in the paths):
 
@@ -311,8 +311,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
 
     Examples
     --------
-    >>> from mechanics.lie_algebra import so3
-    >>> from mechanics.lie_poisson import LiePoissonSystem
+    >>> from mechanics.systems.lie_algebra import so3
+    >>> from mechanics.systems.lie_poisson import LiePoissonSystem
     >>> rb = LiePoissonSystem(so3(), np.diag([1.0, 2.0, 3.0]), 0.5 * np.eye(3), theta=1.0)
     >>> a = run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=50, n_paths=6, seed=1, chunk_size=4,
     ...                  keep_final=True)
@@ -322,7 +322,7 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     True
     """
     from .integrators import CoadjointSolver, LieHeun
-    from .lie_poisson import LiePoissonSystem
+    from .systems.lie_poisson import LiePoissonSystem
 
     if not isinstance(system, LiePoissonSystem):
         raise TypeError(f"system must be a LiePoissonSystem (e.g. mechanics.rigid_body(...)), got "

@@ -42,7 +42,7 @@ from scipy.optimize import brentq
 
 from roughpaths.validation import as_float_array, check_antisymmetric, check_positive_real, check_real
 
-from .lie_poisson import check_inertia, levy_velocity
+from .systems.lie_poisson import check_inertia, levy_velocity
 
 __all__ = [
     "Equilibrium",

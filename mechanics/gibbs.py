@@ -142,7 +142,7 @@ class GibbsMeasure:
 
     @classmethod
     def from_system(cls, system, *, radius=1.0, rtol=1e-10, max_nodes=40_000_000) -> "GibbsMeasure":
-        """The Gibbs law of a rigid-body system (``mechanics.rigid_body.rigid_body``) with isotropic noise.
+        """The Gibbs law of a rigid-body system (``mechanics.systems.rigid_body.rigid_body``) with isotropic noise.
 
         Uses ``system.inertia``, ``system.theta``, ``σ`` from ``system.xi = σ I`` (anything else
         raises: Theorem 3.1 needs isotropic noise) and ``c = system.torque_velocity`` (the shift
@@ -150,7 +150,7 @@ class GibbsMeasure:
         """
         for attr in ("inertia", "xi", "theta", "torque_velocity"):
             if not hasattr(system, attr):
-                raise TypeError(f"system must be a rigid body (mechanics.rigid_body.rigid_body), it has no .{attr}.")
+                raise TypeError(f"system must be a rigid body (mechanics.systems.rigid_body.rigid_body), it has no .{attr}.")
         if system.theta > 0 and not getattr(system, "levy_in_dissipation", True) and np.any(system.torque_velocity):
             raise ValueError("the Gibbs density exp(-2θh̃/σ²) is the invariant law of Theorem 3.1's model, whose "
                              "dissipation is built from h̃; this system has levy_in_dissipation=False (torque in "

@@ -32,7 +32,7 @@ paper's (srblevy) (whose dissipation uses ``h̃``) — :func:`rigid_body_wong_za
 
 The paper's planar example (2dexample) is in :mod:`mechanics.planar`.
 
-Integrators. All systems are :class:`~mechanics.lie_poisson.LiePoissonSystem` rigid bodies (the
+Integrators. All systems are :class:`~mechanics.systems.lie_poisson.LiePoissonSystem` rigid bodies (the
 limit with ``levy_in_dissipation=False``: torque in the conservative term only) integrated by the
 shared Casimir-preserving coadjoint schemes of :mod:`mechanics.integrators` (Lie–Heun by default):
 ``Π ↦ exp(ad*_σ)Π`` with ``σ = w̄Δt + η`` and the step's level-2 log-signature
@@ -55,8 +55,8 @@ from roughpaths.rough_path import RoughPath
 from roughpaths import Solution, solve
 
 from .integrators import CoadjointSolver, LieHeun
-from .lie_poisson import check_inertia, levy_velocity
-from .rigid_body import rigid_body
+from .systems.lie_poisson import check_inertia, levy_velocity
+from .systems.rigid_body import rigid_body
 
 __all__ = [
     "RigidBodyWongZakai",

@@ -9,11 +9,11 @@ A non-geometric scheme (Heun in R³ on the same increments) drifts by far more, 
 import numpy as np
 import pytest
 
-from mechanics.heavy_top import heavy_top
+from mechanics.systems.heavy_top import heavy_top
 from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
-from mechanics.lie_algebra import sl2r
-from mechanics.lie_poisson import LiePoissonSystem
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_algebra import sl2r
+from mechanics.systems.lie_poisson import LiePoissonSystem
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import BrownianDriver, RoughPath, solve
 
 S = np.array([[0.0, 10.0, 25.0], [-10.0, 0.0, -5.0], [-25.0, 5.0, 0.0]])

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from mechanics import ImplicitMidpoint, LieAlgebra, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body
-from mechanics.lie_algebra import sl2r, so3, su2
+from mechanics.systems.lie_algebra import sl2r, so3, su2
 from roughpaths import BrownianDriver, NonFiniteStateError, RoughPath, solve
 
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import RoughPath, solve
 
 N_FINE = 2 ** 12

@@ -11,7 +11,7 @@ import pytest
 distributed = pytest.importorskip("distributed")
 
 from mechanics.ensemble import run_ensemble  # noqa: E402
-from mechanics.rigid_body import rigid_body  # noqa: E402
+from mechanics.systems.rigid_body import rigid_body  # noqa: E402
 
 RB = rigid_body([1.0, 2.0, 3.0], sigma=0.4, s=np.array([[0, 0, 1.0], [0, 0, 0], [-1.0, 0, 0]]), theta=0.5)
 KW = dict(dt=0.01, n_steps=40, n_paths=70, seed=11, burn_in=10, record_every=20, keep_final=True,

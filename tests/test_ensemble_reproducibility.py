@@ -24,7 +24,7 @@ from mechanics.ensemble import (
     run_ensemble,
     split_moment_features,
 )
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.rigid_body import rigid_body
 
 RB = rigid_body([1.0, 2.0, 3.0], sigma=0.4, s=np.array([[0, 0, 1.0], [0, 0, 0], [-1.0, 0, 0]]), theta=0.5)
 KW = dict(dt=0.01, n_steps=60, n_paths=70, seed=2024, burn_in=20, record_every=15, keep_final=True)  # > 1 leaf

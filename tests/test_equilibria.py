@@ -186,8 +186,8 @@ def test_long_deterministic_runs_library_integrator():
     """The coadjoint integrator (zero noise) lands on the computed stable equilibrium."""
     integ = importlib.import_module("mechanics.integrators")
     from roughpaths import RoughPath, solve
-    from mechanics.lie_algebra import so3
-    from mechanics.lie_poisson import LiePoissonSystem
+    from mechanics.systems.lie_algebra import so3
+    from mechanics.systems.lie_poisson import LiePoissonSystem
 
     s = np.zeros((3, 3))
     s[0, 1], s[0, 2], s[1, 2] = -50.0, 25.0, 25.0
@@ -270,7 +270,7 @@ def test_bad_levy_matrix():
 
 
 def test_sleeping_top_is_an_equilibrium_of_the_library_heavy_top():
-    ht = importlib.import_module("mechanics.heavy_top")
+    ht = importlib.import_module("mechanics.systems.heavy_top")
     I1, I3, mgl = 1.0, 2.0, 1.0
     for om3 in (0.9, 2.0):
         top = ht.heavy_top([I1, I1, I3], [0.0, 0.0, mgl])

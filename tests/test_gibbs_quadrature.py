@@ -141,7 +141,7 @@ def test_bad_input():
 
 
 def test_from_system():
-    from mechanics.rigid_body import rigid_body
+    from mechanics.systems.rigid_body import rigid_body
 
     s = np.zeros((3, 3))
     s[0, 2], s[2, 0] = 1.0, -1.0

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from mechanics.integrators import ImplicitMidpoint, LieHeun
-from mechanics.lie_algebra import sl2r, so3, su2
-from mechanics.lie_poisson import LiePoissonSystem, girsanov_shift
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_algebra import sl2r, so3, su2
+from mechanics.systems.lie_poisson import LiePoissonSystem, girsanov_shift
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import RoughPath, solve
 
 S = np.array([[0.0, 0.8, -1.2], [-0.8, 0.0, 0.5], [1.2, -0.5, 0.0]])

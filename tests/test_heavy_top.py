@@ -10,7 +10,7 @@ round-off) by the chord-solved implicit midpoint, to first order only by Lie–E
 import numpy as np
 import pytest
 
-from mechanics.heavy_top import heavy_top
+from mechanics.systems.heavy_top import heavy_top
 from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
 from roughpaths import BrownianDriver, RoughPath, solve
 
@@ -125,8 +125,8 @@ def test_se3_kernel_equals_numpy_scheme(cls, levy, theta, metric, lid):
     """The compiled se(3) path (chosen by the SE3Algebra type) computes the numpy path's scheme, also
     the implicit midpoint's chord iteration: same system on se(3) built from its structure constants
     (no compiled path), same driver; Casimirs kept to 1e-12."""
-    from mechanics.lie_algebra import LieAlgebra, se3, se3_ad_star_exp
-    from mechanics.lie_poisson import LiePoissonSystem
+    from mechanics.systems.lie_algebra import LieAlgebra, se3, se3_ad_star_exp
+    from mechanics.systems.lie_poisson import LiePoissonSystem
 
     S3 = np.array([[0, 1.0, -2.0], [-1.0, 0, 0.5], [2.0, -0.5, 0]])
     top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.4, s=S3, theta=theta, metric=metric,

@@ -14,7 +14,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from mechanics.lie_algebra import LieAlgebra, hat, se3, sl2r, so3, su2, vee
+from mechanics.systems.lie_algebra import LieAlgebra, hat, se3, sl2r, so3, su2, vee
 
 FACTORIES = {"so3": so3, "su2": su2, "se3": se3, "sl2r": sl2r}
 

@@ -9,11 +9,11 @@ or non-geometric drivers, dimension mismatches, bad seed / dt / n_steps / save_a
 import numpy as np
 import pytest
 
-from mechanics.heavy_top import heavy_top
+from mechanics.systems.heavy_top import heavy_top
 from mechanics.integrators import ChordConvergenceError, ImplicitMidpoint, LieHeun, check_on_orbit
-from mechanics.lie_algebra import so3
-from mechanics.lie_poisson import LiePoissonSystem
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_algebra import so3
+from mechanics.systems.lie_poisson import LiePoissonSystem
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import BrownianDriver, RoughPath, solve
 
 I3 = [1.0, 2.0, 3.0]

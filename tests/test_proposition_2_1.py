@@ -22,9 +22,9 @@ import numpy as np
 import pytest
 
 from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
-from mechanics.lie_algebra import sl2r, so3
-from mechanics.lie_poisson import LiePoissonSystem
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_algebra import sl2r, so3
+from mechanics.systems.lie_poisson import LiePoissonSystem
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import RoughPath, solve
 
 S = np.array([[0.0, 1.5, -2.0], [-1.5, 0.0, 0.7], [2.0, -0.7, 0.0]])

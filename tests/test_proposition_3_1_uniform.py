@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from mechanics.ensemble import run_ensemble
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.rigid_body import rigid_body
 
 IU = np.triu_indices(3)
 

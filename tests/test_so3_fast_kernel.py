@@ -18,9 +18,9 @@ import pytest
 from scipy.linalg import expm
 
 from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
-from mechanics.lie_algebra import LieAlgebra, rodrigues_ad_star_exp
-from mechanics.lie_poisson import LiePoissonSystem
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_algebra import LieAlgebra, rodrigues_ad_star_exp
+from mechanics.systems.lie_poisson import LiePoissonSystem
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import BrownianDriver, solve
 
 

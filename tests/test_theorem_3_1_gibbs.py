@@ -24,7 +24,7 @@ import pytest
 
 from mechanics.ensemble import run_ensemble
 from mechanics.gibbs import GibbsMeasure
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.rigid_body import rigid_body
 
 INERTIA = np.array([1.0, 2.0, 3.0])
 IU = np.triu_indices(3)

@@ -20,8 +20,8 @@ import pytest
 from roughpaths import solve
 from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_coloured_noise
 from mechanics.integrators import LieHeun
-from mechanics.lie_poisson import levy_velocity
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_poisson import levy_velocity
+from mechanics.systems.rigid_body import rigid_body
 from mechanics.wong_zakai import rigid_body_wong_zakai_limit, simulate_wong_zakai_rigid_body
 
 A, D = paper_coloured_noise_matrices(k=0.5)
@@ -38,7 +38,7 @@ def test_torque_mapping():
     # the paper's 2N would double it
     assert np.allclose(levy_velocity(wz.limit.unnormalised_area_rate, wz.coloured_xi), 2 * wz.torque)
     try:
-        from mechanics.rigid_body import rigid_body
+        from mechanics.systems.rigid_body import rigid_body
     except ImportError:  # pragma: no cover - the mechanics core is built in parallel
         return
     rb = rigid_body([1.0, 2.0, 3.0], xi=wz.limit_xi, s=wz.perturbation_B, theta=1.0)

@@ -18,7 +18,7 @@ import numpy as np
 from mechanics.equilibria import rigid_body_equilibria
 from mechanics.gibbs import GibbsMeasure
 from mechanics.integrators import LieHeun
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import BrownianDriver, solve
 from roughpaths.brownian import brownian_rough_path
 

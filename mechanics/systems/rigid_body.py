@@ -48,7 +48,7 @@ def _noise_vectors(xi, sigma, dim):
 
 
 class RigidBody(LiePoissonSystem):
-    """A :class:`~mechanics.lie_poisson.LiePoissonSystem` on so(3) with :math:`h = \\tfrac12\\Pi\\cdot\\mathbb I^{-1}\\Pi`."""
+    """A :class:`~mechanics.systems.lie_poisson.LiePoissonSystem` on so(3) with :math:`h = \\tfrac12\\Pi\\cdot\\mathbb I^{-1}\\Pi`."""
 
     def __init__(self, inertia, xi=None, s=None, theta=0.0, convention="rp", *, metric=None,
                  levy_in_dissipation=True):

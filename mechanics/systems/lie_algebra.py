@@ -120,7 +120,7 @@ class LieAlgebra:
     Examples
     --------
     >>> import numpy as np
-    >>> from mechanics.lie_algebra import so3
+    >>> from mechanics.systems.lie_algebra import so3
     >>> g = so3()
     >>> g.bracket([1.0, 0, 0], [0, 1.0, 0])     # [e1, e2] = e3
     array([0., 0., 1.])

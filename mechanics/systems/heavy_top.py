@@ -1,7 +1,7 @@
 r"""The stochastic heavy top: Lie–Poisson on se(3)* with :math:`\mu = (\Pi, \Gamma)`.
 
 :math:`h = \tfrac12\Pi\cdot\mathbb I^{-1}\Pi + \chi\cdot\Gamma`, so :math:`\nabla h = (\Omega, \chi)` and
-(``ad*`` of :func:`mechanics.lie_algebra.se3`) the rough-path-correct equations are
+(``ad*`` of :func:`mechanics.systems.lie_algebra.se3`) the rough-path-correct equations are
 
 .. math::
 
@@ -29,7 +29,7 @@ __all__ = ["HeavyTop", "heavy_top"]
 
 
 class HeavyTop(LiePoissonSystem):
-    """A :class:`~mechanics.lie_poisson.LiePoissonSystem` on se(3)* (state ``(..., 6) = (Pi, Gamma)``)."""
+    """A :class:`~mechanics.systems.lie_poisson.LiePoissonSystem` on se(3)* (state ``(..., 6) = (Pi, Gamma)``)."""
 
     def __init__(self, inertia, chi, xi, s=None, theta=0.0, convention="rp", *, metric=None,
                  levy_in_dissipation=True):
@@ -75,7 +75,7 @@ def heavy_top(inertia, chi, xi=None, sigma=None, s=None, theta=0.0, convention="
     theta : float >= 0
     convention : {"rp", "paper"}
     levy_in_dissipation : bool
-        Where the Lévy-area velocity enters (see :class:`~mechanics.lie_poisson.LiePoissonSystem`):
+        Where the Lévy-area velocity enters (see :class:`~mechanics.systems.lie_poisson.LiePoissonSystem`):
         ``True`` (default) in the Hamiltonian of both the conservative and the double-bracket term;
         ``False`` in the conservative term only (the exact form of driving by ``X.perturb(s)``).
 

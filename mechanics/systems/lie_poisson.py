@@ -146,8 +146,8 @@ class LiePoissonSystem:
     Examples
     --------
     >>> import numpy as np
-    >>> from mechanics.lie_algebra import so3
-    >>> from mechanics.lie_poisson import LiePoissonSystem
+    >>> from mechanics.systems.lie_algebra import so3
+    >>> from mechanics.systems.lie_poisson import LiePoissonSystem
     >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 25.0, -25.0
     >>> sys_ = LiePoissonSystem(so3(), np.diag([1.0, 2.0, 3.0]), 0.05 * np.eye(3), s=s, theta=1.0)
     >>> sys_.levy_velocity          # ½ s^{ij} ξ_i × ξ_j = σ² (s23, -s13, s12)
@@ -165,7 +165,7 @@ class LiePoissonSystem:
                  *, hamiltonian_gradient=None, hamiltonian_hessian=None, metric=None,
                  levy_in_dissipation: bool = True):
         if not isinstance(algebra, LieAlgebra):
-            raise TypeError(f"algebra must be a LieAlgebra (e.g. mechanics.lie_algebra.so3()), got "
+            raise TypeError(f"algebra must be a LieAlgebra (e.g. mechanics.systems.lie_algebra.so3()), got "
                             f"{type(algebra).__name__}.")
         self.algebra = algebra
         n = algebra.dim
