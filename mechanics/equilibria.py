@@ -42,7 +42,8 @@ from scipy.optimize import brentq
 
 from roughpaths.validation import as_float_array, check_antisymmetric, check_positive_real, check_real
 
-from .systems.lie_poisson import check_inertia, levy_velocity
+from .systems.hamiltonian import check_inertia
+from .systems.lie_poisson import levy_velocity
 
 __all__ = [
     "Equilibrium",

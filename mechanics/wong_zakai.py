@@ -55,7 +55,8 @@ from roughpaths.rough_path import RoughPath
 from roughpaths import Solution, solve
 
 from .integrators import CoadjointSolver, LieHeun
-from .systems.lie_poisson import check_inertia, levy_velocity
+from .systems.hamiltonian import check_inertia
+from .systems.lie_poisson import levy_velocity
 from .systems.rigid_body import rigid_body
 
 __all__ = [

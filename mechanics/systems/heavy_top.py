@@ -22,7 +22,8 @@ import numpy as np
 from roughpaths.validation import as_float_array
 
 from .lie_algebra import se3
-from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
+from .hamiltonian import QuadraticHamiltonian, check_inertia
+from .lie_poisson import LiePoissonSystem
 from .rigid_body import _noise_vectors
 
 __all__ = ["HeavyTop", "heavy_top"]

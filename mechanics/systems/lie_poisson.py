@@ -63,10 +63,7 @@ from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
 from .lie_algebra import LieAlgebra
 
 __all__ = [
-    "Hamiltonian",
-    "QuadraticHamiltonian",
     "LiePoissonSystem",
-    "check_inertia",
     "levy_velocity",
     "girsanov_shift",
     "CONVENTIONS",

@@ -25,7 +25,8 @@ import numpy as np
 from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real
 
 from .lie_algebra import so3
-from .lie_poisson import LiePoissonSystem, QuadraticHamiltonian, check_inertia
+from .hamiltonian import QuadraticHamiltonian, check_inertia
+from .lie_poisson import LiePoissonSystem
 
 __all__ = ["RigidBody", "rigid_body", "isotropic_xi"]
 
