@@ -9,8 +9,7 @@ velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``
 paper's printed signs are available as ``convention="paper"``.
 """
 
-from .ensemble import EnsembleResult, run_ensemble
-from .statistics import RunningMoments, moment_observable, split_moment_features
+from .ensemble import EnsembleResult, RunningMoments, moment_observable, run_ensemble, split_moment_features
 from .equilibria import (
     Equilibrium,
     LevelSets,

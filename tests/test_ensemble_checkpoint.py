@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import mechanics
-import mechanics.ensemble as ens
+import mechanics.ensemble.run as ens
 import roughpaths as rp
 
 BODY = dict(inertia=[1.0, 2.0, 3.0], sigma=0.2, theta=0.5)

@@ -19,8 +19,8 @@ chunks of ``chunk_size`` (``driver.select``), each chunk is solved block by bloc
 Reproducibility. A path's noise depends only on ``(seed, path index, levy_area)`` (the driver's
 stream); the coadjoint step of a member does not depend on the rest of the batch; time sums are
 accumulated step by step; the across-path statistics are reduced in fixed leaves of
-:data:`~mechanics.statistics.LEAF` paths merged in path order
-(:class:`~mechanics.statistics.LeafReducer`). So the results — final states and every statistic —
+:data:`~mechanics.ensemble.statistics.LEAF` paths merged in path order
+(:class:`~mechanics.ensemble.statistics.LeafReducer`). So the results — final states and every statistic —
 are bitwise the same whatever ``chunk_size``, ``block_steps`` or ``executor``.
 
 Executors. ``executor=`` accepts any :class:`concurrent.futures.Executor` (thread or process pool)
@@ -321,8 +321,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     >>> bool(np.array_equal(a.final_states, b.final_states) and np.array_equal(a.final.mean, b.final.mean))
     True
     """
-    from .integrators import CoadjointSolver, LieHeun
-    from .systems.lie_poisson import LiePoissonSystem
+    from ..integrators import CoadjointSolver, LieHeun
+    from ..systems.lie_poisson import LiePoissonSystem
 
     if not isinstance(system, LiePoissonSystem):
         raise TypeError(f"system must be a LiePoissonSystem (e.g. mechanics.rigid_body(...)), got "

@@ -1,7 +1,7 @@
 """Checkpoints of :func:`mechanics.run_ensemble`: the statistics merged so far, saved after every chunk.
 
 A checkpoint is an ``.npz`` file (written atomically by :func:`roughpaths.io.atomic_savez`) holding
-the number of chunks done, the state of every :class:`~mechanics.statistics.LeafReducer` (count,
+the number of chunks done, the state of every :class:`~mechanics.ensemble.statistics.LeafReducer` (count,
 mean, scatter and the rows of its unfinished leaf), the final states kept so far, and a SHA-256
 fingerprint of the run's arguments. Resuming restores the reducers exactly, so the merge sequence, and
 hence every bit of the result, is that of an uninterrupted run.
