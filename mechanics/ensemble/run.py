@@ -38,111 +38,18 @@ from typing import Callable
 
 import numpy as np
 
-from roughpaths import BrownianDriver, register_format, solve
+from roughpaths import BrownianDriver, solve
 from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real, check_work
 
+from ..integrators import CoadjointSolver, LieHeun
+from ..systems.lie_poisson import LiePoissonSystem
 from .checkpoint import fingerprint as _fingerprint
 from .checkpoint import load_checkpoint as _load_checkpoint
 from .checkpoint import save_checkpoint as _save_checkpoint
-from .statistics import (
-    LeafReducer,
-    RunningMoments,
-    accumulate,
-    accumulate_moments,
-    moment_observable,
-    split_moment_features,
-)
+from .result import EnsembleResult
+from .statistics import LeafReducer, accumulate, accumulate_moments, moment_observable
 
-__all__ = ["RunningMoments", "EnsembleResult", "moment_observable", "split_moment_features", "run_ensemble"]
-
-
-# ------------------------------------------------------------------------------ results
-@dataclass
-class EnsembleResult:
-    """Output of :func:`run_ensemble`.
-
-    Attributes
-    ----------
-    final : RunningMoments
-        Across-path statistics of ``observable(μ_T)``.
-    time_average : RunningMoments or None
-        Across-path statistics of the per-path time averages over ``burn_in < n ≤ n_steps``
-        (every ``average_every``-th step); None if that window is empty.
-    snapshot_times : ndarray (S,)
-    snapshots : list of RunningMoments
-        Statistics of ``observable(μ_t)`` at ``snapshot_times``.
-    final_states : ndarray (n_paths, n) or None
-        Only with ``keep_final=True`` (memory ``O(n_paths)``).
-    n_paths, n_steps, dt, seed
-    """
-
-    final: RunningMoments
-    time_average: RunningMoments | None
-    snapshot_times: np.ndarray
-    snapshots: list
-    final_states: np.ndarray | None
-    n_paths: int
-    n_steps: int
-    dt: float
-    seed: int
-    state_dim: int = 0
-
-    def moments(self, which: str = "time_average"):
-        """For the default observable: ``(mean (n,), second_moment (n, n), se_mean (n,), se_second (n, n))``
-        of ``which`` in {"time_average", "final"}."""
-        rm = self.time_average if which == "time_average" else self.final if which == "final" else None
-        if rm is None:
-            raise ValueError(f"which must be 'time_average' or 'final' (and that statistic must exist), got {which!r}.")
-        n = self.state_dim
-        if rm.dim != n + n * (n + 1) // 2:
-            raise ValueError("moments() needs the default observable (moment_observable).")
-        mean, m2 = split_moment_features(rm.mean, n)
-        se_mean, se_m2 = split_moment_features(rm.standard_error, n)
-        return mean, m2, se_mean, se_m2
-
-
-def _moments_to_arrays(rm, prefix, arrays):
-    arrays[prefix + "count"] = np.array(rm.count, dtype=np.int64)
-    arrays[prefix + "mean"] = rm.mean
-    arrays[prefix + "scatter"] = rm.scatter
-
-
-def _moments_from_arrays(arrays, prefix):
-    mean = arrays[prefix + "mean"]
-    rm = RunningMoments(mean.shape[0])
-    rm.count = int(arrays[prefix + "count"])
-    rm.mean = np.array(mean, dtype=np.float64)
-    rm.scatter = np.array(arrays[prefix + "scatter"], dtype=np.float64)
-    return rm
-
-
-def _encode_ensemble(res: "EnsembleResult"):
-    arrays = {"snapshot_times": np.asarray(res.snapshot_times, dtype=np.float64)}
-    _moments_to_arrays(res.final, "final_", arrays)
-    if res.time_average is not None:
-        _moments_to_arrays(res.time_average, "time_average_", arrays)
-    for k, rm in enumerate(res.snapshots):
-        _moments_to_arrays(rm, f"snapshot{k}_", arrays)
-    if res.final_states is not None:
-        arrays["final_states"] = res.final_states
-    extra = {"n_paths": res.n_paths, "n_steps": res.n_steps, "dt": res.dt, "seed": res.seed,
-             "state_dim": res.state_dim, "n_snapshots": len(res.snapshots),
-             "has_time_average": res.time_average is not None}
-    return extra, arrays
-
-
-def _decode_ensemble(meta, arrays):
-    return EnsembleResult(
-        final=_moments_from_arrays(arrays, "final_"),
-        time_average=_moments_from_arrays(arrays, "time_average_") if meta["has_time_average"] else None,
-        snapshot_times=arrays["snapshot_times"],
-        snapshots=[_moments_from_arrays(arrays, f"snapshot{k}_") for k in range(meta["n_snapshots"])],
-        final_states=arrays.get("final_states"), n_paths=meta["n_paths"], n_steps=meta["n_steps"],
-        dt=meta["dt"], seed=meta["seed"], state_dim=meta["state_dim"])
-
-
-# roughpaths.save / roughpaths.load write and read ensemble results (format in roughpaths.io)
-register_format("EnsembleResult", EnsembleResult, _encode_ensemble, _decode_ensemble)
+__all__ = ["run_ensemble"]
 
 
 @dataclass(frozen=True)
@@ -321,9 +228,6 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     >>> bool(np.array_equal(a.final_states, b.final_states) and np.array_equal(a.final.mean, b.final.mean))
     True
     """
-    from ..integrators import CoadjointSolver, LieHeun
-    from ..systems.lie_poisson import LiePoissonSystem
-
     if not isinstance(system, LiePoissonSystem):
         raise TypeError(f"system must be a LiePoissonSystem (e.g. mechanics.rigid_body(...)), got "
                         f"{type(system).__name__}.")
