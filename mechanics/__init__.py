@@ -10,9 +10,12 @@ paper's printed signs are available as ``convention="paper"``.
 """
 
 from .ensemble import EnsembleResult, RunningMoments, moment_observable, run_ensemble, split_moment_features
-from .equilibria import (
+from .analysis import (
     Equilibrium,
+    GibbsMeasure,
     LevelSets,
+    gibbs_beta,
+    gibbs_moments,
     isotropic_levy_shift,
     lagrange_top_sleeping_stability,
     modified_hamiltonian,
@@ -20,7 +23,6 @@ from .equilibria import (
     rigid_body_level_sets,
     rigid_body_vector_field,
 )
-from .gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
 from .integrators import (
     ChordConvergenceError,
     CoadjointSolver,

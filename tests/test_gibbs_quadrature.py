@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad
 
-from mechanics.gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
+from mechanics.analysis.gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
 
 
 def _vmf(kappa, mu_hat, r, beta):

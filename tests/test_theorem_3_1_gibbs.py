@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from mechanics.ensemble import run_ensemble
-from mechanics.gibbs import GibbsMeasure
+from mechanics.analysis.gibbs import GibbsMeasure
 from mechanics.systems.rigid_body import rigid_body
 
 INERTIA = np.array([1.0, 2.0, 3.0])

@@ -15,8 +15,8 @@ import os
 
 import numpy as np
 
-from mechanics.equilibria import rigid_body_equilibria
-from mechanics.gibbs import GibbsMeasure
+from mechanics.analysis.equilibria import rigid_body_equilibria
+from mechanics.analysis.gibbs import GibbsMeasure
 from mechanics.integrators import LieHeun
 from mechanics.systems.rigid_body import rigid_body
 from roughpaths import BrownianDriver, solve

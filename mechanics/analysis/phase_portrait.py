@@ -3,7 +3,7 @@ r"""Phase portraits of the modified rigid body: level sets of :math:`\tilde h` o
 :math:`\tilde h(\Pi) = \tfrac12\Pi\cdot\mathbb I^{-1}\Pi + c\cdot\Pi` is conserved by the conservative
 flow and decreased by the double bracket; its level curves on the sphere are the trajectories of
 the undamped body. The separatrices pass through the saddles found by
-:func:`mechanics.equilibria.rigid_body_equilibria`.
+:func:`mechanics.analysis.equilibria.rigid_body_equilibria`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 r"""Equilibria of the modified (Lévy-area-shifted) rigid body and their stability.
 
-Phase portraits (level sets of ``h̃`` on the sphere) are in :mod:`mechanics.phase_portrait`.
+Phase portraits (level sets of ``h̃`` on the sphere) are in :mod:`mechanics.analysis.phase_portrait`.
 
 The deterministic part of the rough-path-correct (RP) rigid body of ``docs/conventions.md`` is
 
@@ -42,8 +42,8 @@ from scipy.optimize import brentq
 
 from roughpaths.validation import as_float_array, check_antisymmetric, check_positive_real, check_real
 
-from .systems.hamiltonian import check_inertia
-from .systems.lie_poisson import levy_velocity
+from ..systems.hamiltonian import check_inertia
+from ..systems.lie_poisson import levy_velocity
 
 __all__ = [
     "Equilibrium",
