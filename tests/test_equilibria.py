@@ -18,7 +18,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import least_squares
 
-from mechanics.analysis.equilibria import (
+from mechanics.analysis import (
     isotropic_levy_shift,
     lagrange_top_sleeping_stability,
     rigid_body_equilibria,

@@ -1,20 +1,8 @@
 r"""Equilibria of the modified (Lévy-area-shifted) rigid body and their stability.
 
-Phase portraits (level sets of ``h̃`` on the sphere) are in :mod:`mechanics.analysis.phase_portrait`.
-
-The deterministic part of the rough-path-correct (RP) rigid body of ``docs/conventions.md`` is
-
-.. math::
-
-    \dot\Pi = \Pi\times W + \vartheta\,\Pi\times(\Pi\times W), \qquad
-    W = \nabla\tilde h(\Pi) = \mathbb I^{-1}\Pi + c, \qquad
-    \tilde h(\Pi) = \tfrac12\,\Pi\cdot\mathbb I^{-1}\Pi + c\cdot\Pi,
-
-with ``c = +½ Σ_ij s^{ij} ξ_i × ξ_j`` (for isotropic noise ``ξ_i = σ e_i``:
-``c = σ² (s23, -s13, s12)``; the paper's printed ``-½`` flips it, see :func:`isotropic_levy_shift`).
-Both terms are tangent to the sphere ``|Π| = r`` (a Casimir); the second one is
-``-ϑ r² P_T ∇h̃``, the gradient descent of ``h̃`` on the sphere, so with ``ϑ > 0`` the flow is
-attracted to the local minima of ``h̃`` on the sphere.
+The model, ``Π̇ = Π × ∇h̃ + ϑ Π × (Π × ∇h̃)`` with ``h̃ = ½ Π·𝕀⁻¹Π + c·Π``, is in
+:mod:`mechanics.analysis.modified_energy`; phase portraits (level sets of ``h̃`` on the sphere) are
+in :mod:`mechanics.analysis.phase_portrait`.
 
 Equilibria are the points where ``Π ∥ ∇h̃``: ``(𝕀⁻¹ − λ) Π = −c``, ``|Π| = r``. In the eigenbasis
 ``𝕀⁻¹ = Q diag(a) Qᵀ``, ``b = Qᵀ c``, this is the secular equation
@@ -40,108 +28,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from roughpaths.validation import as_float_array, check_antisymmetric, check_positive_real, check_real
+from ._inputs import _as_c, _check_radius, _check_theta
+from ._sphere import _tangent_basis
+from .modified_energy import _modified_hamiltonian, as_inverse_inertia
 
-from ..systems.hamiltonian import check_inertia
-from ..systems.lie_poisson import levy_velocity
-
-__all__ = [
-    "Equilibrium",
-    "LevelSets",
-    "as_inverse_inertia",
-    "isotropic_levy_shift",
-    "modified_hamiltonian",
-    "rigid_body_vector_field",
-    "rigid_body_equilibria",
-    "rigid_body_level_sets",
-    "lagrange_top_sleeping_stability",
-]
+__all__ = ["Equilibrium", "rigid_body_equilibria"]
 
 
-# ---------------------------------------------------------------------------------------- inputs
-def as_inverse_inertia(inertia, name: str = "inertia") -> np.ndarray:
-    """Return ``𝕀⁻¹`` (3×3) from an inertia given as 3 principal moments or a 3×3 SPD matrix.
-
-    Raises ``ValueError`` for non-symmetric, non-positive-definite or wrongly shaped input.
-    """
-    return np.linalg.inv(check_inertia(inertia, name, dim=3))
-
-
-def _as_c(c, name: str = "c") -> np.ndarray:
-    if c is None:
-        return np.zeros(3)
-    return as_float_array(c, name, ndim=1, last_dims=(3,))
-
-
-def _check_radius(radius) -> float:
-    r = float(as_float_array(radius, "radius", ndim=0))
-    if not r > 0:
-        raise ValueError(f"radius must be > 0 (the Casimir |Π| of the orbit), got {r!r}.")
-    return r
-
-
-def _check_theta(theta) -> float:
-    th = float(as_float_array(theta, "theta", ndim=0))
-    if th < 0:
-        raise ValueError(f"theta must be >= 0 (a dissipation rate), got {th!r}; "
-                         f"theta < 0 is anti-dissipation and has no Gibbs measure.")
-    return th
-
-
-def isotropic_levy_shift(sigma, s, convention: str = "rp") -> np.ndarray:
-    r"""The Lévy-area velocity ``c`` for isotropic noise ``ξ_i = σ e_i`` on so(3) ≅ R³.
-
-    ``convention="rp"`` (default, ``docs/conventions.md``): ``c = +½ Σ_ij s^{ij} ξ_i × ξ_j
-    = σ² (s23, −s13, s12)``. ``convention="paper"``: the paper's printed ``−½`` (torque sign
-    flipped), ``c = −σ² (s23, −s13, s12)``.
-
-    Examples
-    --------
-    >>> s = np.zeros((3, 3)); s[0, 2], s[2, 0] = 25.0, -25.0
-    >>> isotropic_levy_shift(0.05, s)            # the paper's Fig. surf2 parameters
-    array([ 0.    , -0.0625,  0.    ])
-    """
-    sig = float(as_float_array(sigma, "sigma", ndim=0))
-    s = check_antisymmetric(s, "s", dim=3)
-    if s.ndim != 2:
-        raise ValueError(f"s must be a single 3x3 antisymmetric matrix, got shape {s.shape}.")
-    c = levy_velocity(s, sig * np.eye(3))
-    if convention == "rp":
-        return c
-    if convention == "paper":
-        return -c
-    raise ValueError(f"convention must be 'rp' or 'paper', got {convention!r}.")
-
-
-def modified_hamiltonian(Pi, inertia, c=None) -> np.ndarray:
-    """``h̃(Π) = ½ Π·𝕀⁻¹Π + c·Π`` for ``Π`` of shape ``(..., 3)``; returns shape ``(...)``."""
-    A = as_inverse_inertia(inertia)
-    c = _as_c(c)
-    P = as_float_array(Pi, "Pi", last_dims=(3,))
-    return _modified_hamiltonian(P, A, c)
-
-
-def _modified_hamiltonian(P, A, c):
-    """The one formula for ``h̃ = ½ Π·AΠ + c·Π`` on so(3)* (``A = 𝕀⁻¹``), used by the Gibbs measure too."""
-    return 0.5 * np.einsum("...i,ij,...j->...", P, A, P) + P @ c
-
-
-def rigid_body_vector_field(Pi, inertia, c=None, theta=0.0) -> np.ndarray:
-    """RP deterministic vector field ``Π × W + ϑ Π × (Π × W)``, ``W = 𝕀⁻¹Π + c``; shape ``(..., 3)``.
-
-    Independent of the integrators module (plain numpy), for deterministic checks with
-    ``scipy.integrate.solve_ivp``.
-    """
-    A = as_inverse_inertia(inertia)
-    c = _as_c(c)
-    th = _check_theta(theta)
-    P = as_float_array(Pi, "Pi", last_dims=(3,))
-    W = P @ A.T + c
-    PxW = np.cross(P, W)
-    return PxW + th * np.cross(P, PxW)
-
-
-# ------------------------------------------------------------------------------------ equilibria
 @dataclass(frozen=True)
 class Equilibrium:
     """One equilibrium of the modified rigid body on the sphere ``|Π| = r``.
@@ -190,18 +83,6 @@ class Equilibrium:
                 f"type={self.dissipative_type!r})")
 
 
-def _tangent_basis(n: np.ndarray) -> np.ndarray:
-    """Orthonormal basis (3, 2) of the plane ⟂ n, right-handed: b1 × b2 = n/|n|."""
-    u = n / np.linalg.norm(n)
-    k = int(np.argmin(np.abs(u)))
-    e = np.zeros(3)
-    e[k] = 1.0
-    b1 = np.cross(u, e)
-    b1 /= np.linalg.norm(b1)
-    b2 = np.cross(u, b1)
-    return np.stack([b1, b2], axis=1)
-
-
 def _hat(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
@@ -239,7 +120,7 @@ def _classify(P, lam, A, c, r, theta, scale, manifold_dim=0) -> Equilibrium:
             focus = bool(np.any(np.abs(jev.imag) > 1e-12 * max(1.0, float(np.max(np.abs(jev))))))
             dis = ("stable " if kind == "minimum" else "unstable ") + ("focus" if focus else "node")
         stable = kind == "minimum"
-    energy = float(0.5 * P @ A @ P + c @ P)
+    energy = float(_modified_hamiltonian(P, A, c))
     return Equilibrium(point=P.copy(), multiplier=float(lam), energy=energy, hessian_eigenvalues=hev,
                        kind=kind, conservative_type=cons, dissipative_type=dis,
                        jacobian_eigenvalues=jev, stable=bool(stable), manifold_dim=manifold_dim)
@@ -397,38 +278,3 @@ def rigid_body_equilibria(inertia, c=None, *, radius=1.0, theta=0.0):
     esc = scale * r * r
     out.sort(key=lambda e: (round(e.energy / esc, 10), tuple(np.round(e.point / r, 10))))
     return out
-
-
-# ------------------------------------------------------------------------------ phase portraits
-def lagrange_top_sleeping_stability(I1, I3, omega3, mgl):
-    r"""The sleeping Lagrange top: linear stability of ``Π = (0, 0, I3 ω3)``, ``Γ = e3``.
-
-    Symmetric top ``𝕀 = diag(I1, I1, I3)``, ``h = ½Π·𝕀⁻¹Π + χ·Γ`` with ``χ = M g ℓ e3`` (centre of
-    mass on the symmetry axis at distance ``ℓ``), Lie–Poisson equations on se(3)* in the
-    ``docs/conventions.md`` form ``Π̇ = Π × Ω + Γ × χ``, ``Γ̇ = Γ × Ω``. The upright spin is an equilibrium
-    for every ``ω3``; it is linearly (and, by energy–Casimir, nonlinearly) stable iff
-    ``Π3² > 4 I1 M g ℓ`` (the fast-top criterion). The body-frame linearisation has the eigenvalues
-    ``± √(4 I1 M g ℓ − Π3²) / (2 I1)`` (each twice) plus two zeros along the Casimir directions.
-
-    Returns
-    -------
-    dict with ``stable`` (bool), ``margin`` ``Π3² − 4 I1 M g ℓ`` and ``eigenvalues`` (complex, 6).
-
-    Examples
-    --------
-    >>> lagrange_top_sleeping_stability(1.0, 2.0, 2.0, 1.0)["stable"]
-    True
-    """
-    I1 = check_positive_real(I1, "I1")
-    I3 = check_positive_real(I3, "I3")
-    p3 = I3 * check_real(omega3, "omega3")
-    margin = p3 * p3 - 4.0 * I1 * check_real(mgl, "mgl")
-    if not np.isfinite(margin):
-        raise ValueError(f"the margin (I3*omega3)**2 - 4*I1*mgl overflows for I1={I1!r}, I3={I3!r}, "
-                         f"omega3={omega3!r}, mgl={mgl!r}; rescale the units.")
-    lam = np.sqrt(complex(-margin)) / (2.0 * I1)
-    return {"stable": bool(margin > 0), "margin": margin,
-            "eigenvalues": np.array([lam, lam, -lam, -lam, 0.0, 0.0], dtype=complex)}
-
-
-from .phase_portrait import LevelSets, rigid_body_level_sets  # noqa: E402  (re-exported: former home)

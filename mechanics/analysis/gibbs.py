@@ -45,7 +45,10 @@ import numpy as np
 
 from roughpaths.validation import as_float_array, check_positive_int, check_positive_real, check_rng
 
-from .equilibria import _modified_hamiltonian, _as_c, _check_radius, _tangent_basis, as_inverse_inertia, rigid_body_equilibria
+from ._inputs import _as_c, _check_radius
+from ._sphere import _tangent_basis
+from .equilibria import rigid_body_equilibria
+from .modified_energy import _modified_hamiltonian, as_inverse_inertia
 
 __all__ = ["GibbsMeasure", "gibbs_beta", "gibbs_moments"]
 

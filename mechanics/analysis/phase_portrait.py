@@ -14,7 +14,9 @@ import numpy as np
 
 from roughpaths.validation import as_float_array, check_memory, check_positive_int
 
-from .equilibria import _as_c, _check_radius, as_inverse_inertia, rigid_body_equilibria
+from ._inputs import _as_c, _check_radius
+from .equilibria import rigid_body_equilibria
+from .modified_energy import _modified_hamiltonian, as_inverse_inertia
 
 __all__ = ["LevelSets", "rigid_body_level_sets"]
 
@@ -160,7 +162,7 @@ def rigid_body_level_sets(inertia, c=None, *, radius=1.0, levels=12, include_sep
     ph = np.linspace(-np.pi, np.pi, n_phi)
     TH, PH = np.meshgrid(th, ph, indexing="ij")
     P = r * np.stack([np.sin(TH) * np.cos(PH), np.sin(TH) * np.sin(PH), np.cos(TH)], axis=-1)
-    H = 0.5 * np.einsum("...i,ij,...j->...", P, A, P) + P @ c
+    H = _modified_hamiltonian(P, A, c)
     gen = contourpy.contour_generator(ph, th, H, line_type="Separate")
     curves = []
     for level in lv:
@@ -181,7 +183,7 @@ def _project_to_level(x, A, c, r, level, iters=4):
         g = x @ A.T + c
         n = x / np.linalg.norm(x, axis=-1, keepdims=True)
         gt = g - np.sum(g * n, axis=-1, keepdims=True) * n
-        f = 0.5 * np.einsum("...i,ij,...j->...", x, A, x) + x @ c - level
+        f = _modified_hamiltonian(x, A, c) - level
         g2 = np.sum(gt * gt, axis=-1)
         ok = g2 > 1e-20 * (1.0 + float(np.max(g2, initial=0.0)))
         step = np.where(ok, f / np.where(ok, g2, 1.0), 0.0)
@@ -190,5 +192,3 @@ def _project_to_level(x, A, c, r, level, iters=4):
         x = r * x / np.linalg.norm(x, axis=-1, keepdims=True)
     return x
 
-
-# ------------------------------------------------------------------------------------ heavy top
