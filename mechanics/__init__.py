@@ -53,12 +53,14 @@ from .systems import (
     su2,
     vee,
 )
-from .wong_zakai import (
+from .limits import (
+    PlanarExample,
     RigidBodyWongZakai,
+    planar_example,
+    planar_limit_moments,
     rigid_body_wong_zakai_limit,
     simulate_wong_zakai_rigid_body,
 )
-from .planar import PlanarExample, planar_example, planar_limit_moments
 
 __version__ = "0.1.0"
 

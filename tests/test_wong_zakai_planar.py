@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from mechanics.planar import planar_example, planar_limit_moments
+from mechanics.limits.planar import planar_example, planar_limit_moments
 from roughpaths import BrownianDriver, LogODE, Solution, solve
 
 PARAMS = dict(alpha=1.0, gamma=1.0, delta=2.0, lam=-0.2, mu=0.0)

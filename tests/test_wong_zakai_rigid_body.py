@@ -22,7 +22,7 @@ from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_colo
 from mechanics.integrators import LieHeun
 from mechanics.systems.lie_poisson import levy_velocity
 from mechanics.systems.rigid_body import rigid_body
-from mechanics.wong_zakai import rigid_body_wong_zakai_limit, simulate_wong_zakai_rigid_body
+from mechanics.limits.wong_zakai import rigid_body_wong_zakai_limit, simulate_wong_zakai_rigid_body
 
 A, D = paper_coloured_noise_matrices(k=0.5)
 SIGMA = 0.5

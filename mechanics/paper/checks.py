@@ -174,7 +174,7 @@ def check_prop21(ctx) -> CheckResult:
     s = s_matrix(s12=-50.0, s13=25.0, s23=25.0)
     X = roughpaths.brownian_rough_path(np.linspace(0.0, 10.0, n + 1), 3, ctx.rng("prop21"), batch_shape=(P,))
     # θ = 0: Proposition 2.1 is about the Euler–Poincaré / Lie–Poisson equation; the perturbation of the
-    # driver does not touch the dissipation (which Theorem 3.1 builds from h̃), see mechanics.wong_zakai
+    # driver does not touch the dissipation (which Theorem 3.1 builds from h̃), see mechanics.limits.wong_zakai
     a = roughpaths.solve(paper_body(s, theta=0.0), X, E3, mechanics.LieHeun()).states
     b = roughpaths.solve(paper_body(None, theta=0.0), X.perturb(s), E3, mechanics.LieHeun()).states
     c = roughpaths.solve(paper_body(s, theta=0.0, convention="paper"), X, E3, mechanics.LieHeun()).states

@@ -42,7 +42,7 @@ Where the Lévy-area velocity enters (``levy_in_dissipation``):
   :math:`\mathbb X\mapsto\mathbb X + \mathsf s(t-s)` into the drift :math:`\mathrm{ad}^*_\ell\mu` and leaves
   the rest of the drift alone, this is *exactly* the ``s = 0`` system driven by ``X.perturb(s)``
   (Proposition 2.1 with :math:`\vartheta > 0`), e.g. the white-noise limit of the coloured-noise rigid
-  body (:mod:`mechanics.wong_zakai`). For :math:`\vartheta > 0` the two models differ by
+  body (:mod:`mechanics.limits.wong_zakai`). For :math:`\vartheta > 0` the two models differ by
   :math:`\vartheta\,\mathrm{ad}^*_{(\mathrm{ad}^*_\ell\mu)^\sharp}\mu`, an ``O(1)`` drift.
 
 ``convention="paper"`` reproduces the printed equations (srblevy)/(detrigidbodylevy)/(heavytoplevy):

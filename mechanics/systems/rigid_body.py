@@ -15,7 +15,7 @@ c\cdot\Pi` and :math:`|\Pi|` is the Casimir. ``convention="paper"`` uses :math:`
 ``levy_in_dissipation=False`` keeps the torque in the conservative term only,
 :math:`d\Pi = \Pi\times W\,dt + \vartheta\,\Pi\times(\Pi\times\mathbb I^{-1}\Pi)\,dt + \sum_i
 \Pi\times\xi_i\circ dX^i`: the body with ``s = 0`` driven by ``X.perturb(s)`` (e.g. the white-noise
-limit of the coloured-noise body, :mod:`mechanics.wong_zakai`), not Theorem 3.1's model.
+limit of the coloured-noise body, :mod:`mechanics.limits.wong_zakai`), not Theorem 3.1's model.
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ the torque enters the conservative part only. The dissipation of (srbcoloured) i
 paper's (srblevy) (whose dissipation uses ``h̃``) — :func:`rigid_body_wong_zakai_limit` exposes both
 (``dissipation_shift``) and the tests tell them apart.
 
-The paper's planar example (2dexample) is in :mod:`mechanics.planar`.
+The paper's planar example (2dexample) is in :mod:`mechanics.limits.planar`.
 
 Integrators. All systems are :class:`~mechanics.systems.lie_poisson.LiePoissonSystem` rigid bodies (the
 limit with ``levy_in_dissipation=False``: torque in the conservative term only) integrated by the
@@ -54,10 +54,10 @@ from roughpaths.rough_path import RoughPath
 
 from roughpaths import Solution, solve
 
-from .integrators import CoadjointSolver, LieHeun
-from .systems.hamiltonian import check_inertia
-from .systems.lie_poisson import levy_velocity
-from .systems.rigid_body import rigid_body
+from ..integrators import CoadjointSolver, LieHeun
+from ..systems.hamiltonian import check_inertia
+from ..systems.lie_poisson import levy_velocity
+from ..systems.rigid_body import rigid_body
 
 __all__ = [
     "RigidBodyWongZakai",
