@@ -17,8 +17,7 @@ diagonal), so there E[Π1] = 0; the torque breaks it.
 import numpy as np
 import pytest
 
-from roughpaths import solve
-from roughpaths.coloured_noise import paper_coloured_noise_matrices, sample_coloured_noise
+from roughpaths import paper_coloured_noise_matrices, sample_coloured_noise, solve
 from mechanics.integrators import LieHeun
 from mechanics.systems.lie_poisson import levy_velocity
 from mechanics.systems.rigid_body import rigid_body

@@ -31,8 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from roughpaths import ColouredNoiseDriver, LinearVectorFields
-from roughpaths.coloured_noise import ColouredNoiseLimit, coloured_noise_limit
+from roughpaths import ColouredNoiseDriver, ColouredNoiseLimit, LinearVectorFields, coloured_noise_limit
 from roughpaths.validation import as_float_array, check_batch_shape, check_positive_real, check_real
 
 from .wong_zakai import _coloured_grid

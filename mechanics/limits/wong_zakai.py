@@ -7,7 +7,7 @@ Rigid body (paper eq. (srbcoloured), **no added drift**): with :math:`\Omega = \
     d\Pi = \Pi\times\Omega\,dt + \vartheta\,\Pi\times(\Pi\times\Omega)\,dt
           + \sum_i \Pi\times\xi_i\, dB^{\varepsilon,i}, \qquad \xi_i = \sigma e_i,
 
-driven by the (smooth) coloured noise ``B^ε = ∫ y/ε dt`` of :mod:`roughpaths.coloured_noise`.
+driven by the (smooth) coloured noise ``B^ε = ∫ y/ε dt`` of :class:`roughpaths.ColouredNoiseDriver`.
 
 Limit (Friz–Oberhauser, ``docs/conventions.md``). ``B^ε`` converges as a rough path to
 ``(MB, M BB^{Strat} Mᵀ + N(t−s))`` with ``M = A⁻¹D`` and ``N = Alt(ΣA⁻ᵀ)`` (**B^ε coordinates**).
@@ -47,12 +47,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from roughpaths import ColouredNoiseLimit, RoughPath, Solution, coloured_noise_limit, iter_coloured_noise, solve
 from roughpaths.validation import (as_float_array, check_memory, check_positive_int, check_positive_real, check_rng,
                                    check_work)
-from roughpaths.coloured_noise import (ColouredNoiseLimit, coloured_noise_limit, iter_coloured_noise)
-from roughpaths.rough_path import RoughPath
-
-from roughpaths import Solution, solve
 
 from ..integrators import CoadjointSolver, LieHeun
 from ..systems.hamiltonian import check_inertia
@@ -108,7 +105,7 @@ def rigid_body_wong_zakai_limit(A, D, sigma) -> RigidBodyWongZakai:
     --------
     The paper's case ``A = kI + Λ`` (``Λ13 = 1``), ``k = 0.05``, ``σ = 0.05``:
 
-    >>> from roughpaths.coloured_noise import paper_coloured_noise_matrices
+    >>> from roughpaths import paper_coloured_noise_matrices
     >>> wz = rigid_body_wong_zakai_limit(*paper_coloured_noise_matrices(0.05), 0.05)
     >>> wz.torque.round(6)                       # σ² (N23, -N13, N12)
     array([ 0.      , -0.024938,  0.      ])
@@ -152,7 +149,7 @@ def simulate_wong_zakai_rigid_body(A, D, eps, sigma, *, inertia=(1.0, 2.0, 3.0),
                                    systems=("coloured", "limit", "no_torque"), chunk_steps=None, method=None):
     r"""Coloured rigid body (srbcoloured) and its limits, coupled through the same Brownian motion.
 
-    Streams the exact coloured noise (:func:`roughpaths.coloured_noise.iter_coloured_noise`) in time
+    Streams the exact coloured noise (:func:`roughpaths.iter_coloured_noise`) in time
     chunks (constant memory) and integrates, on the same draws, with the shared coadjoint
     integrators (:func:`roughpaths.solve` on each chunk's :class:`~roughpaths.RoughPath`):
 

@@ -399,7 +399,7 @@ class LiePoissonSystem:
         return np.broadcast_to(jac, mu.shape[:-1] + jac.shape)
 
     def vector_fields(self):
-        r"""The fields in the form :func:`roughpaths.solve.solve` accepts.
+        r"""The fields in the form :func:`roughpaths.solve` accepts.
 
         Returns a ``roughpaths.LinearVectorFields`` with the noise matrices :math:`B_i`
         (:math:`V_i(\mu) = B_i\mu = \mathrm{ad}^*_{\xi_i}\mu`) and the (non-linear) drift
