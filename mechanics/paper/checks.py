@@ -8,7 +8,7 @@ tolerance, and says pass or fail. Sizes come from ``ctx.size(...)`` (``tiny`` / 
 
 The mathematics lives in :mod:`roughpaths` and :mod:`mechanics` (public names only); this module
 only calls it, through the same entry points as the tests (the Gibbs check of Theorem 3.1 through
-:func:`mechanics.run_ensemble`, as ``tests/test_theorem_3_1_gibbs.py``).
+:func:`mechanics.run_ensemble`, as ``tests/mechanics/analysis/test_theorem_3_1_gibbs.py``).
 Conventions: ``docs/conventions.md`` (area ``XX[i,j] = ∫(X^i - X^i_s) dX^j``, Lévy area ``½(XX - XXᵀ)``,
 bracket ``[V,W] = DW·V - DV·W``, Friz–Oberhauser drift ``½ Σ s^{ij}[V_i,V_j]``).
 """

@@ -5,7 +5,7 @@ existing non-empty output folder, unwritable folder) is exactly one line on stde
 never a traceback, and leaves an existing folder untouched; a tiny end-to-end run writes the
 figures (PNG + npz), ``report.md``, a self-contained ``report.html``, ``results.json`` and a
 ``manifest.json`` listing every file. The output folder's safety (atomic writes, lock, resume) is
-tested in ``tests/test_main_job_output.py``.
+tested in ``tests/mechanics/paper/test_main_job_output.py``.
 """
 
 from __future__ import annotations
