@@ -7,6 +7,14 @@ and the coloured-noise Wong–Zakai anomaly, built on :mod:`roughpaths`.
 Conventions (``docs/conventions.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
 velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``h̃ = h + ⟨μ, ℓ⟩``; the
 paper's printed signs are available as ``convention="paper"``.
+
+Layout (imports point down this list, never in a circle): :mod:`mechanics.systems` (Lie algebras,
+Hamiltonians, Lie–Poisson systems, rigid body, heavy top), :mod:`mechanics.integrators` (coadjoint
+solvers for :func:`roughpaths.solve`), :mod:`mechanics.ensemble` (:func:`run_ensemble` and its
+statistics), :mod:`mechanics.analysis` (modified Hamiltonian, equilibria, phase portraits, Gibbs
+measures), :mod:`mechanics.limits` (Wong–Zakai limits). The paper's application
+(:mod:`mechanics.paper`, ``python -m mechanics``) is built on them and never imported by them.
+Every public name below is importable as ``mechanics.<name>``.
 """
 
 from .ensemble import EnsembleResult, RunningMoments, moment_observable, run_ensemble, split_moment_features
@@ -79,5 +87,6 @@ __all__ = [
     # ensembles
     "run_ensemble", "EnsembleResult", "RunningMoments", "moment_observable", "split_moment_features",
     # coloured noise and the Wong–Zakai anomaly
-    "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "simulate_wong_zakai_rigid_body", "PlanarExample", "planar_example", "planar_limit_moments",
+    "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "simulate_wong_zakai_rigid_body",
+    "PlanarExample", "planar_example", "planar_limit_moments",
 ]
