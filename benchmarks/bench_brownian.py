@@ -9,7 +9,7 @@ Two tables, same run, medians of ``--repeats`` calls (the machine is shared: rea
 2. **sampling** (ns per path-step, ``paths x steps``, d = 3), for increments only and with
    areas (davie m = 1, foster m = 1, davie m = 8):
 
-   * ``mech-old``: the former fused sampler of ``mechanics.simulate_brownian`` (one generator,
+   * ``mech-old``: the former fused sampler of mechanics' Brownian simulation (since removed; one generator,
      unit normals step-major into a reused 512 KiB buffer ``(k, P, w)`` by the raw-word ziggurat,
      ``w = 2d + d(d-1)/2`` for davie m = 1); it only drew the normals (the integrator turned them
      into velocities), so it is a floor for any sampler of that stream;

@@ -21,7 +21,7 @@ import numpy as np
 from _timing import median_time
 from roughpaths import paper_coloured_noise_matrices, sample_coloured_noise
 from mechanics import LieHeun, rigid_body
-from mechanics.wong_zakai import simulate_wong_zakai_rigid_body
+from mechanics.limits.wong_zakai import simulate_wong_zakai_rigid_body
 from roughpaths import solve
 
 

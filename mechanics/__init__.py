@@ -7,13 +7,23 @@ and the coloured-noise Wong–Zakai anomaly, built on :mod:`roughpaths`.
 Conventions (``docs/conventions.md``): ``ad*_ξ μ = ad(ξ)ᵀ μ`` (on so(3): ``Π × ξ``); the Lévy-area
 velocity is ``ℓ = +½ Σ s^{ij} [ξ_i, ξ_j]`` and the modified Hamiltonian ``h̃ = h + ⟨μ, ℓ⟩``; the
 paper's printed signs are available as ``convention="paper"``.
+
+Layout (imports point down this list, never in a circle): :mod:`mechanics.systems` (Lie algebras,
+Hamiltonians, Lie–Poisson systems, rigid body, heavy top), :mod:`mechanics.integrators` (coadjoint
+solvers for :func:`roughpaths.solve`), :mod:`mechanics.ensemble` (:func:`run_ensemble` and its
+statistics), :mod:`mechanics.analysis` (modified Hamiltonian, equilibria, phase portraits, Gibbs
+measures), :mod:`mechanics.limits` (Wong–Zakai limits). The paper's application
+(:mod:`mechanics.paper`, ``python -m mechanics``) is built on them and never imported by them.
+Every public name below is importable as ``mechanics.<name>``.
 """
 
-from .ensemble import EnsembleResult, path_generator, run_ensemble
-from .statistics import RunningMoments, moment_observable, split_moment_features
-from .equilibria import (
+from .ensemble import EnsembleResult, RunningMoments, moment_observable, run_ensemble, split_moment_features
+from .analysis import (
     Equilibrium,
+    GibbsMeasure,
     LevelSets,
+    gibbs_beta,
+    gibbs_moments,
     isotropic_levy_shift,
     lagrange_top_sleeping_stability,
     modified_hamiltonian,
@@ -21,8 +31,6 @@ from .equilibria import (
     rigid_body_level_sets,
     rigid_body_vector_field,
 )
-from .gibbs import GibbsMeasure, gibbs_beta, gibbs_moments
-from .heavy_top import HeavyTop, heavy_top
 from .integrators import (
     ChordConvergenceError,
     CoadjointSolver,
@@ -30,22 +38,37 @@ from .integrators import (
     LieEuler,
     LieHeun,
     check_on_orbit,
-    coadjoint_step,
-    simulate,
-    simulate_brownian,
 )
-from .lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra, hat, se3, sl2r, so3, su2, vee
-from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
-from .lie_poisson import LiePoissonSystem, girsanov_shift, levy_velocity
-from .rigid_body import RigidBody, isotropic_xi, rigid_body
-from .wong_zakai import (
+from .systems import (
+    Hamiltonian,
+    HeavyTop,
+    LieAlgebra,
+    LiePoissonSystem,
+    QuadraticHamiltonian,
+    RigidBody,
+    SE3Algebra,
+    SO3Algebra,
+    check_inertia,
+    girsanov_shift,
+    hat,
+    heavy_top,
+    isotropic_xi,
+    levy_velocity,
+    rigid_body,
+    se3,
+    sl2r,
+    so3,
+    su2,
+    vee,
+)
+from .limits import (
+    PlanarExample,
     RigidBodyWongZakai,
-    integrate_rigid_body,
-    levy_torque,
+    planar_example,
+    planar_limit_moments,
     rigid_body_wong_zakai_limit,
     simulate_wong_zakai_rigid_body,
 )
-from .planar import PlanarExample, planar_example, planar_limit_moments
 
 __version__ = "0.1.0"
 
@@ -56,16 +79,14 @@ __all__ = [
     "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     # integrators
-    "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "coadjoint_step",
-    "simulate", "simulate_brownian", "check_on_orbit",
+    "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "check_on_orbit",
     # equilibria, phase portraits, Gibbs measures
     "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",
     "modified_hamiltonian", "rigid_body_vector_field", "lagrange_top_sleeping_stability",
     "GibbsMeasure", "gibbs_beta", "gibbs_moments",
     # ensembles
     "run_ensemble", "EnsembleResult", "RunningMoments", "moment_observable", "split_moment_features",
-    "path_generator",
     # coloured noise and the Wong–Zakai anomaly
-    "levy_torque", "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "integrate_rigid_body",
-    "simulate_wong_zakai_rigid_body", "PlanarExample", "planar_example", "planar_limit_moments",
+    "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "simulate_wong_zakai_rigid_body",
+    "PlanarExample", "planar_example", "planar_limit_moments",
 ]

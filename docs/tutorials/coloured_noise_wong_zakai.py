@@ -14,7 +14,7 @@ import os
 
 import numpy as np
 
-from mechanics.wong_zakai import rigid_body_wong_zakai_limit, simulate_wong_zakai_rigid_body
+from mechanics.limits.wong_zakai import rigid_body_wong_zakai_limit, simulate_wong_zakai_rigid_body
 from roughpaths import coloured_noise_limit, paper_coloured_noise_matrices, sample_coloured_noise
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")

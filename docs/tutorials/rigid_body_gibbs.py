@@ -15,12 +15,11 @@ import os
 
 import numpy as np
 
-from mechanics.equilibria import rigid_body_equilibria
-from mechanics.gibbs import GibbsMeasure
+from mechanics.analysis.equilibria import rigid_body_equilibria
+from mechanics.analysis.gibbs import GibbsMeasure
 from mechanics.integrators import LieHeun
-from mechanics.rigid_body import rigid_body
-from roughpaths import BrownianDriver, solve
-from roughpaths import brownian_rough_path
+from mechanics.systems.rigid_body import rigid_body
+from roughpaths import BrownianDriver, brownian_rough_path, solve
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")
 rng = np.random.default_rng(3)

@@ -1,12 +1,12 @@
 r"""Compiled se(3) kernels of the coadjoint solvers (quadratic Hamiltonian): an implementation detail.
 
 Selected by :meth:`~mechanics.integrators.base.CoadjointSolver.integrate` when the algebra is a
-:class:`~mechanics.lie_algebra.SE3Algebra` and the Hamiltonian is quadratic (the heavy top), for
+:class:`~mechanics.systems.lie_algebra.SE3Algebra` and the Hamiltonian is quadratic (the heavy top), for
 Lie–Euler, Lie–Heun and the implicit midpoint rule (its chord iteration, :mod:`._chord`, with the
 6×6 chord Jacobian inverted per member by Gauss–Jordan elimination with partial pivoting: a singular
 Jacobian fails that member alone). Same scheme as the numpy path; state ``μ = (Π, Γ)``, algebra element
 ``σ = (ω, v)``, :math:`\mathrm{ad}^*_{(\omega,v)}(\Pi,\Gamma) = (\Pi\times\omega + \Gamma\times v,\ \Gamma\times\omega)`
-and the closed-form exponential of :func:`mechanics.lie_algebra.se3_ad_star_exp`
+and the closed-form exponential of :func:`mechanics.systems.lie_algebra.se3_ad_star_exp`
 (:math:`\Gamma' = T\Gamma`, :math:`\Pi' = T(\Pi - (Jv)\times\Gamma)`), with the one small-angle switch
 and Taylor coefficients of :mod:`mechanics.lie_algebra`. Members are independent (a loop over
 members, then over the block's steps); a member that becomes non-finite, or whose chord iteration
@@ -20,7 +20,7 @@ import math
 import numba
 import numpy as np
 
-from ..lie_algebra import SMALL_ANGLE2, taylor_coefficients
+from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2

@@ -1,7 +1,7 @@
 r"""Compiled so(3) kernels of the coadjoint solvers (quadratic Hamiltonian): an implementation detail.
 
 :class:`~mechanics.integrators.base.CoadjointSolver.integrate` selects them when the system's algebra
-is a :class:`~mechanics.lie_algebra.SO3Algebra` and its Hamiltonian is quadratic; they compute the
+is a :class:`~mechanics.systems.lie_algebra.SO3Algebra` and its Hamiltonian is quadratic; they compute the
 same scheme as the numpy path (:mod:`mechanics.integrators.base`), not bit for bit.
 
 Layout: the state lives in three contiguous rows ``m[0], m[1], m[2]`` (one entry per batch member)
@@ -22,7 +22,7 @@ import math
 import numba
 import numpy as np
 
-from ..lie_algebra import SMALL_ANGLE2, taylor_coefficients
+from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 

@@ -8,7 +8,7 @@ Every scheme updates
 
 so :math:`\mu_{n+1}` stays on the coadjoint orbit of :math:`\mu_n` and every Casimir is conserved to
 round-off. The Lie-algebra increment is :math:`\sigma_n = \bar w\,\Delta t_n + \eta_n` with the
-*stochastic velocity* (:meth:`~mechanics.lie_poisson.LiePoissonSystem.stochastic_velocity`)
+*stochastic velocity* (:meth:`~mechanics.systems.lie_poisson.LiePoissonSystem.stochastic_velocity`)
 
 .. math::  \eta_n = \sum_i \xi_i X^i_{n} + \tfrac12\sum_{i,j} A^{ij}_n[\xi_i,\xi_j],
 
@@ -34,9 +34,9 @@ step area) only order ½ for non-commuting ``ξ``. Perturbing the area, :math:`A
 adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` to :math:`\sigma_n`: the
 discrete Proposition 2.1.
 
-Implementation: for a :class:`~mechanics.lie_algebra.SO3Algebra` with a quadratic Hamiltonian,
+Implementation: for a :class:`~mechanics.systems.lie_algebra.SO3Algebra` with a quadratic Hamiltonian,
 :meth:`CoadjointSolver.integrate` runs compiled block kernels (:mod:`mechanics.integrators._so3_kernels`),
-for an :class:`~mechanics.lie_algebra.SE3Algebra` (the heavy top) those of
+for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy top) those of
 :mod:`mechanics.integrators._se3_kernels`; otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
 :func:`roughpaths.expm_batched` per member otherwise). Either way a batch member's result depends
 on its own data only; a member that fails is reported through ``first_bad`` (contract item 8).
@@ -51,8 +51,8 @@ import numpy as np
 from roughpaths import Solver
 from roughpaths.validation import as_float_array, check_positive_int
 
-from ..lie_algebra import SE3Algebra, SO3Algebra
-from ..lie_poisson import LiePoissonSystem
+from ..systems.lie_algebra import SE3Algebra, SO3Algebra
+from ..systems.lie_poisson import LiePoissonSystem
 from . import _se3_kernels, _so3_kernels
 from ._chord import chord_solve
 
@@ -104,7 +104,7 @@ class CoadjointSolver(Solver):
 
     # -------------------------------------------------------------- checks (contract 5-6)
     def check_fields(self, fields):
-        """Accept a :class:`~mechanics.lie_poisson.LiePoissonSystem` (contract item 5)."""
+        """Accept a :class:`~mechanics.systems.lie_poisson.LiePoissonSystem` (contract item 5)."""
         if not isinstance(fields, LiePoissonSystem):
             raise TypeError(f"{self!r} integrates a mechanics.LiePoissonSystem (e.g. mechanics.rigid_body(...)), "
                             f"got {type(fields).__name__}; for roughpaths.VectorFields use Davie(), LogODE(), "

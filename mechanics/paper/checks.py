@@ -8,7 +8,7 @@ tolerance, and says pass or fail. Sizes come from ``ctx.size(...)`` (``tiny`` / 
 
 The mathematics lives in :mod:`roughpaths` and :mod:`mechanics` (public names only); this module
 only calls it, through the same entry points as the tests (the Gibbs check of Theorem 3.1 through
-:func:`mechanics.run_ensemble`, as ``tests/test_theorem_3_1_gibbs.py``).
+:func:`mechanics.run_ensemble`, as ``tests/mechanics/analysis/test_theorem_3_1_gibbs.py``).
 Conventions: ``docs/conventions.md`` (area ``XX[i,j] = ∫(X^i - X^i_s) dX^j``, Lévy area ``½(XX - XXᵀ)``,
 bracket ``[V,W] = DW·V - DV·W``, Friz–Oberhauser drift ``½ Σ s^{ij}[V_i,V_j]``).
 """
@@ -174,7 +174,7 @@ def check_prop21(ctx) -> CheckResult:
     s = s_matrix(s12=-50.0, s13=25.0, s23=25.0)
     X = roughpaths.brownian_rough_path(np.linspace(0.0, 10.0, n + 1), 3, ctx.rng("prop21"), batch_shape=(P,))
     # θ = 0: Proposition 2.1 is about the Euler–Poincaré / Lie–Poisson equation; the perturbation of the
-    # driver does not touch the dissipation (which Theorem 3.1 builds from h̃), see mechanics.wong_zakai
+    # driver does not touch the dissipation (which Theorem 3.1 builds from h̃), see mechanics.limits.wong_zakai
     a = roughpaths.solve(paper_body(s, theta=0.0), X, E3, mechanics.LieHeun()).states
     b = roughpaths.solve(paper_body(None, theta=0.0), X.perturb(s), E3, mechanics.LieHeun()).states
     c = roughpaths.solve(paper_body(s, theta=0.0, convention="paper"), X, E3, mechanics.LieHeun()).states

@@ -1,4 +1,4 @@
-"""The truncated tensor algebra, the level-2 group and the Lyndon basis.
+r"""The truncated tensor algebra, the level-2 group and the Lyndon basis.
 
 * :mod:`~roughpaths.algebra.tensor`: elements of :math:`T^m(\mathbb{R}^d)` in iisignature's flat layout,
   their product, inverse, exponential and logarithm, Lyndon coordinates.

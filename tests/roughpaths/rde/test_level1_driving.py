@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from mechanics.integrators import ImplicitMidpoint, LieEuler, LieHeun
-from mechanics.lie_algebra import sl2r
-from mechanics.lie_poisson import LiePoissonSystem
-from mechanics.rigid_body import rigid_body
+from mechanics.systems.lie_algebra import sl2r
+from mechanics.systems.lie_poisson import LiePoissonSystem
+from mechanics.systems.rigid_body import rigid_body
 from roughpaths import RoughPath, solve
 from roughpaths.algebra.level2 import outer
 

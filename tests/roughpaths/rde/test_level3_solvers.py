@@ -11,25 +11,14 @@ form Hessians of the test fields.
 """
 
 import numpy as np
-from _oracles import poly_fields, poly_jacobians
+from _oracles import poly_fields, poly_jacobians, trig_fields, trig_jacobians
 import pytest
 
 from roughpaths import (Davie, Davie3, Heun, LinearVectorFields, LogODE, LogODE3, RoughPathN, VectorFields,
                         piecewise_linear_lift, solve)
 
 
-def _fields(y):
-    y1, y2 = y[..., 0], y[..., 1]
-    return np.stack([np.stack([np.sin(y2), np.cos(y1)], -1), np.stack([0.5 * np.cos(y1 + y2), np.sin(y1)], -1)], -1)
-
-
-def _jac(y):
-    y1, y2 = y[..., 0], y[..., 1]
-    z = np.zeros(y.shape[:-1])
-    J1 = np.stack([np.stack([z, np.cos(y2)], -1), np.stack([-np.sin(y1), z], -1)], -2)
-    s = -0.5 * np.sin(y1 + y2)
-    J2 = np.stack([np.stack([s, s], -1), np.stack([np.cos(y1), z], -1)], -2)
-    return np.stack([J1, J2], -3)
+_fields, _jac = trig_fields, trig_jacobians   # the shared trigonometric test fields
 
 
 def _hess(y):

@@ -1,0 +1,322 @@
+r"""Ensembles of stochastic Lie–Poisson paths: one entry point, :func:`run_ensemble`, on top of :func:`roughpaths.solve`.
+
+:func:`run_ensemble` simulates ``n_paths`` independent paths of a
+:class:`~mechanics.systems.lie_poisson.LiePoissonSystem` driven by a :class:`roughpaths.BrownianDriver`
+(Stratonovich Brownian motion, with a sampled Lévy area or level-1 driving) and returns streaming
+statistics (memory independent of ``n_steps``; ``O(chunk_size)`` in the paths):
+
+* ``final``: count, mean and covariance across paths of ``observable(μ_T)``;
+* ``time_average``: the same for each path's time average of ``observable(μ_t)`` over
+  ``burn_in < t ≤ T`` (the paths are independent, so the standard error of the ensemble mean of
+  time averages is honest whatever the autocorrelation within a path);
+* ``snapshots``: optional statistics at every ``record_every``-th step.
+
+It is the same computation as ``roughpaths.solve(system, BrownianDriver(m, seed=seed, dt=dt,
+n_steps=n_steps, batch_shape=(n_paths,), levy_area=levy_area), mu0, method)``: paths are split into
+chunks of ``chunk_size`` (``driver.select``), each chunk is solved block by block in time
+(``block_steps``) and reduced to statistics on the fly.
+
+Reproducibility. A path's noise depends only on ``(seed, path index, levy_area)`` (the driver's
+stream); the coadjoint step of a member does not depend on the rest of the batch; time sums are
+accumulated step by step; the across-path statistics are reduced in fixed leaves of
+:data:`~mechanics.ensemble.statistics.LEAF` paths merged in path order
+(:class:`~mechanics.ensemble.statistics.LeafReducer`). So the results — final states and every statistic —
+are bitwise the same whatever ``chunk_size``, ``block_steps`` or ``executor``.
+
+Executors. ``executor=`` accepts any :class:`concurrent.futures.Executor` (thread or process pool)
+or anything with the same ``submit`` interface, e.g. a ``dask.distributed`` cluster through
+``client.get_executor()`` (optional extra ``mechanics[dask]``). Tasks are ``(spec, first_path,
+last_path)`` with a picklable spec: the system and the observable must be picklable for process
+pools and clusters (a module-level function, not a lambda, as ``observable``).
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from roughpaths import BrownianDriver, solve
+from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real, check_work
+
+from ..integrators import CoadjointSolver, LieHeun
+from ..systems.lie_poisson import LiePoissonSystem
+from .checkpoint import fingerprint as _fingerprint
+from .checkpoint import load_checkpoint as _load_checkpoint
+from .checkpoint import save_checkpoint as _save_checkpoint
+from .result import EnsembleResult
+from .statistics import LeafReducer, accumulate, accumulate_moments, moment_observable
+
+__all__ = ["run_ensemble"]
+
+
+@dataclass(frozen=True)
+class _Spec:
+    system: object
+    mu0: np.ndarray
+    driver: BrownianDriver
+    method: object
+    block_steps: int | None
+    burn_in: int
+    average_every: int
+    record_every: int | None
+    observable: Callable
+    keep_final: bool
+
+
+def _observe(observable, x):
+    return np.asarray(observable(x), dtype=np.float64)
+
+
+def _check_observable(observable, mu0, n):
+    """Evaluate ``observable`` on the initial state (shapes ``(1, n)`` and ``(1, 1, n)``) before any
+    work starts: it must return finite arrays of shape ``(1, p)`` and ``(1, 1, p)``; returns ``p``."""
+    x = np.array(np.broadcast_to(mu0, (1, n)), dtype=np.float64)
+    outs = []
+    for probe in (x, x[:, None]):
+        try:
+            v = np.asarray(observable(probe.copy()))
+        except Exception as exc:
+            raise ValueError(f"observable raised {type(exc).__name__}: {exc} when called on the initial state "
+                             f"of shape {probe.shape}; it must map (..., {n}) -> (..., p).") from exc
+        if v.dtype.kind not in "biuf":
+            raise TypeError(f"observable must return real numbers, got an array of dtype {v.dtype} for input "
+                            f"of shape {probe.shape}.")
+        if v.ndim != probe.ndim or v.shape[:-1] != probe.shape[:-1] or v.shape[-1] < 1:
+            raise ValueError(f"observable must map (..., {n}) -> (..., p) keeping the leading axes, but for "
+                             f"input of shape {probe.shape} it returned shape {v.shape}; e.g. return "
+                             f"x[..., :1] rather than a scalar.")
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"observable returned non-finite values on the initial state {x[0]!r}.")
+        outs.append(v.shape[-1])
+    if outs[0] != outs[1]:
+        raise ValueError(f"observable returned {outs[0]} values per state for input (1, {n}) but {outs[1]} for "
+                         f"(1, 1, {n}); it must act on the last axis only.")
+    return outs[0]
+
+
+def _check_picklable(spec, executor):
+    """A process or cluster executor pickles each task: refuse an unpicklable one (e.g. a lambda
+    observable with a ProcessPoolExecutor) before any work is submitted."""
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+
+    if isinstance(executor, ThreadPoolExecutor):
+        return
+    try:
+        pickle.dumps(spec)
+        return
+    except Exception as exc:
+        error = exc
+    if not isinstance(executor, ProcessPoolExecutor):
+        try:                                   # cluster executors (dask) pickle with cloudpickle
+            import cloudpickle
+
+            cloudpickle.dumps(spec)
+            return
+        except ImportError:
+            pass
+        except Exception as exc:
+            error = exc
+    raise TypeError(f"executor {type(executor).__name__} must pickle each task, but the system or observable "
+                    f"cannot be pickled ({type(error).__name__}: {error}); use a module-level function "
+                    f"(not a lambda or a local function) as observable, or executor=None / a ThreadPoolExecutor.")
+
+
+def _run_chunk(spec: _Spec, first: int, last: int):
+    """Solve paths ``first .. last-1`` block by block; return their per-path values (picklable)."""
+    system = spec.system
+    c = last - first
+    n = system.dim
+    mu0 = spec.mu0 if spec.mu0.ndim == 1 else spec.mu0[first:last]
+    mu = np.array(np.broadcast_to(mu0, (c, n)), dtype=np.float64)
+    p = _observe(spec.observable, mu[:1]).shape[-1]
+    acc = np.zeros((c, p))
+    n_avg = 0
+    snaps = []
+    if spec.record_every is not None:
+        snaps.append(_observe(spec.observable, mu))
+    fast_moments = spec.observable is moment_observable
+    step = 0
+    for block in spec.driver.select(range(first, last)).blocks(spec.block_steps):
+        k = block.n_steps
+        states = solve(system, block, mu, spec.method).states                 # (c, k + 1, n)
+        # averaged steps: idx > burn_in and idx % average_every == 0, a strided slice of states[:, 1:]
+        first_ok = max(spec.burn_in + 1, step + 1)
+        first_ok += (-first_ok) % spec.average_every
+        if first_ok <= step + k:
+            window = states[:, first_ok - step::spec.average_every]
+            if fast_moments:
+                accumulate_moments(acc, np.ascontiguousarray(window))
+            else:
+                accumulate(acc, np.ascontiguousarray(_observe(spec.observable, window)))
+            n_avg += window.shape[1]
+        if spec.record_every is not None:
+            for j in range(1, k + 1):
+                if (step + j) % spec.record_every == 0:
+                    snaps.append(_observe(spec.observable, states[:, j]))
+        mu = np.ascontiguousarray(states[:, -1])
+        step += k
+    final = _observe(spec.observable, mu)
+    return final, (acc / n_avg if n_avg else None), snaps, (mu if spec.keep_final else None)
+
+
+def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None,
+                 observable=moment_observable, burn_in=0, average_every=1, record_every=None,
+                 chunk_size=256, block_steps=None, executor=None, keep_final=False,
+                 checkpoint=None) -> EnsembleResult:
+    r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
+
+    Parameters
+    ----------
+    system : LiePoissonSystem
+    mu0 : array_like, shape ``(n,)`` or ``(n_paths, n)``
+        Common initial state, or one per path (e.g. samples of a known law, to skip a burn-in).
+    dt : float
+        Step size.
+    n_steps : int
+        Steps per path (horizon ``T = n_steps · dt``).
+    n_paths : int
+    seed : int
+        Seed of the ``roughpaths.BrownianDriver``; path ``i`` is the driver's path ``i``.
+    method : CoadjointSolver instance, optional
+        ``LieHeun()`` by default; its ``levy_area`` setting follows ``levy_area`` below.
+    levy_area : {None, "davie", "foster"}
+        ``None`` (default): level-1 driving, zero step Lévy area (weak order 1, enough for laws and
+        invariant measures). ``"davie"``/``"foster"``: the driver samples the area (strong order 1).
+    observable : callable
+        ``(..., n) → (..., p)``, evaluated state by state; default :func:`moment_observable` (first
+        and second moments).
+    burn_in : int
+        Steps excluded from the time averages.
+    average_every : int
+        Use every ``average_every``-th step in the time averages.
+    record_every : int, optional
+        Also keep across-path statistics at steps ``0, record_every, 2·record_every, …``.
+    chunk_size : int
+        Paths per task. Changes memory use and parallelism, never the numbers.
+    block_steps : int, optional
+        Steps per time block (default: the driver's cache-sized blocks). Changes memory use and
+        speed, never the numbers.
+    executor : concurrent.futures.Executor, optional
+        Runs the chunks (default: serially in this process); e.g. ``dask.distributed``'s
+        ``client.get_executor()``. Never changes the numbers.
+    keep_final : bool
+        Also return every path's final state.
+    checkpoint : str or os.PathLike, optional
+        A ``.npz`` file where the statistics merged so far are saved, atomically, after every chunk
+        (with a fingerprint of the run's arguments). If the file exists when the run starts, the
+        finished chunks are taken from it and only the rest is simulated: a run killed at any moment
+        and started again with the same arguments returns bitwise the result of an uninterrupted run.
+        A checkpoint of a different run is refused. The file is left in place at the end.
+
+    Returns
+    -------
+    EnsembleResult
+
+    Examples
+    --------
+    >>> from mechanics.systems.lie_algebra import so3
+    >>> from mechanics.systems.lie_poisson import LiePoissonSystem
+    >>> rb = LiePoissonSystem(so3(), np.diag([1.0, 2.0, 3.0]), 0.5 * np.eye(3), theta=1.0)
+    >>> a = run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=50, n_paths=6, seed=1, chunk_size=4,
+    ...                  keep_final=True)
+    >>> b = run_ensemble(rb, [0, 0, 1.0], dt=0.01, n_steps=50, n_paths=6, seed=1, chunk_size=5,
+    ...                  block_steps=7, keep_final=True)
+    >>> bool(np.array_equal(a.final_states, b.final_states) and np.array_equal(a.final.mean, b.final.mean))
+    True
+    """
+    if not isinstance(system, LiePoissonSystem):
+        raise TypeError(f"system must be a LiePoissonSystem (e.g. mechanics.rigid_body(...)), got "
+                        f"{type(system).__name__}.")
+    if method is None:
+        method = LieHeun()
+    if not isinstance(method, CoadjointSolver):
+        raise TypeError(f"method must be a coadjoint solver instance (LieEuler(), LieHeun(), ImplicitMidpoint()), "
+                        f"got {method!r}" + (f"; did you mean {method.__name__}()?" if isinstance(method, type)
+                                             else "."))
+    n = system.dim
+    mu0 = as_float_array(mu0, "mu0", last_dims=(n,))
+    dt = check_positive_real(dt, "dt")
+    n_steps = check_positive_int(n_steps, "n_steps")
+    n_paths = check_positive_int(n_paths, "n_paths")
+    check_work(float(n_paths) * float(n_steps), f"run_ensemble with n_paths={n_paths} and n_steps={n_steps}",
+               "use fewer paths or steps (or raise ROUGHPATHS_MAX_WORK)")
+    if mu0.ndim not in (1, 2) or (mu0.ndim == 2 and mu0.shape[0] != n_paths):
+        raise ValueError(f"mu0 must have shape ({n},) or (n_paths, {n}) = ({n_paths}, {n}), got {mu0.shape}.")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise TypeError(f"seed must be a non-negative integer, got {seed!r}.")
+    if seed < 0:
+        raise ValueError(f"seed must be a non-negative integer (SeedSequence entropy), got {seed!r}.")
+    if levy_area not in (None, "davie", "foster"):
+        raise ValueError(f"levy_area must be None, 'davie' or 'foster', got {levy_area!r}.")
+    if not callable(observable):
+        raise TypeError(f"observable must be callable (..., n) -> (..., p), got {observable!r}.")
+    burn_in = check_positive_int(burn_in, "burn_in", minimum=0)
+    average_every = check_positive_int(average_every, "average_every")
+    if record_every is not None:
+        record_every = check_positive_int(record_every, "record_every")
+    chunk_size = check_positive_int(chunk_size, "chunk_size")
+    if block_steps is not None:
+        block_steps = check_positive_int(block_steps, "block_steps")
+    if executor is not None and not hasattr(executor, "submit"):
+        raise TypeError(f"executor must be a concurrent.futures.Executor (with .submit), got {executor!r}.")
+    p = _check_observable(observable, mu0[:1] if mu0.ndim == 2 else mu0, n)
+    if record_every is not None:
+        n_snap = n_steps // record_every + 1
+        check_memory(8.0 * n_snap * (p + p * p) * 3, f"the snapshot statistics ({n_snap} snapshots of {p} "
+                     f"observables)", "record fewer snapshots (a larger record_every)")
+    if keep_final:
+        check_memory(8.0 * n_paths * n, f"the final states ({n_paths} paths x {n})",
+                     "use keep_final=False or fewer paths")
+    if method.levy_area != (levy_area is not None):                 # the driving level follows levy_area
+        method = copy.copy(method)
+        method.levy_area = levy_area is not None
+
+    driver = BrownianDriver(system.n_noise, seed=int(seed), dt=float(dt), n_steps=n_steps, batch_shape=(n_paths,),
+                            levy_area=levy_area)
+    spec = _Spec(system=system, mu0=mu0, driver=driver, method=method, block_steps=block_steps, burn_in=burn_in,
+                 average_every=average_every, record_every=record_every, observable=observable,
+                 keep_final=bool(keep_final))
+    if executor is not None:
+        _check_picklable(spec, executor)
+    bounds = [(a, min(a + chunk_size, n_paths)) for a in range(0, n_paths, chunk_size)]
+    final = tavg = None
+    snaps: list = []
+    finals = []
+    start = 0
+    if checkpoint is not None:
+        fingerprint = _fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn_in,
+                                   average_every, record_every, chunk_size, keep_final, observable)
+        state = _load_checkpoint(checkpoint, fingerprint)
+        if state is not None:
+            start, final, tavg, snaps, finals = state
+    todo = bounds[start:]
+    if executor is None:
+        parts = (_run_chunk(spec, a, b) for a, b in todo)
+    else:
+        futures = [executor.submit(_run_chunk, spec, a, b) for a, b in todo]
+        parts = (f.result() for f in futures)
+    for done, (fin, ta, sn, fs) in enumerate(parts, start + 1):   # in path order: fixed leaves, bitwise
+        if final is None:
+            p = fin.shape[-1]
+            final = LeafReducer(p)
+            tavg = LeafReducer(p) if ta is not None else None
+            snaps = [LeafReducer(p) for _ in sn]
+        final.add(fin)
+        if tavg is not None:
+            tavg.add(ta)
+        for red, values in zip(snaps, sn):
+            red.add(values)
+        if fs is not None:
+            finals.append(fs)
+        if checkpoint is not None:
+            _save_checkpoint(checkpoint, fingerprint, done, final, tavg, snaps, finals)
+    snap_steps = [] if record_every is None else list(range(0, n_steps + 1, record_every))
+    return EnsembleResult(final=final.result(), time_average=None if tavg is None else tavg.result(),
+                          snapshot_times=np.asarray(snap_steps, dtype=np.float64) * float(dt),
+                          snapshots=[r.result() for r in snaps],
+                          final_states=np.concatenate(finals) if finals else None,
+                          n_paths=n_paths, n_steps=n_steps, dt=float(dt), seed=int(seed), state_dim=n)
