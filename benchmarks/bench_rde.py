@@ -27,10 +27,8 @@ import time
 
 import numpy as np
 
-from roughpaths import BrownianDriver, brownian_rough_path
-from roughpaths import solve
-from roughpaths import Davie, Euler, Heun, LogODE
-from roughpaths import LinearVectorFields
+from roughpaths import (brownian_rough_path, BrownianDriver, Davie, Euler, Heun, LinearVectorFields, LogODE,
+                        solve)
 
 TOL = 1e-3
 Y0 = np.array([1.0, 0.5, -0.3])

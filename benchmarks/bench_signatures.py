@@ -71,8 +71,7 @@ def interleaved_medians(fns, repeats: int) -> list:
 
 DEPTH10 = r"""
 import time, tracemalloc, numpy as np
-from roughpaths import logsignature
-from roughpaths import logsigdim
+from roughpaths import logsigdim, logsignature
 x = np.cumsum(np.random.default_rng(0).standard_normal((10, 3)), 0)
 t_start = time.perf_counter()
 logsignature(x[:3], 3)                     # load the compiled kernels (not the depth-10 map)

@@ -13,10 +13,7 @@ import os
 
 import numpy as np
 
-from roughpaths import brownian_rough_path
-from roughpaths import solve
-from roughpaths import Davie, LogODE
-from roughpaths import LinearVectorFields
+from roughpaths import brownian_rough_path, Davie, LinearVectorFields, LogODE, solve
 
 SMALL = os.environ.get("TUTORIAL_SMALL", "") not in ("", "0")
 rng = np.random.default_rng(7)

@@ -20,8 +20,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from roughpaths import level2_exp, level2_inv, level2_log, level2_mul
-from roughpaths import signature
+from roughpaths import level2_exp, level2_inv, level2_log, level2_mul, signature
 from roughpaths import (from_level2, from_lyndon_coordinates, lyndon_coordinates,
                                        sigdim, tensor_exp, tensor_inverse, tensor_log, tensor_product,
                                        to_level2)

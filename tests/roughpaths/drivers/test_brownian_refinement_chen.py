@@ -20,8 +20,7 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths import brownian_rough_path, refine
-from roughpaths import RoughPath, chen_defect
+from roughpaths import brownian_rough_path, chen_defect, refine, RoughPath
 
 
 def _levy(XX):

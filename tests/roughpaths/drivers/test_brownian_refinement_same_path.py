@@ -29,8 +29,7 @@ import numpy as np
 import pytest
 from scipy.special import polygamma
 
-from roughpaths import BrownianDriver, LinearVectorFields, LogODE, solve
-from roughpaths import brownian_rough_path, refine
+from roughpaths import brownian_rough_path, BrownianDriver, LinearVectorFields, LogODE, refine, solve
 from roughpaths.drivers.refinement import RefinedBrownianDriver
 from roughpaths import levy_area_terms
 

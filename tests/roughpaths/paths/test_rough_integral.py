@@ -15,8 +15,7 @@ Claims, with the area ``XX^{ij} = ∫ (X^i − X^i_s) dX^j`` and ``Y'[..., a, j,
 import numpy as np
 from scipy.integrate import quad
 
-from roughpaths import RoughPath
-from roughpaths import rough_integral
+from roughpaths import rough_integral, RoughPath
 
 
 def _bm(rng, paths, n, d=1, T=1.0):

@@ -19,10 +19,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from roughpaths import RoughPath
-from roughpaths import solve
-from roughpaths import Davie, Euler, Heun, LogODE
-from roughpaths import LinearVectorFields, VectorFields
+from roughpaths import Davie, Euler, Heun, LinearVectorFields, LogODE, RoughPath, solve, VectorFields
 
 
 # ---------------------------------------------------------------------------- smooth driver

@@ -27,10 +27,7 @@ import numpy as np
 from _oracles import rk4_flow
 import pytest
 
-from roughpaths import RoughPath
-from roughpaths import solve
-from roughpaths import Davie, LogODE
-from roughpaths import LinearVectorFields, VectorFields
+from roughpaths import Davie, LinearVectorFields, LogODE, RoughPath, solve, VectorFields
 
 S2 = np.array([[0.0, 1.4], [-1.4, 0.0]])
 S3 = np.array([[0.0, 1.0, -0.6], [-1.0, 0.0, 0.8], [0.6, -0.8, 0.0]])

@@ -9,8 +9,7 @@ Claim: path by path, :math:`\mathbb{X}^{\text{Itô}}_{s,t} = \mathbb{X}^{\text{S
 import numpy as np
 import pytest
 
-from roughpaths import brownian_increments_and_areas, brownian_rough_path, refine
-from roughpaths import chen_defect
+from roughpaths import brownian_increments_and_areas, brownian_rough_path, chen_defect, refine
 
 
 def test_ito_equals_stratonovich_minus_half_h_identity_pathwise():

@@ -19,10 +19,7 @@ For the rigid-body fields ``V_i(Π) = Π × ξ_i`` the solution is the rotation 
 import numpy as np
 import scipy.linalg
 
-from roughpaths import RoughPath
-from roughpaths import solve
-from roughpaths import Davie, LogODE
-from roughpaths import LinearVectorFields, VectorFields
+from roughpaths import Davie, LinearVectorFields, LogODE, RoughPath, solve, VectorFields
 
 
 def _pure_area(s, n, T=1.0):

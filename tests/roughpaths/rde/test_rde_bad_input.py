@@ -10,11 +10,8 @@ becomes non-finite during the solve is reported with its step index and time; a 
 import numpy as np
 import pytest
 
-from roughpaths import RoughPath
-from roughpaths import rough_integral
-from roughpaths import solve
-from roughpaths import Davie, Euler, Heun, LogODE
-from roughpaths import LinearVectorFields, VectorFields
+from roughpaths import (Davie, Euler, Heun, LinearVectorFields, LogODE, rough_integral, RoughPath, solve,
+                        VectorFields)
 
 
 @pytest.fixture

@@ -20,8 +20,7 @@ import scipy.linalg
 from hypothesis import given
 from hypothesis import strategies as st
 
-from roughpaths import expm_batched
-from roughpaths import LinearDrift, LinearVectorFields, VectorFields
+from roughpaths import expm_batched, LinearDrift, LinearVectorFields, VectorFields
 
 E, D = 3, 2
 

@@ -10,8 +10,7 @@ Lévy area enters the canonical extension).
 import numpy as np
 import pytest
 
-from roughpaths import RoughPath
-from roughpaths import rough_path_signature, rough_path_signature_vjp, signature_vjp
+from roughpaths import rough_path_signature, rough_path_signature_vjp, RoughPath, signature_vjp
 
 
 def _rough(rng, n, d, batch=()):

@@ -13,8 +13,7 @@ import iisignature
 import numpy as np
 import pytest
 
-from roughpaths import logsignature, logsignature_vjp, signature_vjp
-from roughpaths import logsigdim, sigdim
+from roughpaths import logsigdim, logsignature, logsignature_vjp, sigdim, signature_vjp
 
 
 def _naive_sig(x, m):

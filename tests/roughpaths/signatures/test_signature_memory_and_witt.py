@@ -17,8 +17,7 @@ import numpy as np
 import pytest
 
 from roughpaths.algebra import _lyndon
-from roughpaths import logsignature, signature
-from roughpaths import logsigdim
+from roughpaths import logsigdim, logsignature, signature
 
 
 def _naive_lyndon_count(d, m):
