@@ -32,7 +32,6 @@ pools and clusters (a module-level function, not a lambda, as ``observable``).
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from typing import Callable
 
@@ -163,7 +162,7 @@ def _run_chunk(spec: _Spec, first: int, last: int):
     return final, (acc / n_avg if n_avg else None), snaps, (mu if spec.keep_final else None)
 
 
-def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None,
+def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None, levy_area_error=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
                  chunk_size=256, block_steps=None, executor=None, keep_final=False,
                  checkpoint=None) -> EnsembleResult:
@@ -182,10 +181,17 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     seed : int
         Seed of the ``roughpaths.BrownianDriver``; path ``i`` is the driver's path ``i``.
     method : CoadjointSolver instance, optional
-        ``LieHeun()`` by default; its ``levy_area`` setting follows ``levy_area`` below.
-    levy_area : {None, "davie", "foster"}
-        ``None`` (default): level-1 driving, zero step Lévy area (weak order 1, enough for laws and
-        invariant measures). ``"davie"``/``"foster"``: the driver samples the area (strong order 1).
+        ``LieHeun()`` by default. It drives with what the driver has: increments alone for
+        ``levy_area=None``, increments and Lévy areas otherwise.
+    levy_area : None or str
+        The driver's Lévy-area method, any name :class:`roughpaths.BrownianDriver` accepts
+        (:data:`roughpaths.LEVY_AREA_METHODS`). ``None`` (the default here): level-1 driving, zero step
+        Lévy area. The default differs from the driver's on purpose: an ensemble estimates laws and time
+        averages, for which the coadjoint schemes have weak order 1 with or without the area (the area has
+        mean zero and enters at second order), and a level-1 driver draws no area, so each path-step is
+        cheaper. Pass a method when the statistics are of pathwise quantities that need strong order 1.
+    levy_area_error : float, optional
+        The per-step L² error of the error-controlled methods, as for :class:`roughpaths.BrownianDriver`.
     observable : callable
         ``(..., n) → (..., p)``, evaluated state by state; default :func:`moment_observable` (first
         and second moments).
@@ -250,8 +256,6 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         raise TypeError(f"seed must be a non-negative integer, got {seed!r}.")
     if seed < 0:
         raise ValueError(f"seed must be a non-negative integer (SeedSequence entropy), got {seed!r}.")
-    if levy_area not in (None, "davie", "foster"):
-        raise ValueError(f"levy_area must be None, 'davie' or 'foster', got {levy_area!r}.")
     if not callable(observable):
         raise TypeError(f"observable must be callable (..., n) -> (..., p), got {observable!r}.")
     burn_in = check_positive_int(burn_in, "burn_in", minimum=0)
@@ -271,12 +275,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     if keep_final:
         check_memory(8.0 * n_paths * n, f"the final states ({n_paths} paths x {n})",
                      "use keep_final=False or fewer paths")
-    if method.levy_area != (levy_area is not None):                 # the driving level follows levy_area
-        method = copy.copy(method)
-        method.levy_area = levy_area is not None
-
     driver = BrownianDriver(system.n_noise, seed=int(seed), dt=float(dt), n_steps=n_steps, batch_shape=(n_paths,),
-                            levy_area=levy_area)
+                            levy_area=levy_area, levy_area_error=levy_area_error)   # checks both
     spec = _Spec(system=system, mu0=mu0, driver=driver, method=method, block_steps=block_steps, burn_in=burn_in,
                  average_every=average_every, record_every=record_every, observable=observable,
                  keep_final=bool(keep_final))
@@ -288,8 +288,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     finals = []
     start = 0
     if checkpoint is not None:
-        fingerprint = _fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn_in,
-                                   average_every, record_every, chunk_size, keep_final, observable)
+        fingerprint = _fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, (levy_area, levy_area_error),
+                                   burn_in, average_every, record_every, chunk_size, keep_final, observable)
         state = _load_checkpoint(checkpoint, fingerprint)
         if state is not None:
             start, final, tavg, snaps, finals = state

@@ -29,8 +29,8 @@ Why the area term, and why :math:`+\tfrac12`: the noise fields are linear, :math
 \tfrac12A^{ij}(B_jB_i - B_iB_j)`, and :math:`B_jB_i - B_iB_j = \mathrm{ad}^*_{[\xi_i,\xi_j]}`. The second-order
 term of :math:`\exp(\mathrm{ad}^*_\sigma)` reproduces both exactly when :math:`\sigma\ni\tfrac12A^{ij}[\xi_i,\xi_j]`.
 With the area the schemes have strong order 1 on Brownian rough paths (order 2 in ``dt`` without
-noise for Lie–Heun and the midpoint rule); without it (``levy_area=False``: level-1 driving, zero
-step area) only order ½ for non-commuting ``ξ``. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
+noise for Lie–Heun and the midpoint rule); without it (a level-1 driver: zero step area) only
+order ½ for non-commuting ``ξ``. The solver holds no flag for this: it reads the level from the driver. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
 adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` to :math:`\sigma_n`: the
 discrete Proposition 2.1.
 
@@ -67,14 +67,12 @@ class ChordConvergenceError(RuntimeError):
 class CoadjointSolver(Solver):
     r"""Base class of the coadjoint solvers (contract of :class:`roughpaths.Solver`).
 
-    Parameters
-    ----------
-    levy_area : bool
-        ``True`` (default): level-2 driving, the step Lévy areas enter :math:`\sigma_n`
-        (``increment_level = 2``; a level-2 geometric driver is required). ``False``: level-1 driving,
-        :math:`\sigma_n` from the increments alone, i.e. zero step Lévy area (``increment_level = 1``);
-        a level-1 driver is then required, so areas are never dropped silently (pass
-        ``X.to_level1()`` to discard the areas of a level-2 path deliberately).
+    The driving level is the driver's: a level-2 geometric driver (a Brownian driver with Lévy areas,
+    a :class:`~roughpaths.RoughPath`) puts its step Lévy areas into :math:`\sigma_n` (strong order 1);
+    a level-1 driver (``BrownianDriver(..., levy_area=None)``, ``X.to_level1()``) drives with the
+    increments alone, i.e. zero step Lévy area (strong order ½ for non-commuting ``ξ``).
+    ``increment_level = 2`` is what a step consumes at most; :func:`roughpaths.solve` passes no areas
+    for a level-1 driver.
     """
 
     calculus = "stratonovich"
@@ -82,25 +80,13 @@ class CoadjointSolver(Solver):
     smooth_order = 2.0
     _code = -1
 
-    def __init__(self, levy_area: bool = True):
-        if not isinstance(levy_area, (bool, np.bool_)):
-            raise TypeError(f"levy_area must be True (use the driver's Lévy areas) or False (level-1 driving, "
-                            f"zero area), got {levy_area!r}.")
-        self.levy_area = bool(levy_area)
-
-    # -------------------------------------------------------------- declarations (contract 1-4)
-    @property
-    def increment_level(self) -> int:
-        """2 with ``levy_area=True`` (increments and areas), 1 without (increments only)."""
-        return 2 if self.levy_area else 1
-
-    @property
-    def order(self) -> float:
-        """Strong order on Brownian rough paths: 1 with the Lévy area, ½ without (non-commuting ξ)."""
-        return 1.0 if self.levy_area else 0.5
+    #: at most increments and areas; a level-1 driver gives increments alone (zero area)
+    increment_level = 2
+    #: strong order on Brownian rough paths with a level-2 driver (½ with a level-1 driver, non-commuting ξ)
+    order = 1.0
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}()" if self.levy_area else f"{type(self).__name__}(levy_area=False)"
+        return f"{type(self).__name__}()"
 
     # -------------------------------------------------------------- checks (contract 5-6)
     def check_fields(self, fields):
@@ -112,19 +98,14 @@ class CoadjointSolver(Solver):
         return fields
 
     def check_driver(self, driver) -> None:
-        """Require a geometric driver of level 2 (``levy_area=True``) or exactly 1 (contract item 6)."""
+        """Accept a geometric driver of level 2, or a level-1 driver (zero step area) (contract item 6)."""
         level = driver.level
-        if self.levy_area and level < 2:
-            raise ValueError(f"the driver is a level-1 path (no area) but {self!r} needs the step Lévy areas. "
-                             f"Pass {type(self).__name__}(levy_area=False) to drive with the increments alone "
-                             f"(zero Lévy area per step), or a level-2 path (e.g. RoughPath.from_path(values) "
-                             f"for the piecewise-linear lift, or the increments with their areas).")
-        if not self.levy_area and level != 1:
-            raise ValueError(f"{self!r} drives with the increments alone but the driver is a level-2 path: its "
-                             f"areas would be discarded. Pass driver.to_level1() to drop them deliberately, or "
-                             f"{type(self).__name__}() to use them.")
+        if level > 2:
+            raise ValueError(f"{self!r} uses the driver up to level 2, but the driver is a level-{level} rough "
+                             f"path; its higher levels would be dropped. Truncate it deliberately (e.g. "
+                             f"RoughPathN.to_rough_path()) or use a level-3 solver on VectorFields.")
         kind = getattr(driver, "kind", "geometric")
-        if self.levy_area and kind not in ("geometric", "stratonovich"):
+        if level == 2 and kind not in ("geometric", "stratonovich"):
             raise ValueError(f"the driver is a {kind!r} rough path; the coadjoint schemes solve the geometric "
                              f"(Stratonovich-type) RDE. Convert an Itô lift with XX + ½(t-s)I first.")
 
@@ -180,7 +161,6 @@ class CoadjointSolver(Solver):
         dts = np.diff(np.asarray(times, dtype=np.float64))
         nk = dts.size
         nsave = int(np.count_nonzero(save))
-        dXX = dXX if self.levy_area else None
         if isinstance(system.algebra, SO3Algebra) and system.hamiltonian.is_quadratic:
             nb = int(np.prod(batch, dtype=np.int64))
             eta_b = _so3_kernels.stochastic_velocities(system, dX, dXX, batch)
@@ -292,16 +272,14 @@ class ImplicitMidpoint(CoadjointSolver):
     smooth_order = 2.0
     _code = 2
 
-    def __init__(self, tol: float = 1e-13, max_iter: int = 50, *, levy_area: bool = True):
-        super().__init__(levy_area)
+    def __init__(self, tol: float = 1e-13, max_iter: int = 50):
         if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not np.isfinite(tol) or tol <= 0:
             raise ValueError(f"tol must be a positive finite number, got {tol!r}.")
         self.tol = float(tol)
         self.max_iter = check_positive_int(max_iter, "max_iter")
 
     def __repr__(self) -> str:
-        extra = "" if self.levy_area else ", levy_area=False"
-        return f"ImplicitMidpoint(tol={self.tol:g}, max_iter={self.max_iter}{extra})"
+        return f"ImplicitMidpoint(tol={self.tol:g}, max_iter={self.max_iter})"
 
     def _sigma(self, system, mu, dt, eta):
         return chord_solve(system, mu, dt, eta, self.tol, self.max_iter)

@@ -41,9 +41,13 @@ class Solver:
 
     1. ``increment_level`` (class attribute, 1, 2 or 3): what a step consumes, the increment
        :math:`X_{s,t}` alone (1), also the area :math:`\mathbb{X}_{s,t}` (2), or also the level-3 step
-       signature (3, :mod:`roughpaths.rde.logode`, :mod:`roughpaths.rde.davie`). ``solve`` refuses a driver of lower level; a
-       level-1 solver never sees the areas of a level-2 driver; the level-1/2 solvers here refuse a
-       level-3 driver (:class:`~roughpaths.RoughPathN`) rather than drop its level 3 silently.
+       signature (3, :mod:`roughpaths.rde.logode`, :mod:`roughpaths.rde.davie`). ``check_driver``
+       decides which driver levels a solver accepts: the schemes here refuse a driver of lower level
+       (Davie on increments alone is not Davie); a level-1 solver never sees the areas of a level-2
+       driver; the level-1/2 solvers refuse a level-3 driver (:class:`~roughpaths.RoughPathN`) rather
+       than drop its level 3 silently. A solver that accepts a lower-level driver (the coadjoint
+       solvers of :mod:`mechanics`: a level-1 driver means zero area) gets what the driver has:
+       ``solve`` passes ``min(increment_level, driver.level)``.
     2. ``order`` and ``smooth_order`` (class attributes): the declared strong order on Brownian rough
        paths (Stratonovich lift, non-commuting fields) and the order on smooth drivers with exact
        increments and areas. Convergence tests fit these.

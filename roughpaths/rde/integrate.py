@@ -220,6 +220,9 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         raise ValueError(f"the driver has dimension d={driver.dim} but the vector fields have "
                          f"dim_noise={fields.dim_noise}; one field per driving component is needed.")
     solver.check_driver(driver)
+    # what a step receives: the solver's level, or the driver's if lower and the solver accepted it
+    # (a coadjoint solver on a level-1 driver: increments alone, zero step area)
+    level = min(solver.increment_level, driver.level)
     e = fields.dim_state
     y = as_float_array(y0, "y0", min_ndim=1)
     if y.shape[-1] != e:
@@ -265,7 +268,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         kb = block.n_steps
         save = save_mask[k0 + 1:k0 + kb + 1]
         y, saved, first_bad = solver.integrate(fields, y, block.times, block.increments,
-                                               _higher_levels(block, solver.increment_level), save,
+                                               _higher_levels(block, level), save,
                                                stop_on_failure=(on_failure == "raise"))
         new_bad = (first_bad >= 0) & (failed_step < 0)
         if new_bad.any():

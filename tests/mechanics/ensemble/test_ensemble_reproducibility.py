@@ -85,7 +85,7 @@ def test_statistics_match_a_direct_simulation():
     res = run_ensemble(RB, [0.0, 0.0, 1.0], dt=dt, n_steps=n_steps, n_paths=n_paths, seed=7,
                        burn_in=burn, record_every=45, chunk_size=4, block_steps=25, keep_final=True)
     X = BrownianDriver(3, seed=7, dt=dt, n_steps=n_steps, batch_shape=(n_paths,), levy_area=None).rough_path()
-    traj = solve(RB, X, np.array([0.0, 0.0, 1.0]), LieHeun(levy_area=False)).states    # (P, N+1, 3)
+    traj = solve(RB, X, np.array([0.0, 0.0, 1.0]), LieHeun()).states    # (P, N+1, 3); level-1 X
     assert np.allclose(traj[:, -1], res.final_states, rtol=0, atol=1e-13)
     f = moment_observable(traj)                                               # (P, N+1, 9)
     tavg = f[:, burn + 1:].mean(axis=1)

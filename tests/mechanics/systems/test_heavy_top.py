@@ -136,8 +136,8 @@ def test_se3_kernel_equals_numpy_scheme(cls, levy, theta, metric, lid):
     X = BrownianDriver(3, seed=4, dt=0.05, n_steps=40, batch_shape=(5,), levy_area="davie" if levy else None)
     X = X.rough_path()
     mu0 = MU0 * np.array([[1.0], [0.1], [2.0], [-1.5], [0.5]])
-    a = solve(top, X, mu0, cls(levy_area=levy)).states
-    b = solve(generic, X, mu0, cls(levy_area=levy)).states
+    a = solve(top, X, mu0, cls()).states
+    b = solve(generic, X, mu0, cls()).states
     np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
     c0 = top.casimirs(mu0)
     assert np.max(np.abs(top.casimirs(a[:, -1]) - c0) / np.maximum(1.0, np.abs(c0))) <= 1e-12
