@@ -236,6 +236,8 @@ def expansion_matrix(dim: int, k: int) -> sp.csr_matrix:
             blk.sum_duplicates()
             blk.eliminate_zeros()
             blocks.append(blk)
+        if not blocks:                                      # no Lyndon word of length k (dim = 1, k > 1)
+            return sp.csr_matrix((0, dim ** k))
         return sp.vstack(blocks, format="csr")
     return _CACHE.get(("E", dim, k), build)
 
@@ -249,7 +251,7 @@ def lyndon_projection(dim: int, k: int) -> tuple:
     def build():
         lidx = lyndon_indices(dim, k)
         n_k = lidx.shape[0]
-        if k == 1:
+        if k == 1 or n_k == 0:                               # n_k = 0: dim = 1, k > 1
             m = sp.csr_matrix((n_k, n_k))
         else:
             ri, ci, vi = [], [], []
