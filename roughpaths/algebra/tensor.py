@@ -280,14 +280,13 @@ def lyndon_basis(dim: int, depth: int) -> list:
     Letters are printed 1-based in decimal: letter ``i`` (0-based) is the number ``i + 1``. A
     bracket is ``[A,B]``, so every letter is a maximal run of digits delimited by ``[``, ``,``,
     ``]`` or the ends of the string, and a label names exactly one bracketed Lyndon word for every
-    ``dim`` (``'[1,10]'`` is the bracket of letters 1 and 10). For ``2 <= dim <= 9``
-    the labels are exactly ``iisignature.basis``'s (iisignature refuses ``dim = 1``). For letters 10 and above they differ:
-    ``iisignature`` prints every such letter as ``'?'`` (its ``'[1,?]'`` is our ``'[1,10]'``), which
-    is still one-to-one at ``dim = 10`` but not from ``dim = 11`` on (``'[1,?]'`` there stands for
-    both ``[1,10]`` and ``[1,11]``); we keep the number. The words, their order and the
-    coordinates are iisignature's for every ``dim``. Coordinate ``i`` of
-    :func:`lyndon_coordinates` (and of :func:`roughpaths.logsignature`) multiplies basis
-    element ``i``.
+    ``dim`` (``'[1,10]'`` is the bracket of letters 1 and 10). For ``2 <= dim <= 9`` the labels
+    are exactly ``iisignature.basis``'s (iisignature refuses ``dim = 1``). For letters 10 and
+    above they differ: ``iisignature`` prints every such letter as ``'?'`` (its ``'[1,?]'`` is
+    our ``'[1,10]'``), which is still one-to-one at ``dim = 10`` but not from ``dim = 11`` on
+    (``'[1,?]'`` there stands for both ``[1,10]`` and ``[1,11]``); we keep the number. The words,
+    their order and the coordinates are iisignature's for every ``dim``. Coordinate ``i`` of
+    :func:`lyndon_coordinates` (and of :func:`roughpaths.logsignature`) multiplies basis element ``i``.
 
     Parameters
     ----------
