@@ -9,7 +9,8 @@ the same :math:`\kappa_4` over :math:`\kappa_2 = h^2/4 - h^2/(12m)`, i.e.
 The tests
 
 * check the derivation's algebra with an independent numerical trace (the bilinear-form matrix ``K``
-  built entry by entry from the Chen sum, :math:`\kappa_4 = 6\,\mathrm{tr}((KK^T)^2)`);
+  built entry by entry from the Chen sum, :math:`\kappa_4 = 6\,\mathrm{tr}((KK^T)^2)`), and the
+  stated sixth-cumulant error (4/9 at ``m = 1``, falling like :math:`m^{-4}`);
 * estimate the excess kurtosis of :math:`A_{12}` from the sampler and accept it within 4 standard
   errors, the standard error computed from the same sample by the delta method (influence function
   of :math:`m_4/m_2^2`), and check that the test can tell 4/3 from the exact law's 2;
@@ -78,6 +79,23 @@ def test_fourth_cumulant_formula(m):
     assert trB4 == pytest.approx(m * (m - 1) * (m * m + m - 3) / 48.0, abs=1e-12)
     foster2 = kappa2 - H ** 2 / (12.0 * m)
     assert kappa4 / foster2 ** 2 == pytest.approx(_expected("foster", m), rel=1e-12)
+
+
+def _sixth_cumulant_relative_error(m):
+    delta, c = H / m, 1.0 / np.sqrt(12.0)
+    K = np.zeros((2 * m, 2 * m))
+    for k in range(m):
+        K[m + k, k], K[k, m + k] = c, -c
+        K[k, k + 1:m], K[k + 1:m, k] = 0.5, -0.5
+    G = K @ K.T
+    kappa6 = 120.0 * delta ** 6 * np.trace(G @ G @ G)
+    return (H ** 6 / 4 - kappa6) / (H ** 6 / 4)               # true Lévy area: κ6 = h⁶/4 (log cosh)
+
+
+def test_sixth_cumulant_error_as_stated():
+    assert _sixth_cumulant_relative_error(1) == pytest.approx(4.0 / 9.0, rel=1e-12)
+    ratio = _sixth_cumulant_relative_error(32) / _sixth_cumulant_relative_error(64)
+    assert ratio == pytest.approx(16.0, rel=0.03)               # falls like m^-4
 
 
 # ------------------------------------------------------------------ the sampler
