@@ -1,6 +1,7 @@
 """Lyndon words and the Lyndon basis of the free Lie algebra (private helpers).
 
-Letters are ``0 .. d-1`` (``iisignature`` prints them 1-based). A Lyndon word ``w`` of length > 1
+Letters are ``0 .. d-1`` (printed 1-based in decimal, as ``iisignature`` prints letters 1..9; it
+prints letters from 10 on as ``'?'``, we print the number, see :func:`roughpaths.lyndon_basis`). A Lyndon word ``w`` of length > 1
 is bracketed by its *standard factorisation* ``w = u v`` with ``v`` the longest proper suffix
 that is itself Lyndon (equivalently, the lexicographically smallest proper suffix):
 ``P(w) = [P(u), P(v)] = P(u)⊗P(v) - P(v)⊗P(u)``. This is the basis ``iisignature.basis`` lists,
@@ -145,7 +146,10 @@ def standard_factorisation(w: tuple) -> tuple:
 
 
 def bracket_string(w: tuple) -> str:
-    """The bracketing of ``w`` in ``iisignature.basis`` notation (1-based letters, no spaces)."""
+    """The bracketing of ``w`` in ``iisignature.basis`` notation (1-based decimal letters, no spaces).
+
+    Letters from 10 on are printed as numbers (iisignature prints ``'?'``), e.g. ``'[1,10]'``.
+    """
     if len(w) == 1:
         return str(w[0] + 1)
     u, v = standard_factorisation(w)
@@ -236,6 +240,8 @@ def expansion_matrix(dim: int, k: int) -> sp.csr_matrix:
             blk.sum_duplicates()
             blk.eliminate_zeros()
             blocks.append(blk)
+        if not blocks:                                      # no Lyndon word of length k (dim = 1, k > 1)
+            return sp.csr_matrix((0, dim ** k))
         return sp.vstack(blocks, format="csr")
     return _CACHE.get(("E", dim, k), build)
 
@@ -249,7 +255,7 @@ def lyndon_projection(dim: int, k: int) -> tuple:
     def build():
         lidx = lyndon_indices(dim, k)
         n_k = lidx.shape[0]
-        if k == 1:
+        if k == 1 or n_k == 0:                               # n_k = 0: dim = 1, k > 1
             m = sp.csr_matrix((n_k, n_k))
         else:
             ri, ci, vi = [], [], []

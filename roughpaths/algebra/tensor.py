@@ -277,12 +277,35 @@ def from_level2(x, a) -> np.ndarray:
 def lyndon_basis(dim: int, depth: int) -> list:
     """The Lyndon basis as bracket strings, e.g. ``'[1,[1,2]]'``, in ``iisignature.basis`` order.
 
-    Letters are printed 1-based, as ``iisignature`` does. Coordinate ``i`` of
-    :func:`lyndon_coordinates` (and of :func:`roughpaths.logsignature`) multiplies
-    basis element ``i``.
+    Letters are printed 1-based in decimal: letter ``i`` (0-based) is the number ``i + 1``. A
+    bracket is ``[A,B]``, so every letter is a maximal run of digits delimited by ``[``, ``,``,
+    ``]`` or the ends of the string, and a label names exactly one bracketed Lyndon word for every
+    ``dim`` (``'[1,10]'`` is the bracket of letters 1 and 10). For ``2 <= dim <= 9`` the labels
+    are exactly ``iisignature.basis``'s (iisignature refuses ``dim = 1``). For letters 10 and
+    above they differ: ``iisignature`` prints every such letter as ``'?'`` (its ``'[1,?]'`` is
+    our ``'[1,10]'``), which is still one-to-one at ``dim = 10`` but not from ``dim = 11`` on
+    (``'[1,?]'`` there stands for both ``[1,10]`` and ``[1,11]``); we keep the number. The words,
+    their order and the coordinates are iisignature's for every ``dim``. Coordinate ``i`` of
+    :func:`lyndon_coordinates` (and of :func:`roughpaths.logsignature`) multiplies basis element ``i``.
 
+    Parameters
+    ----------
+    dim : int
+        Number of letters ``d >= 1``.
+    depth : int
+        Largest word length ``m >= 1``.
+
+    Returns
+    -------
+    list of str
+        ``logsigdim(dim, depth)`` labels, ordered by length, then lexicographically.
+
+    Examples
+    --------
     >>> lyndon_basis(2, 3)
     ['1', '2', '[1,2]', '[1,[1,2]]', '[[1,2],2]']
+    >>> lyndon_basis(11, 2)[-3:]            # iisignature: '[9,?]', '[9,?]', '[?,?]'
+    ['[9,10]', '[9,11]', '[10,11]']
     """
     dim = check_positive_int(dim, "dim")
     depth = check_positive_int(depth, "depth")

@@ -34,16 +34,27 @@ per-step, per-component L² error against the true Lévy area of the same Browni
 
 (independent of ``d``; the Frobenius error of the whole matrix is ``sqrt(d(d-1)/2)`` times this,
 counting each pair ``i < j`` once), and its variance is :math:`h^2/4 - h^2/(12 m)` instead of
-:math:`h^2/4`.
+:math:`h^2/4`; with the fourth cumulant derived below, its excess kurtosis is
+:math:`(2 - \tfrac{2}{3m^3})(\tfrac{3m}{3m-1})^2` (3 for ``m = 1``).
 
 ``levy_area="davie"`` (default) adds an independent antisymmetric Gaussian with variance
 :math:`h^2/(12 m)` per component (Davie 2014, with Foster's space-time refinement): every second
 moment of ``(W, A)`` is then exact, also conditionally on ``W``
 (:math:`\mathrm{Var}(A_{ij}\mid W) = h^2/12 + h(W_i^2 + W_j^2)/12`), and so is the
-conditional mean; the residual law error is in the fourth and higher cumulants and decays like
-``1/m`` (d = 2, measured with 2·10⁶ samples: excess kurtosis 1.36 for the default ``m = 1``
-(Davie's own method) and 2.00 for ``m = 8``, exact value 2; a Kolmogorov–Smirnov test with
-4·10⁵ samples cannot tell the ``m = 8`` law from the exact one). The default ``m``,
+conditional mean; the residual law error is in the fourth and higher cumulants, known exactly.
+Derivation: unconditionally the substep data are independent, so :math:`A_{ij} = \delta\,u^T K v + \lambda`
+with independent standard Gaussian vectors :math:`u = (w^i_k, \sqrt{12} H^i_k)_{k\le m}/\sqrt\delta`,
+``v`` the same for ``j``, :math:`K = \begin{pmatrix} B & -c I \\ c I & 0 \end{pmatrix}`,
+:math:`c = 1/\sqrt{12}`, :math:`B_{kl} = \tfrac12\mathrm{sign}(l - k)` (the Chen cross terms) and
+:math:`\lambda` the added Gaussian. A bilinear Gaussian form has :math:`\kappa_4 = 6\,\mathrm{tr}((KK^T)^2)
+= 6[\mathrm{tr} B^4 + m(m-1)/12 + m/72]`, :math:`\mathrm{tr} B^4 = m(m-1)(m^2+m-3)/48`, and
+:math:`\lambda` adds to :math:`\kappa_2 = h^2/4` only: :math:`\kappa_4 = h^4/8 - h^4/(24 m^3)`, excess
+kurtosis :math:`2 - 2/(3m^3)` against 2 for the true Lévy area, for every ``d``: **4/3** for the
+default ``m = 1`` (Davie's own method; :math:`H^i w^j - w^i H^j` is two independent products of normals,
+each :math:`\kappa_4 = 6(h^2/12)^2`, over :math:`\kappa_2^2 = h^4/16`), 23/12 for ``m = 2``, :math:`2 - 1/768`
+for ``m = 8``; the sixth cumulant's relative error (:math:`120\,\mathrm{tr}((KK^T)^3)` against
+:math:`h^6/4`) is 4/9 at ``m = 1``, falling like :math:`m^{-4}`. Measured (d = 2): a Kolmogorov–Smirnov
+test with 4·10⁵ samples cannot tell the ``m = 8`` law from the exact one. The default ``m``,
 :data:`DEFAULT_SUBSTEPS` ``= 1``, is the same for every entry point (this module's functions,
 :class:`BrownianDriver`); it gives exact second moments at the lowest cost. Its
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
@@ -69,15 +80,16 @@ leaves, bounded through the characteristic functions by Gil-Pelaez
 (:math:`\sup|\Delta F| \le \pi^{-1}\int |\Delta\varphi(\lambda)|/\lambda\, d\lambda`), is below
 5·10⁻⁷ in CDF (sup norm; the resolution of that quadrature) for every ``|w|`` tried (``μ`` from
 0.5 to 50; replacing the tail by its mean alone would leave 1e-5): no Kolmogorov–Smirnov test
-with fewer than ~10¹² samples can see it. Cost: a variable number of normals, about
-``24 + 32 μ`` per step (``E[μ] = 2``: ~90), against 5 for Davie's ``m = 1`` (d = 2).
+with fewer than ~10¹² samples can see it. Cost, in area normals per step: ``1 + 2 + 2`` for ``Z, E₁, E₂``,
+``2(N_k + 1) + 2N_k`` for term ``k`` (arrivals, ``Γ_k``), so ``21 + 32 μ`` on average for the exact part,
+plus 3 per Marsaglia–Tsang attempt of the tail (2 more when its shape ``α = 12.8 μ`` is below 1; measured
+mean 3.1); ``E[μ] = 2`` (``μ ~ χ²₂``): about 88, plus 2 for the increment, against 5 for Davie's ``m = 1``.
 
 Cost per step: ``d`` normals for the increment, plus ``m d`` (bridge, only if ``m > 1``),
 ``m d`` (space-time areas) and ``d(d-1)/2`` (Davie) normals and ``O(m d^2)`` flops for the area.
-The normals come from per-path streams (numpy's ziggurat over ``PCG64``, run by a numba kernel
-over all paths, :mod:`roughpaths.drivers._random`) and the flops from a numba kernel
-(:mod:`roughpaths.drivers._area_kernels`), so the time is essentially that of drawing the normals
-(``benchmarks/bench_brownian.py`` measures it against the former samplers).
+The normals come from per-path streams (numpy's ziggurat over ``PCG64``, :mod:`roughpaths.drivers._random`)
+and the flops from :mod:`roughpaths.drivers._area_kernels`: the time is that of drawing the normals
+(``benchmarks/bench_brownian.py``).
 ``levy_area=None`` returns the increments alone at the cost of ``d`` normals per step.
 
 Every entry point samples the same stream: :class:`BrownianDriver` (lazy, in time blocks) and
@@ -342,7 +354,7 @@ class BrownianDriver(SeededDriver):
       ``(m d if m > 1) + m d + (d(d-1)/2 if davie)`` normals: the bridge normals, the
       space-time normals and Davie's normals, in this order (see
       :mod:`roughpaths.drivers._area_kernels`); for ``"exact"`` a variable number, in the order
-      documented in ``_brownian_kernels._exact_areas_d2``; for the Fourier samplers
+      documented in ``_area_kernels._exact_areas_d2``; for the Fourier samplers
       ``levy_area_normals(method, d, n)`` normals with the ``(method, n)`` of the step's length, in the
       order of :func:`roughpaths.levy_areas_from_normals`.
 
