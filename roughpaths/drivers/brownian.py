@@ -60,30 +60,10 @@ test with 4·10⁵ samples cannot tell the ``m = 8`` law from the exact one. The
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
 component (the added Gaussian is independent of the path).
 
-``levy_area="exact"`` (d = 2 only) samples the Lévy area from its conditional law given the
-increment ``w`` (Lévy 1951), whose characteristic function is
-:math:`\frac{\lambda h/2}{\sinh(\lambda h/2)}\exp\bigl(-\frac{|w|^2}{2h}(\frac{\lambda h}{2}\coth\frac{\lambda h}{2} - 1)\bigr)`.
-Derivation of the sampler: :math:`x/\sinh x = \prod_k (1 + x^2/(k\pi)^2)^{-1}` is the
-characteristic function of a logistic variable of scale :math:`h/(2\pi)` (``λ`` for ``x = λh/2``), and
-:math:`x\coth x - 1 = \sum_k 2x^2/(x^2 + k^2\pi^2)` makes the second factor a product over ``k``
-of compound Poisson laws with rate :math:`\mu = |w|^2/h` and Laplace jumps of scale
-:math:`h/(2\pi k)`. A sum of ``n`` standard Laplace variables is :math:`\sqrt{2\Gamma_n} Z`, so
-
-.. math:: A = h\bigl(L + \sqrt{V} Z\bigr),\quad L = \tfrac{1}{2\pi}\log\tfrac{E_1}{E_2},\quad
-          V = \sum_{k\ge1} \frac{\Gamma(N_k)}{2\pi^2 k^2},\quad N_k \sim \mathrm{Poisson}(\mu),
-
-(``E`` exponential, ``Z`` normal, all independent; check: :math:`E[V] = \mu/12`, so
-:math:`\mathrm{Var}(A\mid w) = h^2/12 + h|w|^2/12`). The first 8 terms are drawn exactly (Poisson
-by exponential arrivals, Gamma as a χ², all from the path's normals), the tail
-:math:`\sum_{k>8}` by a Gamma variable with its exact mean and variance. The law error this
-leaves, bounded through the characteristic functions by Gil-Pelaez
-(:math:`\sup|\Delta F| \le \pi^{-1}\int |\Delta\varphi(\lambda)|/\lambda\, d\lambda`), is below
-5·10⁻⁷ in CDF (sup norm; the resolution of that quadrature) for every ``|w|`` tried (``μ`` from
-0.5 to 50; replacing the tail by its mean alone would leave 1e-5): no Kolmogorov–Smirnov test
-with fewer than ~10¹² samples can see it. Cost, in area normals per step: ``1 + 2 + 2`` for ``Z, E₁, E₂``,
-``2(N_k + 1) + 2N_k`` for term ``k`` (arrivals, ``Γ_k``), so ``21 + 32 μ`` on average for the exact part,
-plus 3 per Marsaglia–Tsang attempt of the tail (2 more when its shape ``α = 12.8 μ`` is below 1; measured
-mean 3.1); ``E[μ] = 2`` (``μ ~ χ²₂``): about 88, plus 2 for the increment, against 5 for Davie's ``m = 1``.
+``levy_area="exact"`` (d = 2 only) samples the Lévy area from its exact conditional law given the
+increment; its derivation, law error and cost are in :mod:`roughpaths.drivers.levy_area`. The
+error-controlled ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"`` and ``"auto"`` are
+documented there too.
 
 Cost per step: ``d`` normals for the increment, plus ``m d`` (bridge, only if ``m > 1``),
 ``m d`` (space-time areas) and ``d(d-1)/2`` (Davie) normals and ``O(m d^2)`` flops for the area.
@@ -110,7 +90,7 @@ import numpy as np
 from ..validation import as_float_array, check_memory, check_positive_int
 from ._area_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
 from ._random import PathStreams
-from .levy_area import LEVY_AREA_METHODS, block_areas, step_plan
+from .levy_area import _FOURIER_METHODS, LEVY_AREA_METHODS, block_areas, step_plan
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from ..paths.rough_path import RoughPath
 from .refinement import RefinedBrownianDriver
@@ -121,8 +101,8 @@ __all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_pa
 #: (Davie's own method: exact second moments at the lowest cost).
 DEFAULT_SUBSTEPS = 1
 
-_LEVY_METHODS = ("davie", "foster", "exact") + LEVY_AREA_METHODS + ("auto",)
-_FOURIER = LEVY_AREA_METHODS + ("auto",)
+_LEVY_METHODS = LEVY_AREA_METHODS
+_FOURIER = _FOURIER_METHODS + ("auto",)
 #: Series terms drawn exactly by ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
 _EXACT_TERMS = 8
 _KINDS = ("stratonovich", "ito")
@@ -170,7 +150,7 @@ def _seed_from_rng(rng) -> np.random.SeedSequence:
 
 # ---------------------------------------------------------------------------- public API
 def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy_area="davie",
-                                  substeps=DEFAULT_SUBSTEPS, kind="stratonovich"):
+                                  substeps=None, kind="stratonovich", levy_area_error=None):
     r"""Sample Brownian increments and step areas: the low-level, streaming-friendly sampler.
 
     Parameters
@@ -188,18 +168,25 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
         Dimension ``d >= 1`` of the Brownian motion.
     batch_shape : tuple of int, optional
         Leading batch axes (independent paths), default ``()``.
-    levy_area : {"davie", "foster", "exact"} or None
-        Lévy-area method (see the module docstring for its exact error; ``"exact"`` for ``d = 2``
-        only): ``"davie"`` (default)
-        matches every second moment of ``(W, A)`` exactly, ``"foster"`` is the conditional mean
-        given the substep information (best L² approximation, variance short by ``h²/(12 m)``).
-        ``None`` (or ``"none"``) returns ``areas=None`` and draws only the increments.
-    substeps : int
-        Substeps ``m >= 1`` per step for the area (default :data:`DEFAULT_SUBSTEPS`). The
-        increments do not depend on it. L² error per component: ``h / sqrt(12 m)`` (foster).
+    levy_area : str or None
+        Lévy-area method, any of :data:`roughpaths.LEVY_AREA_METHODS`, with the meaning and the
+        default of :class:`BrownianDriver` (see the module docstring for each method's exact error):
+        ``"davie"`` (default) matches every second moment of ``(W, A)`` exactly, ``"foster"`` is the
+        conditional mean given the substep information (best L² approximation, variance short by
+        ``h²/(12 m)``); both are of strong order ½ against Brownian motion. ``"exact"`` (``d = 2``)
+        is exact in law; ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"`` and ``"auto"``
+        meet the per-step L² error ``levy_area_error``. ``None`` (or ``"none"``) returns
+        ``areas=None`` and draws only the increments.
+    substeps : int, optional
+        Substeps ``m >= 1`` per step for ``"davie"`` / ``"foster"`` (default
+        :data:`DEFAULT_SUBSTEPS`). The increments do not depend on it. L² error per component:
+        ``h / sqrt(12 m)`` (foster).
     kind : {"stratonovich", "ito"}
         Stratonovich areas :math:`A + \tfrac12 W\otimes W`, or Itô areas
         :math:`A + \tfrac12 W\otimes W - \tfrac12 h I`.
+    levy_area_error : float, optional
+        Per-step L² error of the error-controlled methods (default ``h^{3/2}``), as for
+        :class:`BrownianDriver`.
 
     Returns
     -------
@@ -239,14 +226,14 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
                  "sample fewer steps or paths at a time (BrownianDriver(...).blocks() streams them)")
     h = _check_dt(dt, n_steps)
     drv = BrownianDriver(dim, seed=seed, times=np.concatenate([[0.0], np.cumsum(h)]), batch_shape=batch_shape,
-                         levy_area=levy_area, substeps=substeps, kind=kind)
+                         levy_area=levy_area, substeps=substeps, kind=kind, levy_area_error=levy_area_error)
     drv._h = h                               # the given step sizes exactly (not differences of their sums)
     X = drv.rough_path()
     return X.increments, X.areas
 
 
 def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich", levy_area="davie",
-                        substeps=DEFAULT_SUBSTEPS, x0=None) -> RoughPath:
+                        substeps=None, x0=None, levy_area_error=None) -> RoughPath:
     r"""Brownian motion lifted to a level-2 rough path on exactly the grid ``times``.
 
     Parameters
@@ -263,7 +250,7 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
     kind : {"stratonovich", "ito"}
         Stratonovich (geometric, ``RoughPath.kind == "geometric"``) or Itô
         (``kind == "ito"``, :math:`\mathbb{X}^{\text{Itô}} = \mathbb{X}^{\text{Strat}} - \tfrac12 (t-s) I`).
-    levy_area, substeps
+    levy_area, substeps, levy_area_error
         Area sampler, see :func:`brownian_increments_and_areas`; ``levy_area=None`` gives a
         level-1 path (increments only).
     x0 : array_like, shape ``(d,)`` or ``(*batch_shape, d)``, optional
@@ -285,7 +272,7 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
     """
     seed = _seed_from_rng(rng)
     return BrownianDriver(dim, seed=seed, times=times, batch_shape=batch_shape, kind=kind, levy_area=levy_area,
-                          substeps=substeps, x0=x0).rough_path()
+                          substeps=substeps, x0=x0, levy_area_error=levy_area_error).rough_path()
 
 
 # ---------------------------------------------------------------------------- the driver

@@ -42,6 +42,33 @@ of ``(w, A)`` is exact for every ``n`` (tested); ``"fourier"`` lacks :math:`h^2 
 conditional variance. What is approximate: the law of the tail (Gaussian instead of a sum of
 products of normals), which shows in the fourth and higher moments and vanishes as ``n`` grows.
 
+The exact sampler for d = 2 (``levy_area="exact"`` of :class:`~roughpaths.BrownianDriver`)
+---------------------------------------------------------------------------------------
+For ``d = 2`` the driver samples the Lévy area from its conditional law given the
+increment ``w`` (Lévy 1951), whose characteristic function is
+:math:`\frac{\lambda h/2}{\sinh(\lambda h/2)}\exp\bigl(-\frac{|w|^2}{2h}(\frac{\lambda h}{2}\coth\frac{\lambda h}{2} - 1)\bigr)`.
+Derivation of the sampler: :math:`x/\sinh x = \prod_k (1 + x^2/(k\pi)^2)^{-1}` is the
+characteristic function of a logistic variable of scale :math:`h/(2\pi)` (``λ`` for ``x = λh/2``), and
+:math:`x\coth x - 1 = \sum_k 2x^2/(x^2 + k^2\pi^2)` makes the second factor a product over ``k``
+of compound Poisson laws with rate :math:`\mu = |w|^2/h` and Laplace jumps of scale
+:math:`h/(2\pi k)`. A sum of ``n`` standard Laplace variables is :math:`\sqrt{2\Gamma_n} Z`, so
+
+.. math:: A = h\bigl(L + \sqrt{V} Z\bigr),\quad L = \tfrac{1}{2\pi}\log\tfrac{E_1}{E_2},\quad
+          V = \sum_{k\ge1} \frac{\Gamma(N_k)}{2\pi^2 k^2},\quad N_k \sim \mathrm{Poisson}(\mu),
+
+(``E`` exponential, ``Z`` normal, all independent; check: :math:`E[V] = \mu/12`, so
+:math:`\mathrm{Var}(A\mid w) = h^2/12 + h|w|^2/12`). The first 8 terms are drawn exactly (Poisson
+by exponential arrivals, Gamma as a χ², all from the path's normals), the tail
+:math:`\sum_{k>8}` by a Gamma variable with its exact mean and variance. The law error this
+leaves, bounded through the characteristic functions by Gil-Pelaez
+(:math:`\sup|\Delta F| \le \pi^{-1}\int |\Delta\varphi(\lambda)|/\lambda\, d\lambda`), is below
+5·10⁻⁷ in CDF (sup norm; the resolution of that quadrature) for every ``|w|`` tried (``μ`` from
+0.5 to 50; replacing the tail by its mean alone would leave 1e-5): no Kolmogorov–Smirnov test
+with fewer than ~10¹² samples can see it. Cost, in area normals per step: ``1 + 2 + 2`` for ``Z, E₁, E₂``,
+``2(N_k + 1) + 2N_k`` for term ``k`` (arrivals, ``Γ_k``), so ``21 + 32 μ`` on average for the exact part,
+plus 3 per Marsaglia–Tsang attempt of the tail (2 more when its shape ``α = 12.8 μ`` is below 1; measured
+mean 3.1); ``E[μ] = 2`` (``μ ~ χ²₂``): about 88, plus 2 for the increment, against 5 for Davie's ``m = 1``.
+
 References: M. Wiktorsson, *Joint characteristic function and simultaneous simulation of iterated
 Itô integrals for multiple independent Brownian motions*, Ann. Appl. Probab. 11 (2001);
 F. Mrongowius, A. Rößler, *On the approximation and simulation of iterated stochastic integrals
@@ -61,8 +88,12 @@ from ..validation import as_float_array, check_positive_int, check_rng
 __all__ = ["LEVY_AREA_METHODS", "levy_area_terms", "levy_area_normals", "choose_levy_area_method",
            "levy_areas_from_normals", "sample_levy_areas"]
 
-#: Error-controlled methods (``"auto"`` chooses among them).
-LEVY_AREA_METHODS = ("fourier", "mrongowius-rossler", "wiktorsson")
+#: Every Lévy-area method name that the doors take as ``levy_area`` (:class:`~roughpaths.BrownianDriver`,
+#: :func:`~roughpaths.brownian_rough_path`, :func:`~roughpaths.brownian_increments_and_areas`,
+#: :func:`mechanics.run_ensemble`); ``None`` means no area (a level-1 driver).
+LEVY_AREA_METHODS = ("davie", "foster", "exact", "fourier", "mrongowius-rossler", "wiktorsson", "auto")
+#: The error-controlled (Fourier-series) methods of this module; ``"auto"`` chooses among them.
+_FOURIER_METHODS = ("fourier", "mrongowius-rossler", "wiktorsson")
 _ORDER = {"fourier": 0.5, "mrongowius-rossler": 1.0, "wiktorsson": 1.0}
 _MAX_TERMS = 10**7
 
@@ -83,7 +114,7 @@ def _coefficient(method: str, dim: int, h: float) -> float:
 
 
 def _check_method(method, allow_auto=True) -> str:
-    valid = LEVY_AREA_METHODS + (("auto",) if allow_auto else ())
+    valid = _FOURIER_METHODS + (("auto",) if allow_auto else ())
     if not isinstance(method, str) or method.lower() not in valid:
         raise ValueError(f"method must be one of {valid}, got {method!r}.")
     return method.lower()
@@ -142,7 +173,7 @@ def choose_levy_area_method(dim: int, h: float, error: float | None = None) -> t
     ('fourier', 1)
     """
     best = None
-    for method in LEVY_AREA_METHODS:
+    for method in _FOURIER_METHODS:
         n = levy_area_terms(method, dim, h, error)
         cost = levy_area_normals(method, dim, n)
         if best is None or cost < best[0]:
@@ -165,7 +196,7 @@ def levy_areas_from_normals(increments, h: float, normals, method: str, n: int) 
         ``"mrongowius-rossler"``), then one normal per pair ``i < j`` in lexicographic order
         (``"mrongowius-rossler"`` and ``"wiktorsson"``).
     method : str
-        One of :data:`LEVY_AREA_METHODS`.
+        One of the error-controlled methods ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"``.
     n : int
         Number of Fourier terms.
 
@@ -229,7 +260,8 @@ def sample_levy_areas(increments, h: float, rng, *, method: str = "auto", error:
     rng : numpy.random.Generator
         Source of the normals (drawn as one array of shape ``(..., levy_area_normals(...))``).
     method : str
-        ``"auto"`` (default: fewest normals for the target), or one of :data:`LEVY_AREA_METHODS`.
+        ``"auto"`` (default: fewest normals for the target), or one of the error-controlled methods
+        ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"``.
     error : float, optional
         Target per-component L² error per step; default :math:`h^{3/2}`.
 

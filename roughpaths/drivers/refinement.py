@@ -99,7 +99,7 @@ from ._bridge import (GIBBS_SWEEPS, MODES_PER_SUBSTEP, _assemble, _BridgePlan, _
 from ._random import PathStreams
 from ._seeded import SeededDriver
 from .base import Driver
-from .levy_area import LEVY_AREA_METHODS, _tail_zeta2, step_plan
+from .levy_area import _FOURIER_METHODS, _tail_zeta2, step_plan
 
 __all__ = ["refine", "RefinedBrownianDriver", "GIBBS_SWEEPS", "MODES_PER_SUBSTEP"]
 
@@ -317,7 +317,7 @@ class RefinedBrownianDriver(Driver):
 
     def _area_width(self, h: float) -> int:
         c = self.coarse
-        if c.levy_area in LEVY_AREA_METHODS + ("auto",):
+        if c.levy_area in _FOURIER_METHODS + ("auto",):
             return c._fourier_plan[h][2]
         if c.levy_area in ("davie", "foster"):
             return c._n_area_normals
@@ -368,7 +368,7 @@ class RefinedBrownianDriver(Driver):
         keys[:, 0] = self.path_indices
         keys[:, 1] = 1
         area_streams = None
-        if c.levy_area in ("davie", "foster") + LEVY_AREA_METHODS + ("auto",):
+        if c.levy_area in ("davie", "foster") + _FOURIER_METHODS + ("auto",):
             area_streams = PathStreams(c.seed_sequence, keys)        # the coarse area normals, regenerated
         keys = keys.copy()
         keys[:, 1] = 2

@@ -1,6 +1,6 @@
 r"""Claim: ``levy_area="exact"`` draws its normals in the documented order, ``21 + 32 μ`` on average plus the tail.
 
-:mod:`roughpaths.drivers.brownian` derives the cost of the exact d = 2 sampler: per step ``1 + 2 + 2``
+:mod:`roughpaths.drivers.levy_area` derives the cost of the exact d = 2 sampler: per step ``1 + 2 + 2``
 normals for ``Z, E₁, E₂`` (an exponential is ``(Z₁² + Z₂²)/2``), for each of the 8 exact terms
 ``2(N_k + 1)`` for the Poisson arrivals and ``2N_k`` for ``Γ_k``, i.e. ``21 + 32 μ`` on average given
 ``μ = |w|²/h`` (``N_k ~ Poisson(μ)``); the Gamma tail takes 3 per Marsaglia–Tsang attempt, plus 2 when its
@@ -21,7 +21,7 @@ import math
 import numpy as np
 import pytest
 
-import roughpaths.drivers.brownian as brownian
+import roughpaths.drivers.levy_area as levy_area
 from roughpaths import BrownianDriver
 from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
 
@@ -99,6 +99,6 @@ def test_draw_order_reproduces_the_driver_and_the_counts_are_as_derived():
 
 
 def test_docstring_states_the_derived_cost():
-    doc = brownian.__doc__
+    doc = levy_area.__doc__
     assert "21 + 32 μ" in doc and "about 88" in doc
     assert "24 + 32 μ" not in doc
