@@ -400,8 +400,8 @@ class RefinedBrownianDriver(Driver):
                 r_cols = ro[idx][:, None] + np.arange(rw[idx[0]])
                 Wr = W[:, idx].reshape(-1, d)
                 Lr = None if L is None else L[:, idx].reshape(-1, d, d)
-                zar = za[:, a_cols].reshape(Wr.shape[0], -1)
-                zrr = zr[:, r_cols].reshape(Wr.shape[0], -1)
+                zar = za[:, a_cols].reshape(Wr.shape[0], a_cols.shape[1])      # explicit widths: P may be 0
+                zrr = zr[:, r_cols].reshape(Wr.shape[0], r_cols.shape[1])
                 wr = np.empty((Wr.shape[0], F, d))
                 Ar = None if L is None else np.empty((Wr.shape[0], F, d, d))
                 for r0 in range(0, Wr.shape[0], _ROWS):
