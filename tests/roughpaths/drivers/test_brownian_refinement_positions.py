@@ -20,10 +20,12 @@ The error-controlled methods are run at a tight error (``levy_area_error = 0.02 
 so that what is tested is the refinement, not the coarse sampler's own Gaussian-tail approximation (that
 is tested at 1, 2 and 4 retained terms in ``test_brownian_refinement_few_terms.py``).
 
-Measured with the slow version (10⁶ coarse steps, ``"exact"``, ``F = 3``): before the fix (3 Gibbs sweeps
-from the prior) the fine increments' variances were ``[1.0033, 0.9956, 1.0026] δ``, χ² = 37 on 3 degrees
-of freedom (p ≈ 4e-8), the middle one low; after it (:data:`roughpaths.drivers.refinement.GIBBS_SWEEPS`
-raised) the test passes. The default run is a reduced version (seconds); the full one is ``slow``.
+Measured with the slow version (10⁶ coarse steps, ``"exact"``, ``F = 3``, seed 25): before the fix (3 Gibbs
+sweeps from the prior) the fine increments' variances were ``[1.0060, 0.9943, 1.0032] δ`` (z = 5.9, -5.7,
+3.2; χ² p ≈ 1e-16) and the fine areas' variances failed too (p ≈ 6e-7), the middle position low; after
+it (:data:`roughpaths.drivers.refinement.GIBBS_SWEEPS` = 8) ``[0.9999, 1.0014, 1.0016] δ`` (p = 0.19;
+neighbour covariance p = 0.14, area variance p = 0.79, area neighbour covariance p = 0.23). The default
+run is a reduced version (2·10⁴ coarse steps per case, seconds); the full one is ``slow``.
 """
 
 import math
