@@ -1,5 +1,7 @@
 """Naive reference implementations shared by several test modules (independent of the library)."""
 
+import re
+
 import numpy as np
 
 
@@ -62,3 +64,29 @@ def poly_jacobians(y):
     J[..., 1, idx, [1, 2, 0]] += 0.2 * y
     J[..., 1, idx, idx] += 0.2 * y[..., [1, 2, 0]]
     return J
+
+
+def parse_bracket(label, first_letter=1):
+    """Nested pairs of letters from a bracket label such as ``'[1,[1,2]]'`` (iisignature's and esig's
+    notation; multi-digit letters allowed), numbered from 0: letter ``first_letter`` becomes 0.
+    Raises ``AssertionError`` unless the whole label is one well-formed bracket expression."""
+    tokens = re.findall(r"\[|\]|,|\d+|.", label)
+    pos = 0
+
+    def tree():
+        nonlocal pos
+        tok = tokens[pos]
+        pos += 1
+        if tok != "[":
+            return int(tok) - first_letter
+        left = tree()
+        assert tokens[pos] == ","
+        pos += 1
+        right = tree()
+        assert tokens[pos] == "]"
+        pos += 1
+        return (left, right)
+
+    out = tree()
+    assert pos == len(tokens), label
+    return out

@@ -19,6 +19,7 @@ import re
 import iisignature
 import numpy as np
 import pytest
+from _oracles import parse_bracket
 
 from roughpaths import logsignature, lyndon_basis
 
@@ -28,27 +29,8 @@ def _as_iisignature(label):
 
 
 def _parse(label):
-    """Nested tuples of 1-based letters from a label; raises if the label is not fully consumed."""
-    tokens = re.findall(r"\[|\]|,|\d+|.", label)
-    pos = 0
-
-    def tree():
-        nonlocal pos
-        tok = tokens[pos]
-        pos += 1
-        if tok != "[":
-            return int(tok)
-        left = tree()
-        assert tokens[pos] == ","
-        pos += 1
-        right = tree()
-        assert tokens[pos] == "]"
-        pos += 1
-        return (left, right)
-
-    out = tree()
-    assert pos == len(tokens), label
-    return out
+    """Nested tuples of 1-based letters from a label (the shared parser, letters kept 1-based)."""
+    return parse_bracket(label, first_letter=0)
 
 
 def _flatten(t):

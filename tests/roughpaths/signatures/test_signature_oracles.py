@@ -14,12 +14,12 @@ Paths are scaled so that coordinates are O(1): absolute 1e-12 is then a relative
 """
 
 import itertools
-import re
 
 import esig
 import iisignature
 import numpy as np
 import pytest
+from _oracles import parse_bracket
 
 from roughpaths import (RoughPath, logsignature, lyndon_basis, rough_path_signature, sigdim, signature,
                         tensor_exp, tensor_log, tensor_product)
@@ -103,28 +103,6 @@ def test_logsignature_level2_is_levy_area(rng, d, m):
 
 
 # ------------------------------------------------------------------ esig's Hall basis, independently
-def _parse_bracket(text):
-    """Parse esig's key '[1,[1,2]]' into nested tuples of 0-based letters."""
-    tokens = re.findall(r"\[|\]|,|\d+", text)
-    pos = 0
-
-    def parse():
-        nonlocal pos
-        tok = tokens[pos]
-        pos += 1
-        if tok == "[":
-            left = parse()
-            assert tokens[pos] == ","
-            pos += 1
-            right = parse()
-            assert tokens[pos] == "]"
-            pos += 1
-            return (left, right)
-        return int(tok) - 1
-
-    return parse()
-
-
 def _expand_bracket(tree, d):
     """Naive tensor expansion: dict word -> coefficient."""
     if isinstance(tree, int):
@@ -141,7 +119,7 @@ def _expand_bracket(tree, d):
 @pytest.mark.parametrize("d,m", [(2, 4), (3, 3), (3, 4)])
 def test_expanded_logsignature_matches_esig_hall_basis(rng, d, m):
     keys = esig.logsigkeys(d, m).split()
-    trees = [_parse_bracket(k) for k in keys]
+    trees = [parse_bracket(k) for k in keys]
     for p in _paths(rng, (2,), 10, d):
         coef = np.asarray(esig.stream2logsig(p, m))
         assert coef.shape == (len(keys),)
