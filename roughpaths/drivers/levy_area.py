@@ -42,8 +42,9 @@ of ``(w, A)`` is exact for every ``n`` (tested); ``"fourier"`` lacks :math:`h^2 
 conditional variance. What is approximate: the law of the tail (Gaussian instead of a sum of
 products of normals), which shows in the fourth and higher moments and vanishes as ``n`` grows.
 
-The exact sampler for d = 2 (``levy_area="exact"`` of :class:`~roughpaths.BrownianDriver`)
----------------------------------------------------------------------------------------
+The exact sampler for d = 2
+---------------------------
+:class:`~roughpaths.BrownianDriver` with ``levy_area="exact"``.
 For ``d = 2`` the driver samples the Lévy area from its conditional law given the
 increment ``w`` (Lévy 1951), whose characteristic function is
 :math:`\frac{\lambda h/2}{\sinh(\lambda h/2)}\exp\bigl(-\frac{|w|^2}{2h}(\frac{\lambda h}{2}\coth\frac{\lambda h}{2} - 1)\bigr)`.
