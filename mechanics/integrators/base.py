@@ -30,7 +30,8 @@ Why the area term, and why :math:`+\tfrac12`: the noise fields are linear, :math
 term of :math:`\exp(\mathrm{ad}^*_\sigma)` reproduces both exactly when :math:`\sigma\ni\tfrac12A^{ij}[\xi_i,\xi_j]`.
 With the area the schemes have strong order 1 on Brownian rough paths (order 2 in ``dt`` without
 noise for Lie–Heun and the midpoint rule); without it (a level-1 driver: zero step area) only
-order ½ for non-commuting ``ξ``. The solver holds no flag for this: it reads the level from the driver. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
+order ½ for non-commuting ``ξ``. The solver holds no flag for this: it reads the level from the
+driver. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
 adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` to :math:`\sigma_n`: the
 discrete Proposition 2.1.
 

@@ -31,7 +31,7 @@ MODES_PER_SUBSTEP = 4
 # ------------------------------------------------------------------ antisymmetric (pair) algebra
 def _wedge(u, v):
     """``u ∧ v = u vᵀ - v uᵀ``, batched over leading axes."""
-    return u[..., :, None] * v[..., None, :] - v[..., :, None] * u[..., None, :]
+    return outer(u, v) - outer(v, u)
 
 
 def _pair_solve(N, v, rhs):
@@ -355,15 +355,9 @@ def _refine_bridge(plan, Wsub, Hsub, z):
 
 
 # ------------------------------------------------------------------ refine(X, factor, rng): a given sample
-def _antisym_normal(rng: np.random.Generator, shape: tuple, d: int) -> np.ndarray:
-    """Antisymmetric ``(..., d, d)`` with iid N(0, 1) entries above the diagonal."""
-    iu = np.triu_indices(d, 1)
-    out = np.zeros(shape + (d, d))
-    if iu[0].size:
-        z = rng.standard_normal(shape + (iu[0].size,))
-        out[..., iu[0], iu[1]] = z
-        out[..., iu[1], iu[0]] = -z
-    return out
+def _antisym_normal(rng: np.random.Generator, rows: int, d: int) -> np.ndarray:
+    """Antisymmetric ``(rows, d, d)`` with iid N(0, 1) entries above the diagonal, drawn from ``rng``."""
+    return _Normals(rng.standard_normal((rows, d * (d - 1) // 2))).antisym((), d)
 
 
 def _split(rng, W, L, h, rho, with_area: bool):
@@ -384,8 +378,8 @@ def _split(rng, W, L, h, rho, with_area: bool):
     w1, w2 = rho * W + b, (1.0 - rho) * W - b
     H1 = rng.standard_normal((R, d)) * np.sqrt(h1 / 12.0)[:, None]
     H2 = rng.standard_normal((R, d)) * np.sqrt(h2 / 12.0)[:, None]
-    L1 = _wedge(H1, w1) + _antisym_normal(rng, (R,), d) * (h1 / np.sqrt(12.0))[:, None, None]
-    L2 = _wedge(H2, w2) + _antisym_normal(rng, (R,), d) * (h2 / np.sqrt(12.0))[:, None, None]
+    L1 = _wedge(H1, w1) + _antisym_normal(rng, R, d) * (h1 / np.sqrt(12.0))[:, None, None]
+    L2 = _wedge(H2, w2) + _antisym_normal(rng, R, d) * (h2 / np.sqrt(12.0))[:, None, None]
     # Matheron update: Y <- Y + Cov(Y, Z | W) Var(Z | W)^{-1} (L - Z(Y)), Z(Y) = L1 + L2 + ½ b∧W
     r = L - (L1 + L2 + 0.5 * _wedge(b, W))
     hh = h[:, None, None]

@@ -1,4 +1,4 @@
-r"""Log-ODE schemes: the flow of the step"s log-signature vector field, at level 2 (:class:`LogODE`) and 3 (:class:`LogODE3`).
+r"""Log-ODE schemes: the flow of the step's log-signature vector field, at level 2 (:class:`LogODE`) and 3 (:class:`LogODE3`).
 
 Linear fields take the exact flow (a batched matrix exponential); non-linear ones ``inner_steps`` RK4
 steps of the autonomous ODE on ``[0, 1]``."""
