@@ -196,24 +196,99 @@ def _exp1(sh, sl, ih, il):
     return 0.5 * (z1 * z1 + z2 * z2), sh, sl
 
 
+@njit(cache=True, inline="always")
+def _series_area(mu, n_terms, t1, t2, sh, sl, ih, il):
+    r"""``a = A/h`` from the series ``a = L + √V Z`` given ``μ = |w|²/h`` (the fallback of the table).
+
+    ``L`` logistic of scale ``1/(2π)`` (``L = log(E₁/E₂)/(2π)``), ``Z ~ N(0, 1)`` and
+    ``V = Σ_{k≥1} Γ_k/(2π²k²)``, ``Γ_k ~ Gamma(N_k)`` (0 if ``N_k = 0``), ``N_k ~ Poisson(μ)``
+    (derivation in :mod:`roughpaths.drivers.levy_area`). The first ``n_terms`` terms are drawn
+    exactly (``N_k`` by exponential arrivals, ``Γ_k`` as ``½ χ²_{2N_k}``), the tail ``Σ_{k>n_terms}``
+    by a Gamma variable with its exact mean ``μ t1`` and variance ``2 μ t2`` (Marsaglia–Tsang).
+    Draw order: ``Z``; ``E₁, E₂`` (2 normals each); for each ``k``: the arrivals (2 normals each,
+    the one past ``μ`` included) then the ``2 N_k`` normals of ``Γ_k``; the tail's normals.
+    """
+    inv2pi2 = 1.0 / (2.0 * np.pi * np.pi)
+    z, sh, sl = _pcg64_normal(sh, sl, ih, il)
+    e1, sh, sl = _exp1(sh, sl, ih, il)
+    e2, sh, sl = _exp1(sh, sl, ih, il)
+    V = 0.0
+    for k in range(1, n_terms + 1):
+        n = 0                                    # N_k ~ Poisson(mu): unit-rate arrivals in [0, mu]
+        tarr, sh, sl = _exp1(sh, sl, ih, il)
+        while tarr <= mu:
+            n += 1
+            e, sh, sl = _exp1(sh, sl, ih, il)
+            tarr += e
+        g = 0.0
+        for _ in range(2 * n):
+            x, sh, sl = _pcg64_normal(sh, sl, ih, il)
+            g += x * x
+        V += 0.5 * g * inv2pi2 / (k * k)
+    if mu > 0.0:
+        alpha = mu * t1 * t1 / (2.0 * t2)
+        theta = 2.0 * t2 / t1
+        a = alpha + 1.0 if alpha < 1.0 else alpha
+        dd = a - 1.0 / 3.0
+        c = 1.0 / np.sqrt(9.0 * dd)
+        while True:
+            x, sh, sl = _pcg64_normal(sh, sl, ih, il)
+            v = 1.0 + c * x
+            if v <= 0.0:
+                continue
+            v = v * v * v
+            e, sh, sl = _exp1(sh, sl, ih, il)
+            if -e < 0.5 * x * x + dd - dd * v + dd * np.log(v):
+                break
+        gam = dd * v
+        if alpha < 1.0:
+            e, sh, sl = _exp1(sh, sl, ih, il)
+            gam *= np.exp(-e / alpha)
+        V += theta * gam
+    return np.log(e1 / e2) / (2.0 * np.pi) + np.sqrt(V) * z, sh, sl
+
+
+@njit(cache=True, inline="always")
+def _table_quantile(table, step, s, z):
+    """``g(s, z)`` (``z >= 0``, inside the table): cubic Hermite in ``z``, 4-point Lagrange in ``s``."""
+    ns = table.shape[1]
+    x = s / step
+    i = min(int(x), ns - 3)
+    u = x - i
+    y = z / step
+    j = min(int(y), table.shape[2] - 2)
+    v = y - j
+    v2 = v * v
+    h00 = (2.0 * v - 3.0) * v2 + 1.0
+    h10 = (v2 * v - 2.0 * v2 + v) * step
+    h01 = (3.0 - 2.0 * v) * v2
+    h11 = (v2 * v - v2) * step
+    um, u1, u2 = u + 1.0, u - 1.0, u - 2.0
+    lw0 = -u * u1 * u2 / 6.0
+    lw1 = um * u1 * u2 / 2.0
+    lw2 = -um * u * u2 / 2.0
+    lw3 = um * u * u1 / 6.0
+    g = 0.0
+    for q in range(4):
+        r = abs(i - 1 + q)                       # g is even in s: row -1 is row 1
+        row = h00 * table[0, r, j] + h10 * table[1, r, j] + h01 * table[0, r, j + 1] + h11 * table[1, r, j + 1]
+        g += (lw0 if q == 0 else lw1 if q == 1 else lw2 if q == 2 else lw3) * row
+    return g
+
+
 @njit(cache=True, nogil=True)
-def _exact_areas_d2(dW, h, states, n_terms, t1, t2, ito, out):
+def _exact_areas_d2(dW, h, states, table, step, n_terms, t1, t2, ito, out):
     r"""Exact-in-law d = 2 Lévy areas given the increments, from the per-path area streams.
 
-    For a step of size ``h`` with increment ``w`` and ``μ = |w|²/h``, the Lévy area is
-    ``A = h (L + √V Z)`` with ``L`` logistic of scale ``1/(2π)`` (``L = log(E₁/E₂)/(2π)``),
-    ``Z ~ N(0, 1)`` and ``V = Σ_{k≥1} Γ_k/(2π²k²)``, ``Γ_k ~ Gamma(N_k)`` (0 if ``N_k = 0``),
-    ``N_k ~ Poisson(μ)`` (derivation in :mod:`roughpaths.drivers.brownian`). The first ``n_terms``
-    terms are drawn exactly (``N_k`` by exponential arrivals, ``Γ_k`` as ``½ χ²_{2N_k}``), the
-    tail ``Σ_{k>n_terms}`` by a Gamma variable with its exact mean ``μ t1`` and variance
-    ``2 μ t2`` (Marsaglia–Tsang). Draw order per step: ``Z``; ``E₁, E₂`` (2 normals each);
-    for each ``k``: the arrivals (2 normals each, the one past ``μ`` included) then the ``2 N_k``
-    normals of ``Γ_k``; the tail's normals. ``states`` ``(P, 4)`` advance in place; ``out``
-    ``(P, K, 2, 2)`` receives ``A J + ½ w⊗w (- ½ h I)``.
+    For a step of size ``h`` with increment ``w`` and ``μ = |w|²/h``: one normal ``z``, and
+    ``A = h g(√μ, |z|) sign(z)`` from the quantile ``table`` (``(2, n, n)``, grid ``step``; see
+    :mod:`roughpaths.drivers._levy_table`); outside the table (``√μ`` or ``|z|`` beyond its last node)
+    ``A = h a`` with ``a`` from :func:`_series_area` drawn next from the same stream. An empty
+    table (``n = 0``) draws every area from the series, without ``z``. ``states`` ``(P, 4)`` advance
+    in place; ``out`` ``(P, K, 2, 2)`` receives ``A J + ½ w⊗w (- ½ h I)``.
     """
     P, K, d = dW.shape
-    inv2pi = 1.0 / (2.0 * np.pi)
-    inv2pi2 = 1.0 / (2.0 * np.pi * np.pi)
+    top = step * (table.shape[1] - 1)
     for p in range(P):
         sh, sl, ih, il = states[p, 0], states[p, 1], states[p, 2], states[p, 3]
         for r in range(K):
@@ -221,44 +296,18 @@ def _exact_areas_d2(dW, h, states, n_terms, t1, t2, ito, out):
             w0 = dW[p, r, 0]
             w1 = dW[p, r, 1]
             mu = (w0 * w0 + w1 * w1) / hr
-            z, sh, sl = _pcg64_normal(sh, sl, ih, il)
-            e1, sh, sl = _exp1(sh, sl, ih, il)
-            e2, sh, sl = _exp1(sh, sl, ih, il)
-            V = 0.0
-            for k in range(1, n_terms + 1):
-                # N_k ~ Poisson(mu): number of unit-rate arrivals in [0, mu]
-                n = 0
-                tarr, sh, sl = _exp1(sh, sl, ih, il)
-                while tarr <= mu:
-                    n += 1
-                    e, sh, sl = _exp1(sh, sl, ih, il)
-                    tarr += e
-                g = 0.0
-                for _ in range(2 * n):
-                    x, sh, sl = _pcg64_normal(sh, sl, ih, il)
-                    g += x * x
-                V += 0.5 * g * inv2pi2 / (k * k)
-            if mu > 0.0:
-                alpha = mu * t1 * t1 / (2.0 * t2)
-                theta = 2.0 * t2 / t1
-                a = alpha + 1.0 if alpha < 1.0 else alpha
-                dd = a - 1.0 / 3.0
-                c = 1.0 / np.sqrt(9.0 * dd)
-                while True:
-                    x, sh, sl = _pcg64_normal(sh, sl, ih, il)
-                    v = 1.0 + c * x
-                    if v <= 0.0:
-                        continue
-                    v = v * v * v
-                    e, sh, sl = _exp1(sh, sl, ih, il)
-                    if -e < 0.5 * x * x + dd - dd * v + dd * np.log(v):
-                        break
-                gam = dd * v
-                if alpha < 1.0:
-                    e, sh, sl = _exp1(sh, sl, ih, il)
-                    gam *= np.exp(-e / alpha)
-                V += theta * gam
-            A = hr * (inv2pi * np.log(e1 / e2) + np.sqrt(V) * z)
+            if table.shape[1] == 0:
+                a, sh, sl = _series_area(mu, n_terms, t1, t2, sh, sl, ih, il)
+            else:
+                z, sh, sl = _pcg64_normal(sh, sl, ih, il)
+                s = np.sqrt(mu)
+                if s <= top and abs(z) <= top:
+                    a = _table_quantile(table, step, s, abs(z))
+                    if z < 0.0:
+                        a = -a
+                else:
+                    a, sh, sl = _series_area(mu, n_terms, t1, t2, sh, sl, ih, il)
+            A = hr * a
             sym = 0.5 * w0 * w1
             out[p, r, 0, 0] = 0.5 * w0 * w0 - (0.5 * hr if ito else 0.0)
             out[p, r, 1, 1] = 0.5 * w1 * w1 - (0.5 * hr if ito else 0.0)

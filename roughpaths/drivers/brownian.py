@@ -89,6 +89,7 @@ import numpy as np
 
 from ..validation import as_float_array, check_memory, check_positive_int
 from ._area_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
+from ._levy_table import TABLE_STEP, load_table
 from ._random import PathStreams
 from .levy_area import _FOURIER_METHODS, LEVY_AREA_METHODS, block_areas, step_plan
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
@@ -103,7 +104,7 @@ DEFAULT_SUBSTEPS = 1
 
 _LEVY_METHODS = LEVY_AREA_METHODS
 _FOURIER = _FOURIER_METHODS + ("auto",)
-#: Series terms drawn exactly by ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
+#: Series terms drawn exactly by the fallback of ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
 _EXACT_TERMS = 8
 _KINDS = ("stratonovich", "ito")
 
@@ -463,8 +464,8 @@ class BrownianDriver(SeededDriver):
                     raise RuntimeError("levy_area='exact' needs the numba PCG64 streams, whose self-check "
                                        "against numpy failed in this process; use levy_area='davie'.")
                 areas = np.empty((P, k, d, d))
-                _exact_areas_d2(dW, h, area_streams.states, _EXACT_TERMS, _EXACT_T1, _EXACT_T2,
-                                self.kind == "ito", areas)
+                _exact_areas_d2(dW, h, area_streams.states, load_table(), TABLE_STEP, _EXACT_TERMS, _EXACT_T1,
+                                _EXACT_T2, self.kind == "ito", areas)
             elif self._fourier_plan is not None:
                 widths = [self._fourier_plan[float(hk)][2] for hk in h]
                 z = np.empty((P, int(sum(widths))))

@@ -46,7 +46,15 @@ The exact sampler for d = 2
 ---------------------------
 :class:`~roughpaths.BrownianDriver` with ``levy_area="exact"``.
 For ``d = 2`` the driver samples the Lévy area from its conditional law given the
-increment ``w`` (Lévy 1951), whose characteristic function is
+increment ``w`` (Lévy 1951). That law depends on ``w`` through ``μ = |w|²/h`` only, so the driver
+inverts it: one normal ``z`` per step and ``A = h g(√μ, z)``, with ``g`` the conditional quantile at
+``Φ(z)`` interpolated from a table computed from the characteristic function
+(:mod:`roughpaths.drivers._levy_table`: Kolmogorov distance to the exact law below 6·10⁻⁸, undetectable
+with fewer than ~10¹⁴ samples). Cost: 1 area normal and a 16-point interpolation per step;
+measured (1000 paths × 1000 steps, ``h = 1e-3``, CPU time) 13 million path-steps per second against 17 for
+Davie's ``m = 1`` in the same run (1.1 with the series below, which it replaces). Outside the table
+(``μ > 49`` or ``|z| > 7``, probability 3·10⁻¹¹) it draws from the series sampler, derived next, whose
+characteristic function is
 :math:`\frac{\lambda h/2}{\sinh(\lambda h/2)}\exp\bigl(-\frac{|w|^2}{2h}(\frac{\lambda h}{2}\coth\frac{\lambda h}{2} - 1)\bigr)`.
 Derivation of the sampler: :math:`x/\sinh x = \prod_k (1 + x^2/(k\pi)^2)^{-1}` is the
 characteristic function of a logistic variable of scale :math:`h/(2\pi)` (``λ`` for ``x = λh/2``), and

@@ -1,6 +1,7 @@
-r"""Claim: ``levy_area="exact"`` draws its normals in the documented order, ``21 + 32 μ`` on average plus the tail.
+r"""Claim: the series sampler (the exact d = 2 sampler's fallback) draws its normals in the documented order,
+``21 + 32 μ`` on average plus the tail.
 
-:mod:`roughpaths.drivers.levy_area` derives the cost of the exact d = 2 sampler: per step ``1 + 2 + 2``
+:mod:`roughpaths.drivers.levy_area` derives the cost of the series sampler: per step ``1 + 2 + 2``
 normals for ``Z, E₁, E₂`` (an exponential is ``(Z₁² + Z₂²)/2``), for each of the 8 exact terms
 ``2(N_k + 1)`` for the Poisson arrivals and ``2N_k`` for ``Γ_k``, i.e. ``21 + 32 μ`` on average given
 ``μ = |w|²/h`` (``N_k ~ Poisson(μ)``); the Gamma tail takes 3 per Marsaglia–Tsang attempt, plus 2 when its
@@ -9,7 +10,7 @@ closed form). ``E[μ] = 2``, so about 88 area normals per step.
 
 The test re-implements the documented draw order in numpy over the stream
 ``Generator(PCG64(SeedSequence(seed, spawn_key=(i, 1))))`` of path ``i``, checks that it reproduces the
-driver's areas (so its counts are the kernel's), and checks the counts: the exact part's mean against
+kernel's series-only areas (so its counts are the kernel's), and checks the counts: the exact part's mean against
 ``21 + 32 μ`` within 4 standard errors, the tail's shape constant and its measured mean.
 
 Peers: LevyArea.jl's ``runtests.jl`` pins its sampler's output against a fixed reference; here the
@@ -23,6 +24,8 @@ import pytest
 
 import roughpaths.drivers.levy_area as levy_area
 from roughpaths import BrownianDriver
+from roughpaths.drivers._area_kernels import _exact_areas_d2
+from roughpaths.drivers._random import PathStreams
 from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
 
 
@@ -76,8 +79,13 @@ def _exact_step(w, h, s):
 
 def test_draw_order_reproduces_the_driver_and_the_counts_are_as_derived():
     P, N, h, seed = 4, 1500, 0.01, 7
-    X = BrownianDriver(2, seed=seed, dt=h, n_steps=N, batch_shape=(P,), levy_area="exact").rough_path()
-    levy = 0.5 * (X.areas[..., 0, 1] - X.areas[..., 1, 0])
+    X = BrownianDriver(2, seed=seed, dt=h, n_steps=N, batch_shape=(P,), levy_area=None).rough_path()
+    keys = np.stack([np.arange(P), np.ones(P, dtype=np.int64)], axis=1)
+    out = np.empty((P, N, 2, 2))
+    states = PathStreams(np.random.SeedSequence(seed), keys).states
+    _exact_areas_d2(np.ascontiguousarray(X.increments), np.full(N, h), states, np.empty((2, 0, 0)), 0.05,
+                    _EXACT_TERMS, _EXACT_T1, _EXACT_T2, False, out)                  # series only
+    levy = 0.5 * (out[..., 0, 1] - out[..., 1, 0])
     mus, exact_part, tail = [], [], []
     for i in range(P):
         s = _Stream(np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(i, 1))))

@@ -6,7 +6,8 @@ Claim: for planar Brownian motion over a step of size ``h`` with increment ``w``
 .. math:: E[e^{i\lambda A}\mid w] = \frac{\lambda h/2}{\sinh(\lambda h/2)}
           \exp\Bigl(-\frac{|w|^2}{2h}\bigl(\tfrac{\lambda h}{2}\coth\tfrac{\lambda h}{2} - 1\bigr)\Bigr),
 
-and the sampler draws from this law. Tested by Kolmogorov–Smirnov tests (10⁵ samples) against
+and the sampler draws from this law: the driver's table sampler (``_levy_table``) and its fallback,
+the series sampler, each. Tested by Kolmogorov–Smirnov tests (10⁵ samples) against
 the CDF computed from the characteristic function by Gil-Pelaez inversion (numerical
 quadrature, checked here against the closed form for ``w = 0``, the logistic law), conditionally
 on given increments, and unconditionally against :math:`(2/\pi)\arctan(e^{\pi x/h})`; the same
@@ -20,7 +21,10 @@ from scipy import integrate, stats
 from roughpaths import BrownianDriver
 from roughpaths.drivers._area_kernels import _exact_areas_d2
 from roughpaths.drivers._random import PathStreams
+from roughpaths.drivers._levy_table import TABLE_STEP, load_table
 from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
+
+_SERIES_ONLY = np.empty((2, 0, 0))
 
 
 def _cf(lam, h, w2):
@@ -35,12 +39,13 @@ def _cdf_grid(h, w2, xs):
                                           limit=400, epsabs=1e-11)[0] / np.pi for x in xs])
 
 
-def _sample_given(w, h, n, seed=0):
+def _sample_given(w, h, n, seed=0, series=False):
     dW = np.broadcast_to(np.asarray(w, float), (n, 1, 2)).copy()
     keys = np.stack([np.arange(n), np.ones(n, dtype=np.int64)], axis=1)
     st = PathStreams(np.random.SeedSequence(seed), keys).states
     out = np.empty((n, 1, 2, 2))
-    _exact_areas_d2(dW, np.array([h]), st, _EXACT_TERMS, _EXACT_T1, _EXACT_T2, False, out)
+    table = _SERIES_ONLY if series else load_table()
+    _exact_areas_d2(dW, np.array([h]), st, table, TABLE_STEP, _EXACT_TERMS, _EXACT_T1, _EXACT_T2, False, out)
     return 0.5 * (out[:, 0, 0, 1] - out[:, 0, 1, 0])
 
 
@@ -50,11 +55,12 @@ def test_gil_pelaez_oracle_reproduces_the_closed_forms():
     np.testing.assert_allclose(_cdf_grid(h, 0.0, xs), 1 / (1 + np.exp(-2 * np.pi * xs / h)), atol=1e-8)
 
 
+@pytest.mark.parametrize("series", [False, True], ids=["table", "series"])
 @pytest.mark.parametrize("w", [(0.0, 0.0), (0.3, -0.4), (2.0, 1.0)])
-def test_conditional_law_kolmogorov_smirnov(w):
+def test_conditional_law_kolmogorov_smirnov(w, series):
     h, n = 0.5, 100_000
     w2 = float(np.dot(w, w))
-    a = _sample_given(w, h, n)
+    a = _sample_given(w, h, n, series=series)
     sd = np.sqrt(h * h / 12 + h * w2 / 12)
     xs = np.linspace(-8 * sd, 8 * sd, 321)
     F = _cdf_grid(h, w2, xs)
