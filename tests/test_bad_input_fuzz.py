@@ -270,7 +270,7 @@ R = [
     ("refine", lambda **k: rp.refine(**k).increments, dict(X=_bm((2,)), factor=2, rng=np.random.default_rng(0)),
      dict(X="object", factor="count", rng="rng")),
     ("brownian_rough_path", lambda **k: rp.brownian_rough_path(**k).increments,
-     dict(times=T4, dim=2, rng=np.random.default_rng(0), batch_shape=(2,), substeps=2),
+     dict(times=T4, dim=2, rng=np.random.default_rng(0), batch_shape=(2,), substeps=2, levy_area="davie"),
      dict(times="array", dim="count", rng="rng", batch_shape="shape", substeps="count", levy_area="choice",
           kind="choice")),
     ("brownian_increments_and_areas", lambda **k: rp.brownian_increments_and_areas(**k),

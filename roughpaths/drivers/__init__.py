@@ -2,7 +2,8 @@
 
 * :mod:`~roughpaths.drivers.base`: the :class:`Driver` contract.
 * :mod:`~roughpaths.drivers.brownian`: Brownian motion with Lévy areas (:class:`BrownianDriver`),
-  :mod:`~roughpaths.drivers.levy_area` (the Lévy-area samplers) and
+  :mod:`~roughpaths.drivers.areas` (every Lévy-area method behind one ``levy_area``),
+  :mod:`~roughpaths.drivers.levy_area` (the error-controlled and exact samplers) and
   :mod:`~roughpaths.drivers.refinement` (the same path on a finer grid).
 * :mod:`~roughpaths.drivers.coloured_noise` (and its law, :mod:`~roughpaths.drivers.coloured_noise_law`):
   Ornstein–Uhlenbeck coloured noise and its Wong–Zakai limit.
@@ -12,14 +13,15 @@ The per-path streams (``_random``, ``_ziggurat``, ``_seeded``) and the compiled 
 """
 
 from .base import Driver
-from .brownian import (DEFAULT_SUBSTEPS, BrownianDriver, brownian_increments_and_areas, brownian_rough_path)
+from .areas import DEFAULT_SUBSTEPS, sample_levy_areas
+from .brownian import BrownianDriver, brownian_increments_and_areas, brownian_rough_path
 from .coloured_noise import (ColouredNoiseDriver, ColouredNoiseSample, ResolutionWarning,
                              coloured_noise_limit_path, iter_coloured_noise, sample_coloured_noise)
 from .coloured_noise_law import (ColouredNoiseLimit, coloured_noise_limit, expected_area_rate,
                                  lift_area_rate, ou_step_law, paper_coloured_noise_matrices)
 from .fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
-                        levy_areas_from_normals, sample_levy_areas)
+                        levy_areas_from_normals)
 from .refinement import RefinedBrownianDriver, refine
 
 __all__ = [

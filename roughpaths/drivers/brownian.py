@@ -11,8 +11,12 @@ Conventions (``docs/conventions.md``)
 
 What is exact and what is approximate
 -------------------------------------
-The increments are exact in law on every grid (independent :math:`N(0, h I)`). The Lévy area
-of Brownian motion is not Gaussian and has no cheap exact sampler for general ``d``; each step
+The increments are exact in law on every grid (independent :math:`N(0, h I)`). The areas are
+sampled by the method ``levy_area`` (the table of :mod:`roughpaths.drivers.areas`); the default,
+``"auto"``, is exact in law for ``d <= 2`` (:mod:`roughpaths.drivers.levy_area`) and has per-step L²
+error :math:`h^{3/2}` for ``d >= 3``, so the order-1 solvers keep strong order 1 against the Brownian
+motion. The fast methods ``"davie"`` and ``"foster"``, of strong order ½ against Brownian motion,
+are derived here. The Lévy area of Brownian motion is not Gaussian; for them each step
 of size ``h`` is split into ``m = substeps`` equal substeps of size :math:`\delta = h/m`, on which
 we draw the Brownian increment :math:`w_k` (a Brownian bridge given the step's increment, so the
 step increment is untouched) and the *space-time Lévy area*
@@ -37,7 +41,7 @@ counting each pair ``i < j`` once), and its variance is :math:`h^2/4 - h^2/(12 m
 :math:`h^2/4`; with the fourth cumulant derived below, its excess kurtosis is
 :math:`(2 - \tfrac{2}{3m^3})(\tfrac{3m}{3m-1})^2` (3 for ``m = 1``).
 
-``levy_area="davie"`` (default) adds an independent antisymmetric Gaussian with variance
+``levy_area="davie"`` adds an independent antisymmetric Gaussian with variance
 :math:`h^2/(12 m)` per component (Davie 2014, with Foster's space-time refinement): every second
 moment of ``(W, A)`` is then exact, also conditionally on ``W``
 (:math:`\mathrm{Var}(A_{ij}\mid W) = h^2/12 + h(W_i^2 + W_j^2)/12`), and so is the
@@ -60,7 +64,7 @@ test with 4·10⁵ samples cannot tell the ``m = 8`` law from the exact one. The
 L² error, had the path been coupled to a true Brownian path, is :math:`h/\sqrt{6 m}` per
 component (the added Gaussian is independent of the path).
 
-``levy_area="exact"`` (d = 2 only) samples the Lévy area from its exact conditional law given the
+``levy_area="exact"`` (``d <= 2``) samples the Lévy area from its exact conditional law given the
 increment; its derivation, law error and cost are in :mod:`roughpaths.drivers.levy_area`. The
 error-controlled ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"`` and ``"auto"`` are
 documented there too.
@@ -88,24 +92,15 @@ import numbers
 import numpy as np
 
 from ..validation import as_float_array, check_memory, check_positive_int
-from ._area_kernels import _block_areas, _exact_areas_d2, _scale_accumulate
-from ._levy_table import TABLE_STEP, load_table
-from ._random import PathStreams
-from .levy_area import _FOURIER_METHODS, LEVY_AREA_METHODS, block_areas, step_plan
+from ._area_kernels import _scale_accumulate
+from ._random import PathStreams, _fast_streams_ok
+from .areas import DEFAULT_SUBSTEPS, _Sampler
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from ..paths.rough_path import RoughPath
 from .refinement import RefinedBrownianDriver
 
-__all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path", "DEFAULT_SUBSTEPS"]
+__all__ = ["BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path"]
 
-#: Default number of substeps per grid step for the Lévy-area sampler, the same for every entry point
-#: (Davie's own method: exact second moments at the lowest cost).
-DEFAULT_SUBSTEPS = 1
-
-_LEVY_METHODS = LEVY_AREA_METHODS
-_FOURIER = _FOURIER_METHODS + ("auto",)
-#: Series terms drawn exactly by the fallback of ``levy_area="exact"`` (the rest by a moment-matched Gamma tail).
-_EXACT_TERMS = 8
 _KINDS = ("stratonovich", "ito")
 
 
@@ -114,15 +109,6 @@ def _check_kind(kind) -> str:
     if kind not in _KINDS:
         raise ValueError(f"kind must be 'stratonovich' or 'ito', got {kind!r}.")
     return kind
-
-
-def _check_levy_method(levy_area):
-    if levy_area is None or levy_area == "none":
-        return None
-    if levy_area not in _LEVY_METHODS:
-        raise ValueError(f"levy_area must be one of {_LEVY_METHODS} or None (increments only), "
-                         f"got {levy_area!r}.")
-    return levy_area
 
 
 def _check_dt(dt, n_steps: int) -> np.ndarray:
@@ -150,7 +136,7 @@ def _seed_from_rng(rng) -> np.random.SeedSequence:
 
 
 # ---------------------------------------------------------------------------- public API
-def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy_area="davie",
+def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy_area="auto",
                                   substeps=None, kind="stratonovich", levy_area_error=None):
     r"""Sample Brownian increments and step areas: the low-level, streaming-friendly sampler.
 
@@ -170,14 +156,15 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     batch_shape : tuple of int, optional
         Leading batch axes (independent paths), default ``()``.
     levy_area : str or None
-        Lévy-area method, any of :data:`roughpaths.LEVY_AREA_METHODS`, with the meaning and the
-        default of :class:`BrownianDriver` (see the module docstring for each method's exact error):
-        ``"davie"`` (default) matches every second moment of ``(W, A)`` exactly, ``"foster"`` is the
+        Lévy-area method, any of :data:`roughpaths.LEVY_AREA_METHODS` (table in
+        :mod:`roughpaths.drivers.areas`), default ``"auto"``: exact in law for ``d <= 2``, per-step L²
+        error ``levy_area_error`` for ``d >= 3`` (strong order 1 against Brownian motion).
+        ``"davie"`` matches every second moment of ``(W, A)`` exactly, ``"foster"`` is the
         conditional mean given the substep information (best L² approximation, variance short by
-        ``h²/(12 m)``); both are of strong order ½ against Brownian motion. ``"exact"`` (``d = 2``)
-        is exact in law; ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"`` and ``"auto"``
-        meet the per-step L² error ``levy_area_error``. ``None`` (or ``"none"``) returns
-        ``areas=None`` and draws only the increments.
+        ``h²/(12 m)``); both are fast and of strong order ½ against Brownian motion. ``"exact"``
+        (``d <= 2``) is exact in law; ``"fourier"``, ``"mrongowius-rossler"``, ``"wiktorsson"`` meet
+        the per-step L² error ``levy_area_error``. ``None`` (or ``"none"``) returns ``areas=None`` and
+        draws only the increments.
     substeps : int, optional
         Substeps ``m >= 1`` per step for ``"davie"`` / ``"foster"`` (default
         :data:`DEFAULT_SUBSTEPS`). The increments do not depend on it. L² error per component:
@@ -186,8 +173,8 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
         Stratonovich areas :math:`A + \tfrac12 W\otimes W`, or Itô areas
         :math:`A + \tfrac12 W\otimes W - \tfrac12 h I`.
     levy_area_error : float, optional
-        Per-step L² error of the error-controlled methods (default ``h^{3/2}``), as for
-        :class:`BrownianDriver`.
+        Per-step L² error of the error-controlled methods (``"auto"`` at ``d >= 3``, the Fourier
+        methods; default ``h^{3/2}``), as for :class:`BrownianDriver`.
 
     Returns
     -------
@@ -233,7 +220,7 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     return X.increments, X.areas
 
 
-def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich", levy_area="davie",
+def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich", levy_area="auto",
                         substeps=None, x0=None, levy_area_error=None) -> RoughPath:
     r"""Brownian motion lifted to a level-2 rough path on exactly the grid ``times``.
 
@@ -278,10 +265,6 @@ def brownian_rough_path(times, dim, rng, *, batch_shape=(), kind="stratonovich",
 
 # ---------------------------------------------------------------------------- the driver
 _BLOCK_BYTES = 16 << 20
-_NO_STATES = np.empty((0, 4), dtype=np.uint64)
-# tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
-_EXACT_T1 = (np.pi ** 2 / 6 - sum(1.0 / k ** 2 for k in range(1, _EXACT_TERMS + 1))) / (2 * np.pi ** 2)
-_EXACT_T2 = (np.pi ** 4 / 90 - sum(1.0 / k ** 4 for k in range(1, _EXACT_TERMS + 1))) / (4 * np.pi ** 4)
 
 
 class BrownianDriver(SeededDriver):
@@ -309,10 +292,12 @@ class BrownianDriver(SeededDriver):
     batch_shape : tuple of int
         Independent paths, default ``()``; path ``i`` is the ``i``-th in C order of the batch.
     levy_area : {"davie", "foster", "exact", "fourier", "mrongowius-rossler", "wiktorsson", "auto"} or None
-        Area method (default ``"davie"``, exact second moments); ``"exact"``: the exact law given
-        the increment, ``d = 2`` only (module docstring); the error-controlled Fourier samplers of
-        :mod:`roughpaths.drivers.levy_area` (``"auto"`` picks the cheapest per step size), with the target
-        ``levy_area_error``. ``None``: increments only (``level == 1``).
+        Area method, table in :mod:`roughpaths.drivers.areas`. Default ``"auto"``: ``"exact"`` (the
+        exact law given the increment) for ``d <= 2``, and for ``d >= 3`` the error-controlled Fourier
+        sampler of :mod:`roughpaths.drivers.levy_area` that needs the fewest normals for
+        ``levy_area_error``, per step size; strong order 1 against Brownian motion. ``"davie"``
+        (exact second moments) and ``"foster"``: fast, strong order ½. ``None``: increments only
+        (``level == 1``).
     substeps : int
         Substeps ``m`` per step of the ``"davie"``/``"foster"`` sampler, default
         :data:`DEFAULT_SUBSTEPS` ``= 1`` (Davie's own method). Larger ``m`` lowers the L² error
@@ -341,8 +326,9 @@ class BrownianDriver(SeededDriver):
     * areas: the same with ``spawn_key=S.spawn_key + (i, 1)``; step ``k`` takes the next
       ``(m d if m > 1) + m d + (d(d-1)/2 if davie)`` normals: the bridge normals, the
       space-time normals and Davie's normals, in this order (see
-      :mod:`roughpaths.drivers._area_kernels`); for ``"exact"`` a variable number, in the order
-      documented in ``_area_kernels._exact_areas_d2``; for the Fourier samplers
+      :mod:`roughpaths.drivers._area_kernels`); for ``"exact"`` (``d = 2``) one normal (and,
+      with probability 3·10⁻¹¹, the series sampler's normals after it, in the order documented
+      in ``_area_kernels._exact_areas_d2``; ``d = 1``: none); for the Fourier samplers
       ``levy_area_normals(method, d, n)`` normals with the ``(method, n)`` of the step's length, in the
       order of :func:`roughpaths.levy_areas_from_normals`.
 
@@ -369,29 +355,13 @@ class BrownianDriver(SeededDriver):
     """
 
     def __init__(self, dim, *, seed, times=None, dt=None, n_steps=None, t0=0.0, batch_shape=(),
-                 levy_area="davie", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES,
+                 levy_area="auto", substeps=None, kind="stratonovich", x0=None, block_bytes=_BLOCK_BYTES,
                  levy_area_error=None):
         self._init_common(dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes)
-        self.levy_area = _check_levy_method(levy_area)
-        self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
-        self.levy_area_error = None
-        self._fourier_plan = None
-        if self.levy_area in _FOURIER:
-            if substeps is not None:
-                raise ValueError(f"substeps applies to levy_area='davie' or 'foster'; levy_area="
-                                 f"{self.levy_area!r} sets its accuracy by levy_area_error (default h^1.5).")
-            self.levy_area_error = levy_area_error
-            self._fourier_plan = step_plan(self.levy_area, self.dim, self._h, levy_area_error)
-        elif levy_area_error is not None:
-            raise ValueError(f"levy_area_error applies to the error-controlled methods {_FOURIER}, not to "
-                             f"levy_area={self.levy_area!r}.")
-        if self.levy_area == "exact":
-            if self.dim != 2:
-                raise ValueError(f"levy_area='exact' is available for dim=2 only, got dim={self.dim}; use "
-                                 f"levy_area='davie' (exact second moments) for d > 2.")
-            if self.substeps != 1:
-                raise ValueError(f"substeps={self.substeps} has no effect with levy_area='exact' (the area is "
-                                 f"exact in law); leave substeps at its default.")
+        self._sampler = _Sampler(levy_area, self.dim, self._h, substeps, levy_area_error)
+        self.levy_area = self._sampler.name
+        self.substeps = self._sampler.substeps
+        self.levy_area_error = levy_area_error
         self.kind = _check_kind(kind)
         self.level = 1 if self.levy_area is None else 2
         self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
@@ -405,12 +375,7 @@ class BrownianDriver(SeededDriver):
     # ------------------------------------------------------------------ layout
     @property
     def _n_area_normals(self) -> int:
-        if self.levy_area in (None, "exact"):
-            return 0
-        if self._fourier_plan is not None:
-            return max(w for _, _, w in self._fourier_plan.values())
-        d, m = self.dim, self.substeps
-        return (m * d if m > 1 else 0) + m * d + (d * (d - 1) // 2 if self.levy_area == "davie" else 0)
+        return self._sampler.block_width(self.seed_sequence.pool_size == 4 and _fast_streams_ok())
 
     def _bytes_per_path_step(self) -> int:
         d = self.dim
@@ -439,7 +404,6 @@ class BrownianDriver(SeededDriver):
         keys[:, 0] = self.path_indices
         inc_streams = PathStreams(ss, keys)
         area_streams = None
-        na = self._n_area_normals
         if self.level == 2:
             keys = keys.copy()
             keys[:, 1] = 1
@@ -447,9 +411,7 @@ class BrownianDriver(SeededDriver):
         rp_kind = None if self.level == 1 else ("geometric" if self.kind == "stratonovich" else "ito")
         h_all = self._h
         x = np.array(self._flat(self._x0, d))
-        rows = 1 if area_streams is None or area_streams.states is not None else P * min(K, N)
-        zbuf = np.empty(rows * max(na, 1))      # one step's normals, or the block's (numpy fallback)
-        davie = self.levy_area == "davie" and d > 1
+        zbuf = np.empty(max(self._sampler.width, 1))    # one step's normals (the kernels draw them per step)
         for k0 in range(0, N, K):
             k1 = min(N, k0 + K)
             k = k1 - k0
@@ -458,29 +420,7 @@ class BrownianDriver(SeededDriver):
             inc_streams.fill(dW.reshape(P, k * d))
             x_start = x.copy()
             _scale_accumulate(dW, np.sqrt(h), x)    # x: the position at the end of the block
-            areas = None
-            if self.levy_area == "exact":
-                if area_streams.states is None:  # pragma: no cover - only if numpy's algorithms change
-                    raise RuntimeError("levy_area='exact' needs the numba PCG64 streams, whose self-check "
-                                       "against numpy failed in this process; use levy_area='davie'.")
-                areas = np.empty((P, k, d, d))
-                _exact_areas_d2(dW, h, area_streams.states, load_table(), TABLE_STEP, _EXACT_TERMS, _EXACT_T1,
-                                _EXACT_T2, self.kind == "ito", areas)
-            elif self._fourier_plan is not None:
-                widths = [self._fourier_plan[float(hk)][2] for hk in h]
-                z = np.empty((P, int(sum(widths))))
-                area_streams.fill(z)                 # each path's stream: the block's steps in order
-                areas = block_areas(dW, h, self._fourier_plan, z, self.kind == "ito")
-            elif self.level == 2:
-                areas = np.empty((P, k, d, d))
-                if area_streams.states is not None:      # draw each step's normals inside the kernel
-                    _block_areas(dW, h, zbuf[:na].reshape(1, 1, na), area_streams.states, self.substeps, davie,
-                                 self.kind == "ito", areas)
-                else:
-                    z = zbuf[:P * k * na].reshape(P, k * na)
-                    area_streams.fill(z)
-                    _block_areas(dW, h, z.reshape(P, k, na), _NO_STATES, self.substeps, davie,
-                                 self.kind == "ito", areas)
+            areas = None if self.level == 1 else self._sampler.fill(dW, h, area_streams, self.kind == "ito", zbuf)
             block = RoughPath(dW.reshape(self.batch_shape + (k, d)),
                               None if areas is None else areas.reshape(self.batch_shape + (k, d, d)),
                               times=self.times[k0:k1 + 1], x0=x_start.reshape(self.batch_shape + (d,)),

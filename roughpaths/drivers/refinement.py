@@ -120,7 +120,7 @@ from ._bridge import (GIBBS_SWEEPS, MODES_PER_SUBSTEP, _assemble, _BridgePlan, _
 from ._random import PathStreams
 from ._seeded import SeededDriver
 from .base import Driver
-from .levy_area import _FOURIER_METHODS, _tail_zeta2, step_plan
+from .levy_area import _tail_zeta2, step_plan
 
 __all__ = ["refine", "RefinedBrownianDriver", "GIBBS_SWEEPS", "MODES_PER_SUBSTEP"]
 
@@ -324,10 +324,10 @@ class RefinedBrownianDriver(Driver):
         elif c.levy_area in ("davie", "foster"):
             plan = _BridgePlan(h, F, d, c.substeps, c.levy_area == "davie")
         else:
-            if c.levy_area == "exact":
+            if c._sampler.kind == "exact":
                 method, n, stores_s, fine_method, err = "exact", 0, False, "auto", None
             else:
-                method, n, _ = c._fourier_plan[h]
+                method, n, _ = c._sampler.plan[h]
                 stores_s = method in ("fourier", "mrongowius-rossler")
                 fine_method, err = c.levy_area, c.levy_area_error
             delta = h / F
@@ -338,8 +338,8 @@ class RefinedBrownianDriver(Driver):
 
     def _area_width(self, h: float) -> int:
         c = self.coarse
-        if c.levy_area in _FOURIER_METHODS + ("auto",):
-            return c._fourier_plan[h][2]
+        if c._sampler.kind == "fourier":
+            return c._sampler.plan[h][2]
         if c.levy_area in ("davie", "foster"):
             return c._n_area_normals
         return 0
@@ -389,7 +389,7 @@ class RefinedBrownianDriver(Driver):
         keys[:, 0] = self.path_indices
         keys[:, 1] = 1
         area_streams = None
-        if c.levy_area in ("davie", "foster") + _FOURIER_METHODS + ("auto",):
+        if c._sampler.kind in ("bridge", "fourier"):
             area_streams = PathStreams(c.seed_sequence, keys)        # the coarse area normals, regenerated
         keys = keys.copy()
         keys[:, 1] = 2

@@ -57,7 +57,7 @@ def test_levy_area_second_moments(method, m):
 
 
 def test_ito_areas_are_stratonovich_minus_half_h():
-    kw = dict(seed=4, times=[0.0, 0.2, 0.7], batch_shape=(3,), substeps=2)
+    kw = dict(seed=4, times=[0.0, 0.2, 0.7], batch_shape=(3,), substeps=2, levy_area="davie")
     S = BrownianDriver(2, **kw).rough_path()
     I = BrownianDriver(2, kind="ito", **kw).rough_path()
     assert I.kind == "ito" and S.kind == "geometric"

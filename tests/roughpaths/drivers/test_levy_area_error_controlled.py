@@ -32,7 +32,7 @@ def test_unconditional_second_and_fourth_moments(method):
     d, h, N = 3, 0.05, 200_000
     w = rng.normal(0.0, math.sqrt(h), size=(N, d))
     # error h^1.5 / 4: the tail's law error (O(1/n) in the fourth moment) below what 2e5 samples resolve
-    A = sample_levy_areas(w, h, rng, method=method, error=h**1.5 / 4)
+    A = sample_levy_areas(w, h, rng, levy_area=method, levy_area_error=h**1.5 / 4)
     np.testing.assert_array_equal(A, -np.swapaxes(A, -1, -2))
     for i, j in [(0, 1), (0, 2), (1, 2)]:
         a = A[:, i, j]
@@ -94,8 +94,8 @@ def test_members_do_not_affect_each_other():
 
 def test_bad_arguments_are_refused_clearly():
     rng = np.random.default_rng(0)
-    with pytest.raises(ValueError, match="method must be one of"):
-        sample_levy_areas(np.zeros(2), 0.1, rng, method="exact-ish")
+    with pytest.raises(ValueError, match="levy_area must be one of"):
+        sample_levy_areas(np.zeros(2), 0.1, rng, levy_area="exact-ish")
     with pytest.raises(ValueError, match="h must be a positive finite number"):
         levy_area_terms("fourier", 2, -1.0)
     with pytest.raises(ValueError, match="error must be a positive finite number"):

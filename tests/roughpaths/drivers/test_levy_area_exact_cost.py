@@ -26,7 +26,7 @@ import roughpaths.drivers.levy_area as levy_area
 from roughpaths import BrownianDriver
 from roughpaths.drivers._area_kernels import _exact_areas_d2
 from roughpaths.drivers._random import PathStreams
-from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
+from roughpaths.drivers.areas import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
 
 
 class _Stream:

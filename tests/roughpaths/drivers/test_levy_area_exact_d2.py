@@ -22,7 +22,7 @@ from roughpaths import BrownianDriver
 from roughpaths.drivers._area_kernels import _exact_areas_d2
 from roughpaths.drivers._random import PathStreams
 from roughpaths.drivers._levy_table import TABLE_STEP, load_table
-from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
+from roughpaths.drivers.areas import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
 
 _SERIES_ONLY = np.empty((2, 0, 0))
 
@@ -100,7 +100,7 @@ def test_unconditional_law_through_the_driver():
 
 
 def test_exact_is_refused_where_it_does_not_exist():
-    with pytest.raises(ValueError, match="dim=2 only"):
+    with pytest.raises(ValueError, match="dim <= 2 only"):
         BrownianDriver(3, seed=0, dt=0.1, n_steps=2, levy_area="exact")
     with pytest.raises(ValueError, match="substeps"):
         BrownianDriver(2, seed=0, dt=0.1, n_steps=2, levy_area="exact", substeps=4)

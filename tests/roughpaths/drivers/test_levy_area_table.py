@@ -99,7 +99,7 @@ def test_fallback_beyond_the_table_is_finite_and_has_the_conditional_variance():
     test_levy_area_exact_d2); here: through the driver's kernel, the variance h²(1 + μ)/12."""
     from roughpaths.drivers._area_kernels import _exact_areas_d2
     from roughpaths.drivers._random import PathStreams
-    from roughpaths.drivers.brownian import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
+    from roughpaths.drivers.areas import _EXACT_T1, _EXACT_T2, _EXACT_TERMS
 
     n, h = 20_000, 0.25
     dW = np.broadcast_to(np.array([8.0, 0.0]) * np.sqrt(h), (n, 1, 2)).copy()

@@ -57,7 +57,7 @@ def test_levy_area_error_reaches_the_sampler(method):
 def test_refusals_name_the_fix():
     with pytest.raises(ValueError, match="levy_area must be one of"):
         rp.brownian_rough_path([0.0, 1.0], 2, 0, levy_area="levy")
-    with pytest.raises(ValueError, match="substeps applies to"):
+    with pytest.raises(ValueError, match="substeps=2 applies to levy_area='davie' or 'foster' only"):
         rp.brownian_rough_path([0.0, 1.0], 2, 0, levy_area="wiktorsson", substeps=2)
     with pytest.raises(ValueError, match="levy_area_error applies to"):
         rp.brownian_increments_and_areas(0, 2, 0.1, 2, levy_area="davie", levy_area_error=1e-3)
