@@ -13,7 +13,7 @@ coarse areas (Davie's, Foster's, the error-controlled ones) against the refined 
 
 The time to reach strong error 1e-3 is measured for each solver at its own required number of
 steps ``N*`` (interpolated on the error ladder), **including the sampling of its driver**: the order-1
-solvers draw increments and Lévy areas (``brownian_rough_path``, default sampler), Heun draws increments
+solvers draw increments and Lévy areas (``brownian_rough_path``, Davie's sampler), Heun draws increments
 only. Same run, same machine, ratio printed. Then path-steps per second for a batch of 1,000 paths.
 
 Usage: ``python benchmarks/bench_rde.py`` (about a minute), ``--quick`` for a smoke run.

@@ -66,6 +66,11 @@ class _Sampler:
         if levy_area is not None and levy_area not in LEVY_AREA_METHODS:
             raise ValueError(f"levy_area must be one of {LEVY_AREA_METHODS} or None (increments only), "
                              f"got {levy_area!r}.")
+        if levy_area_error is not None and not callable(levy_area_error):
+            if (isinstance(levy_area_error, bool) or not isinstance(levy_area_error, numbers.Real)
+                    or not np.isfinite(levy_area_error) or levy_area_error <= 0):
+                raise ValueError(f"levy_area_error must be a positive number or a callable h -> error, got "
+                                 f"{levy_area_error!r}; the default is h^1.5.")
         self.name, self.dim = levy_area, dim
         self.substeps = DEFAULT_SUBSTEPS if substeps is None else check_positive_int(substeps, "substeps")
         self.levy_area_error = levy_area_error
@@ -89,11 +94,6 @@ class _Sampler:
         if levy_area_error is not None and self.kind in (None, "bridge"):
             raise ValueError(f"levy_area_error applies to the error-controlled methods {_FOURIER_METHODS + ('auto',)}, "
                              f"not to levy_area={levy_area!r}; leave it unset or pick one of those.")
-        if levy_area_error is not None and not callable(levy_area_error):
-            if (isinstance(levy_area_error, bool) or not isinstance(levy_area_error, numbers.Real)
-                    or not np.isfinite(levy_area_error) or levy_area_error <= 0):
-                raise ValueError(f"levy_area_error must be a positive number or a callable h -> error, got "
-                                 f"{levy_area_error!r}; the default is h^1.5.")
 
     def block_width(self, fast: bool) -> int:
         """Area normals per path-step held in a block buffer: none when the kernels draw them (``fast``)."""

@@ -216,6 +216,7 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
     drv = BrownianDriver(dim, seed=seed, times=np.concatenate([[0.0], np.cumsum(h)]), batch_shape=batch_shape,
                          levy_area=levy_area, substeps=substeps, kind=kind, levy_area_error=levy_area_error)
     drv._h = h                               # the given step sizes exactly (not differences of their sums)
+    drv._sampler = _Sampler(levy_area, dim, h, substeps, levy_area_error)       # planned for those sizes
     X = drv.rough_path()
     return X.increments, X.areas
 
