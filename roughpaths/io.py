@@ -221,7 +221,10 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
 def _fspath(path):
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a str or os.PathLike naming a .npz file, got {type(path).__name__}.")
-    return os.fspath(path)
+    p = os.fspath(path)
+    if "\0" in str(p):
+        raise ValueError(f"path must not contain a null byte, got {p!r}; pass a plain file name.")
+    return p
 
 
 def atomic_savez(target, arrays: dict) -> Path:

@@ -76,8 +76,10 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     if ndim is not None and arr.ndim != ndim:
         raise ValueError(f"{name} must have {ndim} axes, got shape {arr.shape}.")
     if arr.ndim < min_ndim:
+        hint = (f"{name}[:, None] for one path of {arr.shape[0]} points in one dimension, or {name}[None] for "
+                f"one point in {arr.shape[0]} dimensions" if arr.ndim == 1 and min_ndim == 2 else f"{name}[None]")
         raise ValueError(f"{name} must have at least {min_ndim} axes, got shape {arr.shape}; "
-                         f"add the missing axes (e.g. {name}[None]).")
+                         f"add the missing axes (e.g. {hint}).")
     if last_dims is not None:
         k = len(last_dims)
         if arr.ndim < k:

@@ -110,6 +110,9 @@ class RunningMoments:
 def moment_observable(x) -> np.ndarray:
     """``(x, x_i x_j for i ≤ j)``: first and second moments; ``(..., n)`` → ``(..., n + n(n+1)/2)``."""
     x = np.asarray(x, dtype=np.float64)
+    if x.ndim == 0:
+        raise ValueError(f"moment_observable takes states of shape (..., n), got the scalar {float(x)!r}; pass "
+                         f"np.atleast_1d(x).")
     n = x.shape[-1]
     i, j = np.triu_indices(n)
     out = np.empty(x.shape[:-1] + (n + len(i),))

@@ -34,6 +34,10 @@ def check_inertia(inertia, name: str = "inertia", *, dim: int | None = None) -> 
         raise ValueError(f"{name} must be positive definite, but its smallest eigenvalue is "
                          f"{eig[0]:.6g} (eigenvalues {np.array2string(eig, precision=4)}); principal "
                          f"moments of inertia are strictly positive.")
+    if not eig[0] > 1e-12 * eig[-1]:
+        raise ValueError(f"{name} is too ill-conditioned to invert in float64 (eigenvalues "
+                         f"{np.array2string(eig, precision=4)}, smallest/largest < 1e-12); rescale the moments "
+                         f"(e.g. to units where the largest is 1) or drop the degenerate axis.")
     return 0.5 * (arr + arr.T)
 
 

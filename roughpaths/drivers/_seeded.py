@@ -47,6 +47,11 @@ def grid(times, dt, n_steps, t0):
     if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not np.isfinite(dt) or dt <= 0:
         raise ValueError(f"dt must be a positive finite number, got {dt!r}; pass times=... for a "
                          f"non-uniform grid.")
+    if isinstance(t0, bool) or not isinstance(t0, numbers.Real) or not np.isfinite(t0):
+        raise ValueError(f"t0 must be a finite number, got {t0!r}.")
+    if not np.isfinite(float(t0) + float(dt) * n):
+        raise ValueError(f"the grid t0 + dt * arange(n_steps + 1) overflows (t0={t0!r}, dt={dt!r}, n_steps={n}); "
+                         f"use a smaller dt or fewer steps.")
     return float(t0) + float(dt) * np.arange(n + 1, dtype=np.float64), np.full(n, float(dt))
 
 

@@ -154,10 +154,12 @@ def levy_area_terms(method: str, dim: int, h: float, error: float | None = None)
     dim = check_positive_int(dim, "dim")
     h = _check_positive(h, "h")
     error = h ** 1.5 if error is None else _check_positive(error, "error")
-    n = math.ceil((_coefficient(method, dim, h) / error) ** (1.0 / _ORDER[method]) - 1e-12)
-    if n > _MAX_TERMS:
-        raise ValueError(f"method {method!r} needs {n:.3g} terms per step for error={error:g} at h={h:g}, "
-                         f"d={dim}; ask for a larger error (the default is h^1.5) or a Gaussian-tail method.")
+    log_n = (math.log(_coefficient(method, dim, h)) - math.log(error)) / _ORDER[method]    # cannot overflow
+    if log_n > math.log(_MAX_TERMS):
+        raise ValueError(f"method {method!r} needs {math.exp(min(log_n, 700.0)):.3g} terms per step for "
+                         f"error={error:g} at h={h:g}, d={dim}, more than {_MAX_TERMS:.0e}; ask for a larger error "
+                         f"(the default is h^1.5) or a Gaussian-tail method.")
+    n = math.ceil(math.exp(log_n) - 1e-12)
     return max(1, int(n))
 
 
@@ -198,7 +200,9 @@ def choose_levy_area_method(dim: int, h: float, error: float | None = None) -> t
         if best is None or cost < best[0]:
             best = (cost, method, n)
     if best is None:
-        raise refusal
+        raise ValueError(f"levy_area='auto' needs more than {_MAX_TERMS:.0e} Fourier terms per step for error="
+                         f"{h ** 1.5 if error is None else error:g} at h={h:g}, d={dim}; ask for a larger levy_area_error (the default is "
+                         f"h^1.5).") from refusal
     return best[1], best[2]
 
 

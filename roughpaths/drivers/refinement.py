@@ -283,6 +283,9 @@ class RefinedBrownianDriver(Driver):
         self.dim, self.level, self.kind = coarse.dim, coarse.level, coarse.kind
         F = self.factor
         t = coarse.times
+        check_memory(8.0 * 3 * (float(coarse.n_steps) * F + 1),     # the fine grid and its temporaries
+                     f"the refined grid ({coarse.n_steps} steps x factor={F})",
+                     "refine by a smaller factor (refine twice, or by up to ~100 at once)")
         fine = (t[:-1, None] + coarse._h[:, None] * (np.arange(F) / F)).ravel()
         self.times = np.append(fine, t[-1])
         self.times.setflags(write=False)

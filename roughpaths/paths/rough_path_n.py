@@ -29,7 +29,7 @@ import numpy as np
 from .rough_path import RoughPath
 from ..algebra.tensor import (from_lyndon_coordinates, lyndon_coordinates, sigdim, tensor_exp,
                              tensor_inverse, tensor_log, tensor_product)
-from ..validation import as_float_array, check_antisymmetric, check_positive_int, check_times
+from ..validation import as_float_array, check_antisymmetric, check_memory, check_positive_int, check_times
 
 __all__ = ["RoughPathN"]
 
@@ -152,6 +152,8 @@ class RoughPathN:
         if v.shape[-2] < 2:
             raise ValueError(f"values needs at least 2 samples along axis -2, got shape {v.shape}.")
         d = v.shape[-1]
+        check_memory(8.0 * 3 * float(np.prod(v.shape[:-1], dtype=float)) * float(sigdim(d, level)),
+                     f"the level-{level} lift of {v.shape[:-1]} samples in d={d}", "lower level or lift fewer samples")
         inc = np.diff(v, axis=-2)
         z = np.zeros(inc.shape[:-1] + (sigdim(d, level),))
         z[..., :d] = inc

@@ -100,6 +100,11 @@ class _Level3(Solver):
         # Σ_k Σ_ij c^{ijk} D²V_k[V_j, V_i]
         if self.hessians is not None:
             Hs = np.asarray(self.hessians(y), dtype=np.float64)             # [..., k, a, b, c]
+            e = y.shape[-1]
+            if Hs.shape[-4:] != (d, e, e, e) or Hs.shape[:-4] not in ((), y.shape[:-1]):
+                raise ValueError(f"hessians(y) must return shape (..., d, e, e, e) = {y.shape[:-1] + (d, e, e, e)} "
+                                 f"with [..., k, a, b, c] = d_b d_c V_k^a, got {Hs.shape}; fix the callable "
+                                 f"or pass hessians=None for central differences.")
             for i in range(d):
                 for k in range(d):
                     w = (V @ c[..., i, :, k, None])[..., 0]                   # Σ_j c^{ijk} V_j

@@ -190,8 +190,10 @@ class VectorFields:
         try:
             return np.asarray(f(t, y))
         except TypeError as exc:
-            raise TypeError(f"calling {name} on y of shape {y.shape} failed: {exc}."
-                            f"{_signature_hint(raw, name) if not self.time_dependent else ''}") from None
+            hint = (_signature_hint(raw, name) if not self.time_dependent else
+                    f" With time_dependent=True, {name} is called as {name}(t, y): define it with two "
+                    f"arguments (t, y), or pass time_dependent=False for {name}(y).")
+            raise TypeError(f"calling {name} on y of shape {y.shape} failed: {exc}.{hint}") from None
         except Exception as exc:             # the user's callable failed on a valid probe point
             raise ValueError(f"calling {name} on the probe point y of shape {y.shape} raised "
                              f"{type(exc).__name__}: {exc}; {name} must be defined on (..., e) arrays.") from exc

@@ -68,7 +68,7 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
         return
     what = "logsignature" if log else "signature"
     check_memory(need, f"depth={depth} with d={d} and {batch} path(s): the {what} (sigdim({d}, {depth}) = "
-                 f"{dim} floats per path)", "lower depth, process the batch in smaller pieces, or use "
+                 f"{float(dim):.3g} floats per path)", "lower depth, process the batch in smaller pieces, or use "
                  "fewer dimensions")
 
 
