@@ -25,23 +25,39 @@ from .statistics import LeafReducer
 __all__ = ["fingerprint", "save_checkpoint", "load_checkpoint"]
 
 
+def _identity(obj, name: str) -> bytes:
+    """Bytes that identify ``obj`` across processes, or a refusal: a checkpoint never guesses.
+
+    A picklable object is identified by its pickle (a module-level function by its module and name) and,
+    for a function, by its code too (an edited body is another function). A lambda, a closure or a local
+    function does not pickle: nothing can prove that a later run passes the same one.
+    """
+    try:
+        ident = pickle.dumps(obj)
+    except Exception:                      # noqa: BLE001 - whatever pickling raises, the answer is the same
+        raise ValueError(f"{name}={obj!r} cannot be identified across runs (a lambda, a closure or a local "
+                         f"function, or an object holding one), so a resumed run could not prove it is the "
+                         f"same; with checkpoint=..., define {name} at module level (or as a picklable "
+                         f"callable object), or run without a checkpoint.") from None
+    code = getattr(obj, "__code__", None)
+    if code is not None:
+        ident += code.co_code + repr(code.co_consts).encode()
+    return ident
+
+
 def fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn_in, average_every,
                  record_every, chunk_size, keep_final, observable) -> str:
-    """A digest of what determines the numbers of a run (a checkpoint of another run is refused)."""
+    """A digest of what determines the numbers of a run (a checkpoint of another run is refused).
+
+    Raises ``ValueError`` when the system, the solver or the observable cannot be identified (see
+    :func:`_identity`).
+    """
     h = hashlib.sha256()
-    for part in (repr(system), repr(method), getattr(observable, "__qualname__", repr(observable)),
-                 (float(dt), int(n_steps), int(n_paths), int(seed), levy_area, int(burn_in), int(average_every),
-                  record_every, int(chunk_size), bool(keep_final))):
-        h.update(pickle.dumps(part))
+    for part in (_identity(system, "system"), _identity(method, "method"), _identity(observable, "observable"),
+                 pickle.dumps((float(dt), int(n_steps), int(n_paths), int(seed), levy_area, int(burn_in),
+                               int(average_every), record_every, int(chunk_size), bool(keep_final)))):
+        h.update(part)
     h.update(np.ascontiguousarray(mu0).tobytes())
-    try:                                   # the whole system when it pickles (inertia, Hamiltonian, ...)
-        h.update(pickle.dumps(system))
-    except Exception:                      # noqa: BLE001 - user callables that do not pickle: repr and arrays
-        pass
-    for name in ("xi", "s"):
-        value = getattr(system, name, None)
-        if value is not None:
-            h.update(np.ascontiguousarray(np.asarray(value, dtype=np.float64)).tobytes())
     return h.hexdigest()
 
 
@@ -81,7 +97,11 @@ def load_checkpoint(path, fingerprint):
     if str(arrays.get("__fingerprint__", "")) != fingerprint:
         raise ValueError(f"checkpoint {os.fspath(path)!r} belongs to a run with other arguments (system, mu0, "
                          f"sizes, seed, method or observable); pass another checkpoint file or delete this one.")
-    layout = json.loads(str(arrays["__layout__"]))
+    try:
+        layout = json.loads(str(arrays["__layout__"]))
+    except (KeyError, ValueError) as exc:
+        raise ValueError(f"checkpoint {os.fspath(path)!r} has no readable layout ({exc}); delete it to start the "
+                         f"run afresh.") from None
 
     def reducer(name):
         red = LeafReducer(arrays[name + "_mean"].shape[0])
@@ -91,8 +111,13 @@ def load_checkpoint(path, fingerprint):
         red._pending = np.array(arrays[name + "_pending"]).reshape(-1, red.moments.dim)
         return red
 
-    final = reducer("final")
-    tavg = reducer("tavg") if layout["tavg"] else None
-    snaps = [reducer(f"snap{k}") for k in range(layout["snaps"])]
-    finals = [arrays[f"finals{k}"] for k in range(layout["finals"])]
-    return int(arrays["__done__"]), final, tavg, snaps, finals
+    try:
+        final = reducer("final")
+        tavg = reducer("tavg") if layout["tavg"] else None
+        snaps = [reducer(f"snap{k}") for k in range(layout["snaps"])]
+        finals = [arrays[f"finals{k}"] for k in range(layout["finals"])]
+        done = int(arrays["__done__"])
+    except (KeyError, ValueError, TypeError) as exc:
+        raise ValueError(f"checkpoint {os.fspath(path)!r} is incomplete or damaged ({type(exc).__name__}: {exc}); "
+                         f"delete it to start the run afresh.") from None
+    return done, final, tavg, snaps, finals

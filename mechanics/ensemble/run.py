@@ -32,6 +32,8 @@ pools and clusters (a module-level function, not a lambda, as ``observable``).
 
 from __future__ import annotations
 
+import os
+
 from dataclasses import dataclass
 from typing import Callable
 
@@ -165,7 +167,7 @@ def _run_chunk(spec: _Spec, first: int, last: int):
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None, levy_area_error=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
                  chunk_size=256, block_steps=None, executor=None, keep_final=False,
-                 checkpoint=None) -> EnsembleResult:
+                 checkpoint=None, keep_checkpoint=False) -> EnsembleResult:
     r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
 
     Parameters
@@ -216,7 +218,12 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         (with a fingerprint of the run's arguments). If the file exists when the run starts, the
         finished chunks are taken from it and only the rest is simulated: a run killed at any moment
         and started again with the same arguments returns bitwise the result of an uninterrupted run.
-        A checkpoint of a different run is refused. The file is left in place at the end.
+        A checkpoint of a different run is refused, and so is a checkpointed run whose ``system``,
+        ``method`` or ``observable`` cannot be identified across processes (a lambda or a closure: a
+        resume could not prove it is the same; define it at module level). The file is removed when
+        the run completes, unless ``keep_checkpoint``.
+    keep_checkpoint : bool
+        Leave the checkpoint file in place after a completed run (default False).
 
     Returns
     -------
@@ -314,6 +321,11 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
             finals.append(fs)
         if checkpoint is not None:
             _save_checkpoint(checkpoint, fingerprint, done, final, tavg, snaps, finals)
+    if checkpoint is not None and not keep_checkpoint:
+        try:
+            os.unlink(checkpoint)
+        except FileNotFoundError:          # nothing was written (no chunk ran)
+            pass
     snap_steps = [] if record_every is None else list(range(0, n_steps + 1, record_every))
     return EnsembleResult(final=final.result(), time_average=None if tavg is None else tavg.result(),
                           snapshot_times=np.asarray(snap_steps, dtype=np.float64) * float(dt),

@@ -3,7 +3,10 @@
 Statement: ``run_ensemble(..., checkpoint=f)`` saves the statistics merged so far atomically after every
 chunk; a rerun with the same arguments resumes from ``f``, and its result (every count, mean and scatter
 matrix, the snapshots and the final states) is bitwise that of a run that was never interrupted, whether
-the first run was stopped by an exception or killed with SIGKILL. A checkpoint of another run is refused.
+the first run was stopped by an exception or killed with SIGKILL. A checkpoint of another run is refused,
+including one of a run with another observable; an observable (or system) that cannot be identified
+across processes (a lambda) is refused with checkpoint=...; a completed run removes its checkpoint unless
+``keep_checkpoint=True``.
 """
 
 import os
@@ -64,7 +67,7 @@ def test_resume_after_an_exception_is_bitwise(tmp_path):
 def test_checkpoint_of_another_run_is_refused(tmp_path):
     ck = tmp_path / "ck.npz"
     body = mechanics.rigid_body(**BODY)
-    mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, **dict(KW, n_paths=50))
+    mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, keep_checkpoint=True, **dict(KW, n_paths=50))
     with pytest.raises(ValueError, match="belongs to a run with other arguments"):
         mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, **dict(KW, seed=4, n_paths=50))
 
@@ -105,3 +108,45 @@ def test_sigkill_at_random_moments_then_resume_is_bitwise(tmp_path):
     assert kills >= 1
     assert not [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")]       # no half-written files
     _same(rp.load(tmp_path / "result.npz"), _reference())
+
+
+def _double(x):
+    return 2.0 * np.asarray(x)
+
+
+def _identity_obs(x):
+    return np.asarray(x, dtype=float)
+
+
+def test_another_observable_is_another_run_and_lambdas_are_refused(tmp_path):
+    ck = tmp_path / "ck.npz"
+    body = mechanics.rigid_body(**BODY)
+    kw = dict(KW, n_paths=50)
+    mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, keep_checkpoint=True, observable=_identity_obs,
+                           **kw)
+    with pytest.raises(ValueError, match="belongs to a run with other arguments"):
+        mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, observable=_double, **kw)
+    for fn in (lambda x: x, lambda x: 2 * x):
+        with pytest.raises(ValueError, match="observable=.*cannot be identified across runs.*module level"):
+            mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=tmp_path / "other.npz", observable=fn, **kw)
+    assert not (tmp_path / "other.npz").exists()
+
+
+def test_a_completed_run_removes_its_checkpoint_unless_kept(tmp_path):
+    ck = tmp_path / "ck.npz"
+    body = mechanics.rigid_body(**BODY)
+    mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, **dict(KW, n_paths=50))
+    assert not ck.exists()
+    mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, keep_checkpoint=True, **dict(KW, n_paths=50))
+    assert ck.exists()
+
+
+def test_a_damaged_checkpoint_names_the_file(tmp_path):
+    ck = tmp_path / "ck.npz"
+    body = mechanics.rigid_body(**BODY)
+    mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, keep_checkpoint=True, **dict(KW, n_paths=50))
+    with np.load(ck) as data:
+        arrays = {k: data[k] for k in data.files if k != "final_mean"}
+    np.savez(ck, **arrays)
+    with pytest.raises(ValueError, match="ck.npz.*incomplete or damaged.*delete it"):
+        mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, **dict(KW, n_paths=50))
