@@ -31,6 +31,7 @@ from datetime import datetime, timezone
 import importlib
 
 import mechanics
+import roughpaths
 
 from .output import OutputError, RunFolder
 from .report import (
@@ -53,6 +54,9 @@ __all__ = ["main", "build_parser", "parse_options", "Options", "UsageError", "ru
 PROG = "levy-area-paper"
 SCALES = ("tiny", "default", "full")
 CONVENTIONS = ("rp", "paper")
+#: accepted values of --levy-area: the library's vocabulary (roughpaths.drivers.areas)
+LEVY_AREA_METHODS = tuple(roughpaths.LEVY_AREA_METHODS)
+DEFAULT_LEVY_AREA = "auto"
 DEFAULT_OUTPUT = "paper-output"
 #: environment variable overriding the default size scale (used by the tests: ``tiny``)
 SCALE_ENV = "LEVY_AREA_PAPER_SCALE"
@@ -105,6 +109,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="'rp' (default): rough-path-correct signs and factors (docs/conventions.md); 'paper': "
                    "the paper's printed equations, slips included, to reproduce its figures literally")
     p.add_argument("--seed", default="0", metavar="INT", help="seed of every random stream (default 0)")
+    p.add_argument("--levy-area", default=DEFAULT_LEVY_AREA, metavar="METHOD",
+                   help=f"sampler of the Brownian Lévy areas in the figures and checks, one of "
+                   f"{', '.join(LEVY_AREA_METHODS)} (default {DEFAULT_LEVY_AREA}: the exact conditional law for "
+                   "d = 2, Mrongowius-Rössler with per-step L² error h^1.5 for d = 3, strong order 1; davie and "
+                   "foster are faster, strong order ½). 'exact' exists for d = 2 only: d = 3 drivers then use "
+                   "auto's sampler. The Gibbs check's ensembles use increments only, whatever this option.")
     size = p.add_mutually_exclusive_group()
     size.add_argument("--full", action="store_true",
                       help="paper-scale sizes (see docs/main-job.md for the measured cost; epsilon = 0.005 over "
@@ -128,6 +138,7 @@ class Options:
     resume: bool = False
     convention: str = "rp"
     seed: int = 0
+    levy_area: str = DEFAULT_LEVY_AREA
     scale: str = "default"
     only: list[str] | None = None
     list_only: bool = False
@@ -137,6 +148,8 @@ class Options:
     def command(self) -> str:
         """The command that reproduces the results (without the output folder)."""
         parts = [PROG, "--convention", self.convention, "--seed", str(self.seed)]
+        if self.levy_area != DEFAULT_LEVY_AREA:
+            parts += ["--levy-area", self.levy_area]
         if self.scale != "default":
             parts.append(f"--{self.scale}")
         if self.only:
@@ -157,6 +170,9 @@ def parse_options(argv: list[str] | None) -> Options:
         raise UsageError(f"--seed must be a non-negative integer, got {ns.seed!r}") from None
     if seed < 0:
         raise UsageError(f"--seed must be a non-negative integer, got {seed}")
+    levy_area = ns.levy_area.strip().lower()
+    if levy_area not in LEVY_AREA_METHODS:
+        raise UsageError(f"--levy-area must be one of {', '.join(LEVY_AREA_METHODS)}, got {ns.levy_area!r}")
     scale = "full" if ns.full else "tiny" if ns.tiny else None
     if scale is None:
         env = os.environ.get(SCALE_ENV, "").strip().lower()
@@ -190,7 +206,7 @@ def parse_options(argv: list[str] | None) -> Options:
     if ns.resume and ns.list:
         raise UsageError("--resume and --list do not go together")
     return Options(output=str(ns.output), overwrite=ns.overwrite, resume=ns.resume, convention=conv, seed=seed,
-                   scale=scale, only=only, list_only=ns.list, quiet=ns.quiet, argv=argv)
+                   levy_area=levy_area, scale=scale, only=only, list_only=ns.list, quiet=ns.quiet, argv=argv)
 
 
 def _run_tasks(opts: Options, folder: RunFolder, prog: Progress):
@@ -211,8 +227,8 @@ def _run_tasks(opts: Options, folder: RunFolder, prog: Progress):
                 reused.append(key)
                 prog.message(f"[{key}] finished before the interruption: reused ({res.status})")
             else:
-                ctx = Context(folder=folder, convention=opts.convention, seed=opts.seed, scale=opts.scale,
-                              progress=prog, cache=cache)
+                ctx = Context(folder=folder, convention=opts.convention, seed=opts.seed,
+                              levy_area=opts.levy_area, scale=opts.scale, progress=prog, cache=cache)
                 prog.message(f"[{key}] {task.title}")
                 t0 = time.perf_counter()
                 try:
@@ -268,8 +284,8 @@ def run(opts: Options) -> int:
     """
     prog = Progress(enabled=not opts.quiet)
     folder = RunFolder(opts.output)
-    run_info = {"seed": opts.seed, "convention": opts.convention, "scale": opts.scale, "only": opts.only,
-                "versions": versions()}
+    run_info = {"seed": opts.seed, "convention": opts.convention, "levy_area": opts.levy_area,
+                "scale": opts.scale, "only": opts.only, "versions": versions()}
     in_main_thread = threading.current_thread() is threading.main_thread()   # signals: main thread only
     previous = signal.signal(signal.SIGTERM, _on_sigterm) if in_main_thread else None
     try:
@@ -279,16 +295,19 @@ def run(opts: Options) -> int:
                 prog.message(f"{PROG}: '{folder.shown}' is complete (manifest.json verified); nothing to resume")
                 return 0
             started = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
-            prog.message(f"{PROG}: convention={opts.convention} seed={opts.seed} sizes={opts.scale} -> "
+            prog.message(f"{PROG}: convention={opts.convention} seed={opts.seed} levy-area={opts.levy_area} "
+                         f"sizes={opts.scale} -> "
                          f"{folder.show(folder.staging)}/ (renamed to {folder.shown}/ when complete)")
             t0 = time.perf_counter()
             figures, checks, sizes, timings, reused = _run_tasks(opts, folder, prog)
             meta = RunMetadata(command=opts.command(), seed=opts.seed, convention=opts.convention,
-                               scale=opts.scale, sizes=sizes, versions=run_info["versions"])
+                               scale=opts.scale, sizes=sizes, versions=run_info["versions"],
+                               levy_area=opts.levy_area)
             write_report(folder, meta, checks, figures)
             manifest = {
                 "package": "roughpaths-mechanics", "version": mechanics.__version__, "seed": opts.seed,
-                "convention": opts.convention, "scale": opts.scale, "only": opts.only, "command": opts.command(),
+                "convention": opts.convention, "levy_area": opts.levy_area, "scale": opts.scale, "only": opts.only,
+                "command": opts.command(),
                 "argv": opts.argv, "versions": run_info["versions"], "sizes": sizes, "started": started,
                 "finished": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
                 "seconds_this_process": time.perf_counter() - t0, "task_seconds": timings,

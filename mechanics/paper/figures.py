@@ -61,7 +61,7 @@ def _simulate_long(ctx, body, rng, T, dt, label, save_every):
         while done < n_steps:
             k = min(per, n_steps - done) if done + per < n_steps else n_steps - done
             driver = roughpaths.BrownianDriver(3, seed=np.random.SeedSequence(root, spawn_key=(chunk,)), dt=dt,
-                                               n_steps=k)
+                                               n_steps=k, levy_area=ctx.levy_area_for(3))
             keep = driver.times[save_every::save_every]
             sol = roughpaths.solve(body, driver, mu, mechanics.LieHeun(), save_at=np.append(keep, driver.times[-1]))
             states.append(sol.states[:keep.size])

@@ -5,7 +5,7 @@ The main job (``python -m mechanics``) collects, for every theorem / proposition
 figure, a :class:`FigureResult` (PNG and the ``.npz`` of the data behind it). :func:`write_report`
 turns them into ``report.md`` (figures linked), ``report.html`` (figures embedded as base64, no
 external resources) and ``results.json`` (the same results, machine-readable), with the run's
-metadata (the command that reproduces it, seed, convention, sizes, versions).
+metadata (the command that reproduces it, seed, convention, Lévy-area sampler, sizes, versions).
 
 The three files depend only on the results and the options, never on the clock or the output
 folder's name: the same run gives the same bytes (wall times and dates are in ``manifest.json``).
@@ -29,7 +29,7 @@ import roughpaths
 
 __all__ = [
     "CheckResult", "FigureResult", "RunMetadata", "format_value", "write_report", "versions",
-    "result_to_json", "result_from_json", "PASS", "FAIL", "ERROR",
+    "result_to_json", "result_from_json", "levy_area_text", "PASS", "FAIL", "ERROR",
 ]
 
 #: status strings of a check or figure
@@ -97,6 +97,7 @@ class RunMetadata:
     scale: str
     sizes: dict = field(default_factory=dict)
     versions: dict = field(default_factory=dict)
+    levy_area: str = "auto"
 
 
 def _jsonable(value):
@@ -189,6 +190,28 @@ _CONVENTION_TEXT = {
     "rp": "rough-path-correct signs and factors, see the project's docs/conventions.md",
     "paper": "the paper's printed equations, slips included",
 }
+_LEVY_AREA_TEXT = {
+    "auto": "exact conditional law for d = 2; Mrongowius–Rößler, per-step L² error h^1.5 for d = 3",
+    "exact": "exact conditional law for d = 2; d = 3 has no exact sampler and uses auto's: Mrongowius–Rößler, "
+             "per-step L² error h^1.5",
+    "mrongowius-rossler": "Mrongowius–Rößler Fourier series with Gaussian tail, per-step L² error h^1.5",
+    "wiktorsson": "Wiktorsson's Fourier series with Gaussian tail, per-step L² error h^1.5",
+    "fourier": "truncated Fourier series (Milstein), per-step L² error h^1.5, variance short by h² s_n/(2π²) per step",
+    "davie": "Davie: exact second moments, strong order ½ against Brownian motion",
+    "foster": "Foster: conditional mean given the space-time area, variance short by h²/12 per step, strong order ½",
+}
+_LEVY_AREA_NOTE = (
+    "The Lévy-area option applies to the Brownian drivers of the checks and figures that use areas; the Gibbs "
+    "check's ensembles (mechanics.run_ensemble) use increments only, and the coloured-noise figures and checks "
+    "lift their own paths."
+)
+
+
+def levy_area_text(method: str) -> str:
+    """The Lévy-area sampler of a run in words: ``method`` and what it samples (``"auto"`` resolved)."""
+    return f"{method} ({_LEVY_AREA_TEXT[method]})" if method in _LEVY_AREA_TEXT else str(method)
+
+
 _TIMING_NOTE = "Wall times and dates are in manifest.json (the report depends only on the results)."
 
 
@@ -200,6 +223,9 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
         "",
         f"Convention: **{meta.convention}** ({_CONVENTION_TEXT.get(meta.convention, meta.convention)})"
         f" · seed **{meta.seed}** · sizes **{meta.scale}**",
+        "",
+        f"Lévy areas: **{meta.levy_area}** ({_LEVY_AREA_TEXT.get(meta.levy_area, meta.levy_area)}). "
+        + _LEVY_AREA_NOTE,
         "",
         f"Checks: **{counts[PASS]} passed**, {counts[FAIL]} failed, {counts[ERROR]} errors.",
         "",
@@ -235,7 +261,8 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
             lines += [f"*{f.status}*: {_md_escape(f.details.strip().splitlines()[-1] if f.details else '')}", ""]
         lines += [f.caption, ""]
     lines += ["## Run metadata", "", f"- command: `{meta.command}`", f"- seed: {meta.seed}",
-              f"- convention: {meta.convention}", f"- sizes: {meta.scale}", f"- {_TIMING_NOTE}", ""]
+              f"- convention: {meta.convention}", f"- Lévy areas: {levy_area_text(meta.levy_area)}",
+              f"- sizes: {meta.scale}", f"- {_TIMING_NOTE}", ""]
     if meta.sizes:
         lines += ["| size parameter | value |", "|---|---|"]
         lines += [f"| {k} | {format_value(v)} |" for k, v in meta.sizes.items()]
@@ -270,6 +297,8 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
         "Correction</i></h1>",
         f"<p>Convention: <b>{e(meta.convention)}</b> ({e(_CONVENTION_TEXT.get(meta.convention, ''))}) · seed "
         f"<b>{meta.seed}</b> · sizes <b>{e(meta.scale)}</b></p>",
+        f"<p>Lévy areas: <b>{e(meta.levy_area)}</b> ({e(_LEVY_AREA_TEXT.get(meta.levy_area, meta.levy_area))}). "
+        f"{e(_LEVY_AREA_NOTE)}</p>",
         f"<p class='summary'>Checks: <b>{counts[PASS]} passed</b>, {counts[FAIL]} failed, "
         f"{counts[ERROR]} errors.</p>",
         f"<p>{e(_CONVENTION_NOTE)}</p>",
@@ -303,6 +332,7 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
               f"<tr><th>command</th><td><code>{e(meta.command)}</code></td></tr>",
               f"<tr><th>seed</th><td>{meta.seed}</td></tr>",
               f"<tr><th>convention</th><td>{e(meta.convention)}</td></tr>",
+              f"<tr><th>Lévy areas</th><td>{e(levy_area_text(meta.levy_area))}</td></tr>",
               f"<tr><th>sizes</th><td>{e(meta.scale)}</td></tr></table>",
               f"<p>{e(_TIMING_NOTE)}</p>"]
     if meta.sizes:

@@ -128,6 +128,10 @@ class Context:
         Where :meth:`save_figure` writes (None: nothing is saved, e.g. in tests of a single check).
     convention, seed, scale : str, int, str
         The run's options.
+    levy_area : str
+        The run's ``--levy-area``: the sampler of the Brownian Lévy areas (one of
+        :data:`roughpaths.LEVY_AREA_METHODS`). Every Brownian driver a task creates with areas passes
+        :meth:`levy_area_for` of its dimension (this value, but for ``"exact"`` at ``d > 2``).
     progress : Progress
     sizes : dict
         The sizes the current task picked (``size``), recorded for the report.
@@ -141,6 +145,7 @@ class Context:
     folder: Any = None
     convention: str = "rp"
     seed: int = 0
+    levy_area: str = "auto"
     scale: str = "default"
     progress: Progress = field(default_factory=lambda: Progress(enabled=False))
     sizes: dict = field(default_factory=dict)
@@ -154,6 +159,14 @@ class Context:
     def seed_for(self, name: str) -> int:
         """A non-negative integer seed derived from ``(seed, name)`` (for APIs taking a seed)."""
         return int(np.random.SeedSequence([self.seed, zlib.crc32(name.encode())]).generate_state(1, np.uint64)[0])
+
+    def levy_area_for(self, dim: int) -> str:
+        """The ``levy_area`` of a Brownian driver of dimension ``dim``: the run's ``--levy-area``.
+
+        ``"exact"`` samples ``d <= 2`` only; a ``d > 2`` driver then uses ``"auto"`` (Mrongowius–Rößler,
+        per-step L² error ``h^1.5``, strong order 1), as the report states (:func:`~.report.levy_area_text`).
+        """
+        return "auto" if self.levy_area == "exact" and dim > 2 else self.levy_area
 
     def size(self, key: str, *, tiny, default, full):
         """Pick a size for the current scale and record it for the report's metadata."""

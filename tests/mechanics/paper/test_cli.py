@@ -17,10 +17,11 @@ import sys
 
 import pytest
 
+import roughpaths
 from mechanics.paper.checks import CHECKS
 from mechanics.paper.cli import SCALE_ENV, UsageError, main, parse_options
 from mechanics.paper.figures import FIGURES
-from mechanics.paper.tasks import Progress
+from mechanics.paper.tasks import Context, Progress
 
 
 # ------------------------------------------------------------------------------------ option parsing
@@ -30,6 +31,7 @@ def test_defaults(monkeypatch):
     assert str(o.output) == "paper-output"
     assert (o.convention, o.seed, o.scale, o.only, o.quiet, o.overwrite, o.resume) == (
         "rp", 0, "default", None, False, False, False)
+    assert o.levy_area == "auto" and "--levy-area" not in o.command()
 
 
 def test_values(monkeypatch):
@@ -40,6 +42,49 @@ def test_values(monkeypatch):
     monkeypatch.setenv(SCALE_ENV, "tiny")
     assert parse_options([]).scale == "tiny"
     assert parse_options(["--full"]).scale == "full"  # the option beats the environment
+
+
+@pytest.mark.parametrize("method", roughpaths.LEVY_AREA_METHODS)
+def test_levy_area_values(method):
+    """Every method of the library is accepted (case-insensitively); command() names it unless default."""
+    o = parse_options(["--levy-area", method.upper()])
+    assert o.levy_area == method
+    assert ("--levy-area" in o.command()) == (method != "auto")
+    if method != "auto":
+        assert f"--levy-area {method}" in o.command()
+        assert parse_options(o.command().split()[1:]).levy_area == method   # the command reproduces it
+
+
+def test_bad_levy_area_names_the_accepted_values(capsys, tmp_path):
+    assert main(["--levy-area", "levy", "--output", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--levy-area" in err and "'levy'" in err
+    assert all(m in err for m in roughpaths.LEVY_AREA_METHODS), err
+    assert not (tmp_path / "o").exists()
+
+
+def test_levy_area_reaches_the_drivers(monkeypatch):
+    """The run's method is what the checks' Brownian drivers receive ('exact' at d = 3: 'auto')."""
+    import mechanics.paper.checks as checks
+    seen = []
+    real = roughpaths.brownian_rough_path
+
+    def spy(*args, **kwargs):
+        seen.append((args[1], kwargs.get("levy_area", "<default>")))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(checks.roughpaths, "brownian_rough_path", spy)
+    for method in ("davie", "exact"):
+        seen.clear()
+        for name in ("chen", "brownian_levy_area"):
+            assert CHECKS[name].run(Context(levy_area=method, scale="tiny")).passed
+        assert seen == [(3, "auto" if method == "exact" else method)] + [(2, method)] * 2, seen
+
+
+def test_help_names_levy_area(capsys):
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    assert "--levy-area" in out and all(m in out for m in roughpaths.LEVY_AREA_METHODS)
 
 
 def test_only_names_and_groups():
@@ -56,6 +101,8 @@ def test_only_names_and_groups():
     (["--seed", "x"], "--seed"),
     (["--seed", "-3"], "--seed"),
     (["--convention", "ito"], "--convention"),
+    (["--levy-area", "exakt"], "--levy-area must be one of davie, foster, exact"),
+    (["--levy-area", "none"], "--levy-area"),
     (["--only", "no_such_figure"], "unknown name 'no_such_figure'"),
     (["--only", ","], "--only"),
     (["--bogus"], "unrecognized arguments"),
@@ -161,12 +208,17 @@ def test_tiny_end_to_end_run(tiny_paper_run):
     for name in list(CHECKS):
         assert f"`{name}`" in md
     assert "seed **3**" in md
+    assert "Lévy areas: **auto** (exact conditional law for d = 2; Mrongowius–Rößler, per-step L² error h^1.5 " \
+           "for d = 3)" in md
+    assert "Lévy areas: <b>auto</b>" in page
     assert "http://" not in page and "https://" not in page  # self-contained
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["complete"] and manifest["seed"] == 3 and manifest["scale"] == "tiny"
+    assert manifest["levy_area"] == "auto"
     assert sorted(f["name"] for f in manifest["files"]) == sorted(p.name for p in out.iterdir()
                                                                    if p.name != "manifest.json")
     results = json.loads((out / "results.json").read_text())
+    assert results["metadata"]["levy_area"] == "auto"
     assert [c["name"] for c in results["checks"]] == list(CHECKS)
     for name in FIGURES:
         assert (out / f"{name}.png").stat().st_size > 10_000, name

@@ -156,6 +156,8 @@ def test_resume_verifies_pieces_and_refuses_other_options(tmp_path, capsys, monk
     assert main(["--tiny", "--quiet", "--only", "surf,chen,girsanov", "--seed", "1", "--output", str(out),
                  "--resume"]) == 2
     assert "seed: 0 then, 1 now" in _one_line(capsys.readouterr().err)
+    assert main(QUICK + ["--levy-area", "davie", "--output", str(out), "--resume"]) == 2
+    assert "levy_area: 'auto' then, 'davie' now" in _one_line(capsys.readouterr().err)
     with open(work / "surf.png", "r+b") as f:          # damage a finished figure
         f.seek(1000)
         f.write(b"\0\0\0\0")
@@ -168,6 +170,21 @@ def test_resume_verifies_pieces_and_refuses_other_options(tmp_path, capsys, monk
     other = tmp_path / "other"
     assert main(QUICK + ["--output", str(other), "--resume"]) == 0
     assert _files(other) == reference
+
+
+def test_report_states_the_levy_area_method(tmp_path):
+    """A non-default --levy-area is in the report (Markdown, HTML, results.json), the command and the manifest."""
+    out = tmp_path / "run"
+    assert main(["--tiny", "--quiet", "--only", "chen,brownian_levy_area", "--levy-area", "Foster",
+                 "--output", str(out)]) == 0
+    md, page = (out / "report.md").read_text(), (out / "report.html").read_text()
+    assert "Lévy areas: **foster** (Foster: conditional mean given the space-time area" in md
+    assert "- Lévy areas: foster (" in md and "--levy-area foster" in md
+    assert "Lévy areas: <b>foster</b>" in page and "<th>Lévy areas</th><td>foster (" in page
+    assert "levy_area='foster'" in md     # the check that depends on the method says which it used
+    assert json.loads((out / "results.json").read_text())["metadata"]["levy_area"] == "foster"
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["levy_area"] == "foster" and "--levy-area foster" in manifest["command"]
 
 
 def test_overwrite_discards_an_unfinished_run(tmp_path, monkeypatch, reference):
