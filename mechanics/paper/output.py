@@ -214,6 +214,10 @@ class RunFolder:
         :attr:`already_complete` (``--resume`` of a run that had finished).
         """
         assert self._lock_fd is not None, "acquire() first"
+        self._recover_replaced(notify)
+        if overwrite and os.path.ismount(self.final):
+            raise OutputError(f"output folder '{self.shown}' is a mount point: a completed run is renamed into place, "
+                              f"which a mount point cannot be; pass --output '{self.shown}/run' (a folder inside it)")
         final_used = self.final.is_dir() and any(self.final.iterdir())
         if final_used and not overwrite:
             if resume and not self.staging.exists() and self._verify_manifest(self.final):
@@ -241,6 +245,30 @@ class RunFolder:
         elif resume:
             notify(f"nothing to resume for '{self.shown}' (no '{self.show(self.staging)}'): starting a new run")
         self._start(run)
+
+    def _recover_replaced(self, notify) -> None:
+        """Report and clean up what a kill between the two renames of ``--overwrite`` left.
+
+        ``_rename_into_place`` first moves the previous run aside as ``.OUT.replaced-PID``, then the new one
+        into place, then deletes the previous one. If ``OUT`` exists, the replacement had completed: the
+        leftover is deleted. If not, the newest leftover is the previous run: it is restored to ``OUT``
+        (the new, complete run stays in ``OUT.incomplete``, where ``--resume`` finishes it).
+        """
+        leftovers = sorted(self.parent.glob(f".{self.final.name}.replaced-*"), key=lambda p: p.stat().st_mtime)
+        if not leftovers:
+            return
+        if not self.final.exists():
+            newest = leftovers.pop()
+            try:
+                os.replace(newest, self.final)
+            except OSError as exc:
+                raise OutputError(f"cannot restore '{self.show(newest)}' to '{self.shown}': {_why(exc)}") from None
+            notify(f"restored '{self.shown}' from '{self.show(newest)}', where an interrupted --overwrite had "
+                   f"moved it")
+        for old in leftovers:
+            self._remove_tree(old)
+            notify(f"removed '{self.show(old)}', a previous run that an interrupted --overwrite had already "
+                   f"replaced")
 
     def _remove_tree(self, path: Path) -> None:
         try:

@@ -266,3 +266,35 @@ def test_sigterm_leaves_a_marked_unfinished_run(tmp_path):
     assert proc.returncode == 128 + signal.SIGTERM, err
     assert not out.exists() and (work / "INCOMPLETE.txt").is_file()
     assert "--resume" in err and "Traceback" not in err
+
+
+def test_a_previous_run_hidden_by_an_interrupted_overwrite_is_restored_or_cleaned(tmp_path, capsys):
+    """A kill between the two renames of --overwrite left '.run.replaced-PID': reported and cleaned up."""
+    out = tmp_path / "run"
+    assert main(["--tiny", "--quiet", "--only", "chen", "--output", str(out)]) == 0
+    before = _files(out)
+    hidden = tmp_path / ".run.replaced-12345"
+    out.rename(hidden)                               # the state after the first rename only
+    assert main(["--tiny", "--only", "planar_constant", "--output", str(out)]) == 2     # no --overwrite
+    err = capsys.readouterr()
+    assert "restored" in err.out + err.err and not hidden.exists()
+    assert _files(out) == before                     # the previous run is back, intact
+    stale = tmp_path / ".run.replaced-999"
+    stale.mkdir()
+    (stale / "report.md").write_text("old")
+    assert main(["--tiny", "--only", "planar_constant", "--output", str(out), "--overwrite"]) == 0
+    err = capsys.readouterr()
+    assert "removed" in err.out + err.err and not stale.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+
+
+def test_overwrite_refuses_a_mount_point_before_the_run(tmp_path, capsys, monkeypatch):
+    import mechanics.paper.output as output
+
+    out = tmp_path / "run"
+    assert main(["--tiny", "--quiet", "--only", "chen", "--output", str(out)]) == 0
+    real = output.os.path.ismount
+    monkeypatch.setattr(output.os.path, "ismount", lambda p: Path(p) == out or real(p))
+    assert main(["--tiny", "--quiet", "--only", "chen", "--output", str(out), "--overwrite"]) == 2
+    assert "mount point" in _one_line(capsys.readouterr().err)
+    assert not (tmp_path / "run.incomplete").exists()
