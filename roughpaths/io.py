@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from .paths.rough_path import RoughPath
+from .validation import check_memory
 from .rde.integrate import Solution
 
 __all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "FORMAT", "FORMAT_VERSION"]
@@ -56,6 +57,7 @@ __all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "
 FORMAT = "roughpaths-npz"
 FORMAT_VERSION = 1
 _META_KEY = "__metadata__"
+_MAX_DEPTH = 64                  # metadata nesting, on save and on load
 _CONVENTIONS = {
     "area": "XX[..., i, j] over [s, t] = int_s^t (X^i_r - X^i_s) dX^j_r (iisignature/esig ordering: "
             "word (i, j) <-> entry [i, j])",
@@ -96,19 +98,22 @@ def _package_version() -> str:
     return __version__
 
 
-def _to_json(value, where: str):
+def _to_json(value, where: str, depth: int = 0):
     """``value`` as JSON-ready data; tuples tagged so that they come back as tuples."""
+    if depth > _MAX_DEPTH:
+        raise ValueError(f"{where} is nested deeper than {_MAX_DEPTH} levels (or refers to itself); save flatter "
+                         f"metadata.")
     if isinstance(value, tuple):
-        return {"__tuple__": [_to_json(v, f"{where}[{i}]") for i, v in enumerate(value)]}
+        return {"__tuple__": [_to_json(v, f"{where}[{i}]", depth + 1) for i, v in enumerate(value)]}
     if isinstance(value, list):
-        return [_to_json(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return [_to_json(v, f"{where}[{i}]", depth + 1) for i, v in enumerate(value)]
     if isinstance(value, dict):
         out = {}
         for k, v in value.items():
             if not isinstance(k, str):
                 raise TypeError(f"{where} has the key {k!r} of type {type(k).__name__}; only str keys can be "
                                 f"saved (JSON).")
-            out[k] = _to_json(v, f"{where}[{k!r}]")
+            out[k] = _to_json(v, f"{where}[{k!r}]", depth + 1)
         return out
     if isinstance(value, np.generic):
         value = value.item()
@@ -210,7 +215,11 @@ def save(obj, path, *, seed=None, metadata=None) -> Path:
         **extra,
     }
     payload = {name: np.asarray(a, order="C") for name, a in arrays.items()}   # keeps 0-d arrays 0-d
-    payload[_META_KEY] = np.array(json.dumps(meta, ensure_ascii=False))
+    try:
+        payload[_META_KEY] = np.array(json.dumps(meta, ensure_ascii=False, allow_nan=False))   # strict JSON
+    except ValueError:
+        raise ValueError("metadata holds NaN or infinity, which strict JSON cannot store; pass finite numbers "
+                         "(or strings such as 'nan') in metadata and stats.") from None
 
     target = Path(_fspath(path))
     if target.suffix != ".npz":
@@ -248,10 +257,58 @@ def atomic_savez(target, arrays: dict) -> Path:
     return target
 
 
+def _depth(value, limit: int = _MAX_DEPTH) -> None:
+    """Refuse metadata nested deeper than ``limit`` (iteratively: a deep file cannot exhaust the stack)."""
+    stack = [(value, 0)]
+    while stack:
+        v, level = stack.pop()
+        if level > limit:
+            raise ValueError(f"metadata nested deeper than {limit} levels")
+        if isinstance(v, dict):
+            stack.extend((x, level + 1) for x in v.values())
+        elif isinstance(v, list):
+            stack.extend((x, level + 1) for x in v)
+
+
+def _check_entries(p: Path) -> None:
+    """Read every ``.npy`` header of the archive and check the declared sizes before any array is read."""
+    total = 0.0
+    try:
+        with zipfile.ZipFile(p) as zf:
+            for info in zf.infolist():
+                with zf.open(info) as fh:
+                    version = np.lib.format.read_magic(fh)
+                    read = np.lib.format.read_array_header_1_0 if version == (1, 0) else \
+                        np.lib.format.read_array_header_2_0
+                    shape, _, dtype = read(fh)
+                    header = fh.tell()
+                if dtype.hasobject:
+                    raise ValueError(f"{p}: entry {info.filename!r} holds Python objects; not a roughpaths file.")
+                nbytes = float(np.prod(shape, dtype=float)) * dtype.itemsize
+                if info.file_size - header != nbytes:
+                    raise ValueError(f"{p}: entry {info.filename!r} declares shape {shape} of {dtype} "
+                                     f"({nbytes:.3g} bytes) but holds {info.file_size - header} bytes; the file is "
+                                     f"corrupt or forged.")
+                total += nbytes
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise ValueError(f"{p} is not a readable .npz file ({exc}); it is not a file written by roughpaths.save, "
+                         f"or it is truncated or corrupt.") from None
+    except ValueError as exc:
+        if str(exc).startswith(str(p)):
+            raise
+        raise ValueError(f"{p}: an array header is unreadable ({exc}); the file is corrupt.") from None
+    check_memory(total, f"the arrays of {p}", "load it on a machine with more memory, or set ROUGHPATHS_MAX_BYTES")
+
+
 def _open(path):
     p = Path(_fspath(path))
     if not p.exists():
         raise FileNotFoundError(f"no such file: {p}")
+    if not p.is_file():
+        raise ValueError(f"{p} is not a regular file (a folder, a pipe or a device); load reads .npz files written "
+                         f"by roughpaths.save.")
+    if zipfile.is_zipfile(p):
+        _check_entries(p)
     try:
         data = np.load(p, allow_pickle=False)
     except (ValueError, OSError, zipfile.BadZipFile, EOFError) as exc:
@@ -268,8 +325,10 @@ def _metadata(p: Path, data) -> dict:
                          f"the arrays {sorted(data.files)}; read it with numpy.load).")
     try:
         meta = json.loads(str(data[_META_KEY][()]))
-    except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
-        raise ValueError(f"{p}: the metadata entry is unreadable ({exc}); the file is corrupt.") from None
+        _depth(meta)
+    except (ValueError, RecursionError, zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise ValueError(f"{p}: the metadata entry is unreadable ({type(exc).__name__}: {exc}); the file is "
+                         f"corrupt.") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise ValueError(f"{p}: the metadata does not declare format {FORMAT!r}; not a roughpaths file.")
     version = meta.get("format_version")
@@ -348,6 +407,10 @@ def load(path):
             except (KeyError, ValueError, TypeError) as exc:
                 raise ValueError(f"{p}: the stored {kind} is inconsistent ({exc}); the file is corrupt.") from None
         names = _ARRAYS[kind] + (("areas",) if kind == "RoughPath" and meta.get("level") == 2 else ())
+        if kind == "RoughPath" and meta.get("level") not in (1, 2):
+            raise ValueError(f"{p}: metadata level {meta.get('level')!r}, expected 1 or 2; the file is corrupt.")
+        if kind == "RoughPath" and meta.get("level") == 1 and "areas" in data.files:
+            raise ValueError(f"{p}: the metadata says level 1 but the file holds areas; the file is corrupt.")
         missing = [n for n in names if n not in data.files]
         if missing:
             raise ValueError(f"{p}: the {kind} arrays {missing} are missing; the file is corrupt.")
@@ -364,13 +427,33 @@ def load(path):
         if a.dtype != np.float64:
             raise ValueError(f"{p}: array {n!r} has dtype {a.dtype}, expected float64; the file is corrupt.")
     if kind == "Solution":
+        if arrays["times"].ndim != 1 or arrays["states"].ndim < 2 or \
+                arrays["states"].shape[-2] != arrays["times"].shape[0]:
+            raise ValueError(f"{p}: times of shape {arrays['times'].shape} and states of shape "
+                             f"{arrays['states'].shape} disagree (states must be (..., len(times), e)); the file is "
+                             f"corrupt.")
         failed = None
         if "failed_step" in data_files:
             failed = failed_arr
         return Solution(times=arrays["times"], states=arrays["states"], failed_step=failed,
                         stats=_from_json(meta.get("stats", {})))
     try:
-        return RoughPath(arrays["increments"], arrays.get("areas"), times=arrays["times"], x0=arrays["x0"],
-                         kind=meta.get("kind"))
+        X = RoughPath(arrays["increments"], arrays.get("areas"), times=arrays["times"], x0=arrays["x0"],
+                      kind=meta.get("kind"))
     except ValueError as exc:
         raise ValueError(f"{p}: the stored rough path is inconsistent ({exc}); the file is corrupt.") from None
+    bs = meta.get("batch_shape")
+    declared = (meta.get("dim"), meta.get("n_steps"), tuple(bs) if isinstance(bs, list) else bs)
+    if declared != (X.dim, X.n_steps, tuple(X.batch_shape)):
+        raise ValueError(f"{p}: the metadata declares dim, n_steps, batch_shape = {declared}, the arrays have "
+                         f"{(X.dim, X.n_steps, tuple(X.batch_shape))}; the file is corrupt.")
+    if X.kind == "ito":                       # Itô areas: Sym(XX) = ½ X⊗X − ½ h I
+        h = np.diff(X.times)[:, None, None]
+        strat = arrays["areas"] + 0.5 * h * np.eye(X.dim)
+        sym = 0.5 * (strat + np.swapaxes(strat, -1, -2)) - 0.5 * arrays["increments"][..., :, None] * \
+            arrays["increments"][..., None, :]
+        scale = 1.0 + float(np.max(np.abs(strat), initial=0.0))
+        if float(np.max(np.abs(sym), initial=0.0)) > 1e-9 * scale:
+            raise ValueError(f"{p}: the metadata says kind 'ito' but the areas' symmetric part is not "
+                             f"½ X⊗X − ½ h I (off by {float(np.max(np.abs(sym))):.3g}); the file is corrupt.")
+    return X

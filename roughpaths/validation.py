@@ -27,7 +27,17 @@ __all__ = [
     "memory_budget",
     "check_work",
     "work_budget",
+    "arrays_equal",
 ]
+
+
+def arrays_equal(a, b) -> bool:
+    """``True`` if ``a`` and ``b`` are both None, or arrays of the same shape with equal entries (NaN equal to
+    NaN): the equality of results saved and loaded (``==`` on ``RoughPath``, ``Solution``, ``EnsembleResult``)."""
+    if a is None or b is None:
+        return a is None and b is None
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=a.dtype.kind == "f"))
 
 
 def _describe(x) -> str:

@@ -12,13 +12,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from roughpaths import register_format
+from roughpaths.validation import arrays_equal
 
 from .statistics import RunningMoments, split_moment_features
 
 __all__ = ["EnsembleResult"]
 
 
-@dataclass
+@dataclass(eq=False)
 class EnsembleResult:
     """Output of :func:`run_ensemble`.
 
@@ -47,6 +48,18 @@ class EnsembleResult:
     dt: float
     seed: int
     state_dim: int = 0
+
+    def __eq__(self, other) -> bool:
+        """Equal statistics, snapshot times and final states (entry by entry) and equal sizes and seed."""
+        if not isinstance(other, EnsembleResult):
+            return NotImplemented
+        return (self.final == other.final and self.time_average == other.time_average
+                and self.snapshots == other.snapshots and arrays_equal(self.snapshot_times, other.snapshot_times)
+                and arrays_equal(self.final_states, other.final_states)
+                and (self.n_paths, self.n_steps, self.dt, self.seed, self.state_dim)
+                == (other.n_paths, other.n_steps, other.dt, other.seed, other.state_dim))
+
+    __hash__ = None
 
     def moments(self, which: str = "time_average"):
         """For the default observable: ``(mean (n,), second_moment (n, n), se_mean (n,), se_second (n, n))``
@@ -93,6 +106,18 @@ def _encode_ensemble(res: "EnsembleResult"):
 
 
 def _decode_ensemble(meta, arrays):
+    """The inverse of :func:`_encode_ensemble`; refuses arrays that disagree with each other or the metadata."""
+    n, paths = meta["state_dim"], meta["n_paths"]
+    fs = arrays.get("final_states")
+    if fs is not None and fs.shape != (paths, n):
+        raise ValueError(f"final_states has shape {fs.shape}, but n_paths={paths} and state_dim={n}")
+    dims = {arrays[k].shape for k in arrays if k.endswith("_mean")}
+    scat = {arrays[k].shape for k in arrays if k.endswith("_scatter")}
+    if len(dims) != 1 or {(d[0], d[0]) for d in dims} != scat or len(next(iter(dims))) != 1:
+        raise ValueError(f"the statistics' means {sorted(dims)} and scatter matrices {sorted(scat)} disagree")
+    if arrays["snapshot_times"].shape != (meta["n_snapshots"],):
+        raise ValueError(f"snapshot_times has shape {arrays['snapshot_times'].shape}, but n_snapshots="
+                         f"{meta['n_snapshots']}")
     return EnsembleResult(
         final=_moments_from_arrays(arrays, "final_"),
         time_average=_moments_from_arrays(arrays, "time_average_") if meta["has_time_average"] else None,

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from roughpaths.validation import as_float_array, check_memory, check_positive_int
+from roughpaths.validation import arrays_equal, as_float_array, check_memory, check_positive_int
 
 __all__ = ["RunningMoments", "moment_observable", "split_moment_features", "LeafReducer", "LEAF"]
 
@@ -101,6 +101,14 @@ class RunningMoments:
         out = RunningMoments(self.dim)
         out.count, out.mean, out.scatter = self.count, self.mean.copy(), self.scatter.copy()
         return out
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, RunningMoments):
+            return NotImplemented
+        return (self.dim == other.dim and self.count == other.count and arrays_equal(self.mean, other.mean)
+                and arrays_equal(self.scatter, other.scatter))
+
+    __hash__ = None
 
     def __repr__(self) -> str:
         return f"RunningMoments(dim={self.dim}, count={self.count})"

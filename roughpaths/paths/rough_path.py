@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..validation import as_float_array, check_antisymmetric, check_times
+from ..validation import arrays_equal, as_float_array, check_antisymmetric, check_times
 from ..algebra.level2 import outer
 
 __all__ = ["RoughPath", "chen_defect"]
@@ -391,6 +391,16 @@ class RoughPath:
         r"""Per-path :math:`\max_k |\mathrm{Sym}(\mathbb{X}_k) - \tfrac12 X_k\otimes X_k|`, shape ``(...)``."""
         self._need_level2("geometric_defect")
         return np.max(_geometric_defect(self._increments, self._areas), axis=-1)
+
+    def __eq__(self, other) -> bool:
+        """Same kind and level, and equal times, start, increments and areas (entry by entry, NaN equal)."""
+        if not isinstance(other, RoughPath):
+            return NotImplemented
+        return (self._kind == other._kind and self.level == other.level
+                and all(arrays_equal(getattr(self, n), getattr(other, n))
+                        for n in ("_times", "_x0", "_increments", "_areas")))
+
+    __hash__ = None
 
     def __repr__(self) -> str:
         return (f"RoughPath(level={self.level}, kind={self._kind!r}, d={self.dim}, n_steps={self.n_steps}, "

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
+from ..validation import arrays_equal, as_float_array, check_memory, check_positive_int, check_same_batch
 from ..drivers.base import Driver
 from ..paths.rough_path import RoughPath
 from ..paths.rough_path_n import RoughPathN
@@ -50,7 +50,7 @@ class NonFiniteStateError(ValueError):
         self.steps = tuple(steps)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Solution:
     """Result of :func:`solve`.
 
@@ -77,6 +77,15 @@ class Solution:
     def final(self) -> np.ndarray:
         """The state at the last saved time, shape ``(..., e)``."""
         return self.states[..., -1, :]
+
+    def __eq__(self, other) -> bool:
+        """Equal times, states and failed steps (entry by entry, NaN equal) and equal ``stats``."""
+        if not isinstance(other, Solution):
+            return NotImplemented
+        return (arrays_equal(self.times, other.times) and arrays_equal(self.states, other.states)
+                and arrays_equal(self.failed_step, other.failed_step) and self.stats == other.stats)
+
+    __hash__ = None
 
     @property
     def failed(self) -> np.ndarray:
