@@ -40,6 +40,7 @@ from .integrators import (
     check_on_orbit,
 )
 from .systems import (
+    CotangentLift,
     Hamiltonian,
     HeavyTop,
     LieAlgebra,
@@ -49,6 +50,7 @@ from .systems import (
     SE3Algebra,
     SO3Algebra,
     check_inertia,
+    cotangent_lift,
     girsanov_shift,
     hat,
     heavy_top,
@@ -78,6 +80,8 @@ __all__ = [
     # Lie–Poisson systems
     "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
+    # phase space and reduction (Section 2.3)
+    "CotangentLift", "cotangent_lift",
     # integrators
     "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "check_on_orbit",
     # equilibria, phase portraits, Gibbs measures

@@ -5,9 +5,11 @@ constants) with their coadjoint exponentials; :mod:`.hamiltonian` the Hamiltonia
 check; :mod:`.lie_poisson` the stochastic Lie–Poisson system (SALT noise, the Lévy-area velocity
 :math:`\ell = \tfrac12\sum s^{ij}[\xi_i, \xi_j]`, double-bracket dissipation) that every solver in
 :mod:`mechanics.integrators` integrates; :mod:`.rigid_body` and :mod:`.heavy_top` are its two worked
-examples on so(3)* and se(3)*.
+examples on so(3)* and se(3)*; :mod:`.cotangent_lift` lifts a system to the rough symplectic system
+on phase space that reduces to it (Section 2.3).
 """
 
+from .cotangent_lift import CotangentLift, cotangent_lift
 from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
 from .heavy_top import HeavyTop, heavy_top
 from .lie_algebra import (LieAlgebra, SE3Algebra, SO3Algebra, hat, rodrigues_ad_star_exp, se3, se3_ad_star_exp, sl2r,
@@ -21,4 +23,5 @@ __all__ = [
     "Hamiltonian", "QuadraticHamiltonian", "check_inertia",
     "LiePoissonSystem", "levy_velocity", "girsanov_shift",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
+    "CotangentLift", "cotangent_lift",
 ]
