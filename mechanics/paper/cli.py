@@ -117,8 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "auto's sampler. The Gibbs check's ensembles use increments only, whatever this option.")
     size = p.add_mutually_exclusive_group()
     size.add_argument("--full", action="store_true",
-                      help="paper-scale sizes (see docs/main-job.md for the measured cost; epsilon = 0.005 over "
-                      "T = 500 for Figures 4-5)")
+                      help="paper-scale sizes: about 8 min of CPU time and 1.2 GB of memory (docs/main-job.md); "
+                      "epsilon = 0.005 over T = 500 for Figures 4-5")
     size.add_argument("--tiny", action="store_true",
                       help="smoke-test sizes (seconds; numbers not meaningful, checks may fail)")
     p.add_argument("--only", action="append", default=None, metavar="NAMES",
