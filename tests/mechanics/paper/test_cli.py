@@ -76,7 +76,7 @@ def test_levy_area_reaches_the_drivers(monkeypatch):
     monkeypatch.setattr(checks.roughpaths, "brownian_rough_path", spy)
     for method in ("davie", "exact"):
         seen.clear()
-        for name in ("chen", "brownian_levy_area"):
+        for name in ("levy_log", "brownian_levy_area"):
             assert CHECKS[name].run(Context(levy_area=method, scale="tiny")).passed
         assert seen == [(3, "auto" if method == "exact" else method)] + [(2, method)] * 2, seen
 
