@@ -58,6 +58,7 @@ FORMAT = "roughpaths-npz"
 FORMAT_VERSION = 1
 _META_KEY = "__metadata__"
 _MAX_DEPTH = 64                  # metadata nesting, on save and on load
+_MAX_EXPANSION = 200             # compressed entries expanding more than this (and past 64 MiB): refused
 _CONVENTIONS = {
     "area": "XX[..., i, j] over [s, t] = int_s^t (X^i_r - X^i_s) dX^j_r (iisignature/esig ordering: "
             "word (i, j) <-> entry [i, j])",
@@ -272,7 +273,7 @@ def _depth(value, limit: int = _MAX_DEPTH) -> None:
 
 def _check_entries(p: Path) -> None:
     """Read every ``.npy`` header of the archive and check the declared sizes before any array is read."""
-    total = 0.0
+    total, packed, compressed = 0.0, 0, False
     try:
         with zipfile.ZipFile(p) as zf:
             for info in zf.infolist():
@@ -290,6 +291,8 @@ def _check_entries(p: Path) -> None:
                                      f"({nbytes:.3g} bytes) but holds {info.file_size - header} bytes; the file is "
                                      f"corrupt or forged.")
                 total += nbytes
+                packed += info.compress_size
+                compressed |= info.compress_type != zipfile.ZIP_STORED
     except (zipfile.BadZipFile, OSError, EOFError) as exc:
         raise ValueError(f"{p} is not a readable .npz file ({exc}); it is not a file written by roughpaths.save, "
                          f"or it is truncated or corrupt.") from None
@@ -297,6 +300,10 @@ def _check_entries(p: Path) -> None:
         if str(exc).startswith(str(p)):
             raise
         raise ValueError(f"{p}: an array header is unreadable ({exc}); the file is corrupt.") from None
+    if compressed and total > _MAX_EXPANSION * max(packed, 1) and total > 2**26:
+        raise ValueError(f"{p} expands from {packed / 2**20:.3g} MiB of compressed entries to {total / 2**30:.3g} GiB "
+                         f"(more than {_MAX_EXPANSION}x): roughpaths.save never compresses, and a file this "
+                         f"compressible is forged (a zip bomb) or not ours; load it with numpy.load if you trust it.")
     check_memory(total, f"the arrays of {p}", "load it on a machine with more memory, or set ROUGHPATHS_MAX_BYTES")
 
 

@@ -31,6 +31,8 @@ CASES = [
      ValueError, ["terms", "larger error"]),
     ("auto beyond the term limit", lambda: rp.BrownianDriver(3, seed=0, dt=0.1, n_steps=2, levy_area_error=1e-300),
      ValueError, ["levy_area='auto'", "levy_area_error"]),
+    ("lift of 9 points in 1000 dimensions", lambda: rp.RoughPathN.from_path(np.zeros((9, 1000)), 3), ValueError,
+     ["level-3 lift", "memory budget"]),
     ("level-50 lift", lambda: rp.RoughPathN.from_path(np.zeros((5, 2)), 50), ValueError, ["level", "lower level"]),
     ("signature depth 1000", lambda: rp.signature(np.zeros((5, 2)), 1000), ValueError, ["depth=1000", "e+301"]),
     ("1-D path hint", lambda: rp.signature(np.zeros(5), 2), ValueError, ["paths[:, None]"]),

@@ -75,6 +75,19 @@ def test_a_header_claiming_1e12_elements_is_refused_before_allocating(tmp_path, 
         rp.load(forged)
 
 
+def test_a_zip_bomb_is_refused_before_expanding(tmp_path, saved):
+    """A few hundred KiB of compressed zeros declaring 80 MB: refused from the headers, not inflated."""
+    X, path = saved
+    with np.load(path, allow_pickle=False) as data:
+        arrays = {k: data[k] for k in data.files}
+    arrays["x0"] = np.zeros((10**7,))
+    bomb = tmp_path / "bomb.npz"
+    np.savez_compressed(bomb, **arrays)
+    assert bomb.stat().st_size < 10**6
+    with pytest.raises(ValueError, match="bomb.npz expands from .* MiB .* zip bomb"):
+        rp.load(bomb)
+
+
 def test_declared_sizes_are_checked_against_the_budget(tmp_path, saved, monkeypatch):
     _, path = saved
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", "100")
