@@ -41,6 +41,10 @@ for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy top) those 
 :mod:`mechanics.integrators._se3_kernels`; otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
 :func:`roughpaths.expm_batched` per member otherwise). Either way a batch member's result depends
 on its own data only; a member that fails is reported through ``first_bad`` (contract item 8).
+
+Forces (``force``, ``noise_forces`` of the system) are added outside the group update, on the numpy
+path, by :mod:`mechanics.integrators._forced` (orders and Casimirs stated there); the compiled
+kernels, and so systems without forces, are unchanged.
 """
 
 from __future__ import annotations
@@ -56,6 +60,7 @@ from ..systems.lie_algebra import SE3Algebra, SO3Algebra
 from ..systems.lie_poisson import LiePoissonSystem
 from . import _se3_kernels, _so3_kernels
 from ._chord import chord_solve
+from ._forced import forced_sigma_and_state
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
            "check_on_orbit"]
@@ -141,6 +146,31 @@ class CoadjointSolver(Solver):
         ok[live] = ok_l
         return new, ok, conv
 
+    def _advance_forced(self, system, mu, dt, eta, dx, dxx):
+        """One step of the forced scheme (:mod:`._forced`): ``(new mu, ok, converged)``."""
+        n, m = mu.shape[-1], dx.shape[-1]
+        batch = np.broadcast_shapes(np.shape(mu)[:-1], np.shape(eta)[:-1], np.shape(dx)[:-1])
+        mu = np.broadcast_to(np.asarray(mu, dtype=np.float64), batch + (n,))
+        eta = np.broadcast_to(np.asarray(eta, dtype=np.float64), batch + (n,))
+        dx = np.broadcast_to(np.asarray(dx, dtype=np.float64), batch + (m,))
+        dxx = None if dxx is None else np.broadcast_to(np.asarray(dxx, dtype=np.float64), batch + (m, m))
+        live = np.all(np.isfinite(mu), axis=-1) & np.all(np.isfinite(eta), axis=-1) & np.all(np.isfinite(dx), axis=-1)
+        sub = (lambda a: a) if np.all(live) else (lambda a: None if a is None else a[live])
+        new = np.full(batch + (n,), np.nan)
+        with np.errstate(all="ignore"):
+            new_l, conv_l = forced_sigma_and_state(self._code, system, sub(mu), dt, sub(eta), sub(dx), sub(dxx),
+                                                   self._sigma)
+        ok_l = np.all(np.isfinite(new_l), axis=-1)
+        conv = None
+        if conv_l is not None:
+            ok_l = ok_l & conv_l
+            conv = np.ones(batch, dtype=bool)
+            conv[live] = conv_l
+        new[live] = np.where(ok_l[..., None], new_l, np.nan)
+        ok = np.zeros(batch, dtype=bool)
+        ok[live] = ok_l
+        return new, ok, conv
+
     @staticmethod
     def _eta(system, dX, dXX):
         areas = None if dXX is None else 0.5 * (dXX - np.swapaxes(dXX, -1, -2))
@@ -148,6 +178,8 @@ class CoadjointSolver(Solver):
 
     def step(self, fields, y, t, dt, dX, dXX):
         """One step (contract item 7); a failed member comes back NaN."""
+        if fields.has_forces:
+            return self._advance_forced(fields, y, float(dt), self._eta(fields, dX, dXX), dX, dXX)[0]
         return self._advance(fields, y, float(dt), self._eta(fields, dX, dXX))[0]
 
     def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
@@ -162,7 +194,8 @@ class CoadjointSolver(Solver):
         dts = np.diff(np.asarray(times, dtype=np.float64))
         nk = dts.size
         nsave = int(np.count_nonzero(save))
-        if isinstance(system.algebra, SO3Algebra) and system.hamiltonian.is_quadratic:
+        plain = system.hamiltonian.is_quadratic and not system.has_forces      # forces: the numpy path
+        if isinstance(system.algebra, SO3Algebra) and plain:
             nb = int(np.prod(batch, dtype=np.int64))
             eta_b = _so3_kernels.stochastic_velocities(system, dX, dXX, batch)
             y2, saved, first_bad, reason = _so3_kernels.integrate_so3(
@@ -170,7 +203,7 @@ class CoadjointSolver(Solver):
                 getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
             y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
             first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
-        elif isinstance(system.algebra, SE3Algebra) and system.hamiltonian.is_quadratic:
+        elif isinstance(system.algebra, SE3Algebra) and plain:
             nb = int(np.prod(batch, dtype=np.int64))
             d = dX.shape[-1]
             dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
@@ -190,7 +223,11 @@ class CoadjointSolver(Solver):
             y2 = y
             eta = self._eta(system, dX, dXX)                                    # (B_X..., K, n)
             for k in range(nk):
-                y2, ok, conv = self._advance(system, y2, float(dts[k]), eta[..., k, :])
+                if system.has_forces:
+                    y2, ok, conv = self._advance_forced(system, y2, float(dts[k]), eta[..., k, :], dX[..., k, :],
+                                                        None if dXX is None else dXX[..., k, :, :])
+                else:
+                    y2, ok, conv = self._advance(system, y2, float(dts[k]), eta[..., k, :])
                 new = ~ok & (first_bad < 0)
                 if new.any():
                     first_bad[new] = k

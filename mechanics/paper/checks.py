@@ -24,6 +24,7 @@ import mechanics
 import roughpaths
 
 from .model import INERTIA, PI0, SIGMA, THETA, hemisphere_mean, paper_body, s_matrix, standard_error
+from . import section2
 from .report import CheckResult
 from .tasks import registry_decorator
 
@@ -238,6 +239,13 @@ def check_prop21(ctx) -> CheckResult:
         details=f"{P} paths x {n} steps on [0, 10], s12 = −50, s13 = s23 = 25, σ = 0.05; with the paper's sign the "
                 f"gap is {wrong:.3g}",
     )
+
+
+# Sections 2.2 and 2.3 (module section2), in report order right after prop21
+register("forced_euler_poincare", "Section 2.2: forced Euler–Poincaré (rough Lagrange–d'Alembert) against a loop "
+         "reference; double bracket as a force")(section2.check_forced_euler_poincare)
+register("hamiltonian_reduction", "Section 2.3: Hamiltonian reduction of the lift driven by X.perturb(s) = "
+         "corrected Lie–Poisson on X")(section2.check_hamiltonian_reduction)
 
 
 @register("casimir", "Coadjoint integrators keep |Π| to round-off")

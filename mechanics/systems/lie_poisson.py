@@ -45,6 +45,11 @@ Where the Lévy-area velocity enters (``levy_in_dissipation``):
   body (:mod:`mechanics.limits.wong_zakai`). For :math:`\vartheta > 0` the two models differ by
   :math:`\vartheta\,\mathrm{ad}^*_{(\mathrm{ad}^*_\ell\mu)^\sharp}\mu`, an ``O(1)`` drift.
 
+Forces (Section 2.2): ``force`` :math:`F^0` and ``noise_forces`` :math:`F^i` add vector fields to the drift and
+the driving fields, :math:`d\mu = (\mathrm{ad}^*_{w}\mu + F^0)dt + (\mathrm{ad}^*_{\xi_i}\mu + F^i)d\mathbf X^i`, with the
+Lévy term from the :math:`\xi_i` only; Casimirs are conserved only by forces tangent to the orbits
+(:mod:`mechanics.systems._forces`).
+
 ``convention="paper"`` reproduces the printed equations (srblevy)/(detrigidbodylevy)/(heavytoplevy):
 the Lévy torque enters with the opposite sign, :math:`\tilde h_{\rm paper} = h - \langle\mu,\ell\rangle`,
 in the conservative term and (with ``levy_in_dissipation=True``) the dissipative term. It is *not* what a rough path with area
@@ -60,6 +65,7 @@ import numpy as np
 from roughpaths.validation import as_float_array, check_antisymmetric
 
 from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
+from ._forces import ForcesMixin
 from .lie_algebra import LieAlgebra
 
 __all__ = [
@@ -111,7 +117,7 @@ def _levy_velocity(s, brackets):
     return 0.5 * np.einsum("ij,ijk->k", s, brackets)
 
 
-class LiePoissonSystem:
+class LiePoissonSystem(ForcesMixin):
     r"""A stochastic Lie–Poisson (Euler–Poincaré) system on :math:`\mathfrak g^*` with SALT noise.
 
     Parameters
@@ -139,6 +145,12 @@ class LiePoissonSystem:
         ``False``: conservative term only, dissipation from :math:`h` — the exact equation of the
         ``s = 0`` system driven by ``X.perturb(s)`` (and of the coloured-noise limit). The two
         coincide when ``theta == 0`` or ``s == 0``.
+    force, noise_forces : callable, optional
+        :math:`F^0`: ``mu (..., n) -> (..., n)``; :math:`(F^1..F^m)`: ``mu -> (..., n, m)`` (column ``i`` is
+        :math:`F^i`); see :mod:`mechanics.systems._forces` (signs, Lévy term, Casimirs).
+    force_jacobian, noise_forces_jacobian : callable, optional
+        ``mu -> (..., n, n)`` (``[..., a, b] = ∂F^0_a/∂μ_b``) and ``mu -> (..., n, m, n)``
+        (``[..., a, i, b] = ∂F^i_a/∂μ_b``); central differences if omitted.
 
     Examples
     --------
@@ -160,7 +172,8 @@ class LiePoissonSystem:
 
     def __init__(self, algebra: LieAlgebra, hamiltonian, xi, s=None, theta=0.0, convention: str = "rp",
                  *, hamiltonian_gradient=None, hamiltonian_hessian=None, metric=None,
-                 levy_in_dissipation: bool = True):
+                 levy_in_dissipation: bool = True, force=None, noise_forces=None, force_jacobian=None,
+                 noise_forces_jacobian=None):
         if not isinstance(algebra, LieAlgebra):
             raise TypeError(f"algebra must be a LieAlgebra (e.g. mechanics.systems.lie_algebra.so3()), got "
                             f"{type(algebra).__name__}.")
@@ -208,6 +221,7 @@ class LiePoissonSystem:
         for arr in (self.xi, self.s, self._xi_brackets, self._levy_velocity, self._noise_matrices,
                     self._shift_dissipation):
             arr.setflags(write=False)
+        self._set_forces(force, noise_forces, force_jacobian, noise_forces_jacobian)
 
     @staticmethod
     def _make_hamiltonian(h, grad, hess, n):
@@ -287,14 +301,19 @@ class LiePoissonSystem:
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         LiePoissonSystem.__init__(new, self.algebra, self.hamiltonian, self.xi, s, self.theta,
-                                  self.convention, metric=None, levy_in_dissipation=self.levy_in_dissipation)
+                                  self.convention, metric=None, levy_in_dissipation=self.levy_in_dissipation,
+                                  force=self.force, noise_forces=self.noise_forces,
+                                  force_jacobian=self.force_jacobian,
+                                  noise_forces_jacobian=self.noise_forces_jacobian)
         new._metric_inv = self._metric_inv
         return new
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}(algebra={self.algebra.name!r}, n={self.dim}, m={self.n_noise}, "
                 f"theta={self.theta}, convention={self.convention!r}"
-                + ("" if self.levy_in_dissipation else ", levy_in_dissipation=False") + ")")
+                + ("" if self.levy_in_dissipation else ", levy_in_dissipation=False")
+                + (", force" if self.force is not None else "") + (", noise_forces" if self.noise_forces is not None else "")
+                + ")")
 
     # ------------------------------------------------------------------ Hamiltonians
     def _mu(self, mu):
@@ -376,26 +395,33 @@ class LiePoissonSystem:
         return hess + self.theta * d
 
     def drift(self, mu) -> np.ndarray:
-        r"""Total drift :math:`\mathrm{ad}^*_{w(\mu)}\mu` (conservative + Lévy torque + dissipation), ``(..., n)``."""
+        r"""Total drift :math:`\mathrm{ad}^*_{w(\mu)}\mu + F^0(\mu)` (conservative + Lévy torque + dissipation
+        + ``force``), ``(..., n)``."""
         mu = self._mu(mu)
-        return self._ad_star(self._w(mu), mu)
+        out = self._ad_star(self._w(mu), mu)
+        return out if self.force is None else out + self._f0(mu)
 
     def drift_jacobian(self, mu) -> np.ndarray:
         """Jacobian of :meth:`drift`, shape ``(..., n, n)`` (``[..., a, b] = ∂drift_a/∂μ_b``)."""
         mu = self._mu(mu)
         c = self.algebra._c
         w = self._w(mu)
-        return np.einsum("...i,ijk->...jk", w, c) + np.einsum("...k,ijk->...ji", mu, c) @ self._w_jacobian(mu)
+        out = np.einsum("...i,ijk->...jk", w, c) + np.einsum("...k,ijk->...ji", mu, c) @ self._w_jacobian(mu)
+        return out if self.force is None else out + self._f0_jacobian(mu)
 
     def noise(self, mu) -> np.ndarray:
-        r"""Noise fields as columns: ``[..., :, i]`` is :math:`\mathrm{ad}^*_{\xi_i}\mu`, shape ``(..., n, m)``."""
+        r"""Noise fields as columns: ``[..., :, i]`` is :math:`\mathrm{ad}^*_{\xi_i}\mu + F^i(\mu)`, shape ``(..., n, m)``."""
         mu = self._mu(mu)
-        return np.einsum("iab,...b->...ai", self._noise_matrices, mu)
+        out = np.einsum("iab,...b->...ai", self._noise_matrices, mu)
+        return out if self.noise_forces is None else out + self._fi(mu)
 
     def noise_jacobian(self, mu) -> np.ndarray:
-        """``[..., a, i, b] = ∂ V_i^a / ∂ μ_b`` (constant: the fields are linear), shape ``(..., n, m, n)``."""
+        """``[..., a, i, b] = ∂ V_i^a / ∂ μ_b`` (constant without ``noise_forces``: the fields are linear), shape
+        ``(..., n, m, n)``."""
         mu = self._mu(mu)
         jac = np.transpose(self._noise_matrices, (1, 0, 2))
+        if self.noise_forces is not None:
+            return jac + self._fi_jacobian(mu)
         return np.broadcast_to(jac, mu.shape[:-1] + jac.shape)
 
     def vector_fields(self):
@@ -405,11 +431,18 @@ class LiePoissonSystem:
         (:math:`V_i(\mu) = B_i\mu = \mathrm{ad}^*_{\xi_i}\mu`) and the (non-linear) drift
         :meth:`drift` with its Jacobian. The drift contains the Lévy torque of ``s`` — drive it with
         ``X``; the uncorrected system (``with_s(0)``) driven by ``X.perturb(s)`` is the same RDE
-        (Proposition 2.1).
-        """
-        from roughpaths import LinearVectorFields
+        (Proposition 2.1) — but only without ``noise_forces`` (with them, driving by ``X.perturb(s)`` adds the
+        brackets of the :math:`F^i` as well; module docstring).
 
-        return LinearVectorFields(self._noise_matrices, drift=self.drift, drift_jacobian=self.drift_jacobian)
+        With ``force`` the drift contains :math:`F^0`; with ``noise_forces`` the family is a
+        ``roughpaths.VectorFields`` with the fields :meth:`noise` and their Jacobians :meth:`noise_jacobian`.
+        """
+        from roughpaths import LinearVectorFields, VectorFields
+
+        if self.noise_forces is None:
+            return LinearVectorFields(self._noise_matrices, drift=self.drift, drift_jacobian=self.drift_jacobian)
+        return VectorFields(self.noise, self._noise_jacobians_rp, drift=self.drift,
+                            drift_jacobian=self.drift_jacobian, dim_state=self.dim, dim_noise=self.n_noise)
 
     # ------------------------------------------------------------------ log-signature → algebra
     def stochastic_velocity(self, increments, levy_areas=None) -> np.ndarray:
