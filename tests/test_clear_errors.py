@@ -43,6 +43,8 @@ CASES = [
      TypeError, ["(t, y)", "time_dependent=False"]),
     ("scalar moment_observable", lambda: mc.moment_observable(3.0), ValueError, ["moment_observable", "(..., n)"]),
     ("degenerate inertia", lambda: mc.rigid_body([1, 1, 1e-320]), ValueError, ["inertia", "rescale"]),
+    ("a coadjoint solver given a Lévy-area flag", lambda: mc.LieHeun(levy_area=False), TypeError,
+     ["takes no arguments", "levy_area=None"]),
     ("Davie3 hessians of the wrong shape", _solve_davie3_bad_hessians, ValueError, ["hessians", "(..., d, e, e, e)"]),
 ]
 

@@ -91,6 +91,12 @@ class CoadjointSolver(Solver):
     #: strong order on Brownian rough paths with a level-2 driver (½ with a level-1 driver, non-commuting ξ)
     order = 1.0
 
+    def __init__(self, **unexpected):
+        if unexpected:
+            raise TypeError(f"{type(self).__name__}() takes no arguments, got {', '.join(sorted(unexpected))}; the "
+                            f"driving level is the driver's: for increments only pass a level-1 driver "
+                            f"(BrownianDriver(..., levy_area=None) or X.to_level1()).")
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
 
