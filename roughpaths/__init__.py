@@ -29,14 +29,14 @@ from .norms import (area_holder_seminorm, area_p_variation, holder_distance, hol
                     rough_path_holder_norm, rough_path_p_variation)
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
 from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
-                  NonFiniteStateError, Solution, Solver, VectorFields, solve)
+                  NonFiniteStateError, Solution, Solver, VectorFields, central_jacobian, solve)
 from .signatures import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp, signature,
                          signature_vjp)
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
     "solve", "Solution", "NonFiniteStateError", "Driver", "Solver", "Euler", "Heun", "Davie", "LogODE", "LogODE3",
-    "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift", "rough_integral",
+    "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift", "central_jacobian", "rough_integral",
     # coloured noise
     "coloured_noise_limit", "ColouredNoiseDriver", "ColouredNoiseLimit", "ColouredNoiseSample",
     "sample_coloured_noise", "iter_coloured_noise", "coloured_noise_limit_path", "paper_coloured_noise_matrices",

@@ -28,24 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
+import roughpaths
+
 __all__ = ["ForcesMixin"]
-
-#: relative central-difference step, ε^(1/3) (ε the float64 machine epsilon)
-_FD_STEP = float(np.finfo(np.float64).eps ** (1.0 / 3.0))
-
-
-def _central_differences(f, mu):
-    """``∂f/∂μ_b`` by central differences, step ``_FD_STEP·max(1, |μ_b|)``; returns ``(..., *out, n)``."""
-    mu = np.asarray(mu, dtype=np.float64)
-    h = _FD_STEP * np.maximum(1.0, np.abs(mu))
-    cols = []
-    for b in range(mu.shape[-1]):
-        step = np.zeros_like(mu)
-        step[..., b] = h[..., b]
-        diff = np.asarray(f(mu + step), dtype=np.float64) - np.asarray(f(mu - step), dtype=np.float64)
-        hb = h[..., b].reshape(h.shape[:-1] + (1,) * (diff.ndim - mu.ndim + 1))
-        cols.append(diff / (2.0 * hb))
-    return np.stack(cols, axis=-1)
 
 
 class ForcesMixin:
@@ -84,7 +69,7 @@ class ForcesMixin:
     def _f0_jacobian(self, mu):
         if self.force_jacobian is not None:
             return np.asarray(self.force_jacobian(mu), dtype=np.float64)
-        return _central_differences(self.force, mu)
+        return roughpaths.central_jacobian(self.force, mu)
 
     def _fi(self, mu):
         return np.asarray(self.noise_forces(mu), dtype=np.float64)
@@ -93,7 +78,7 @@ class ForcesMixin:
         """``[..., a, i, b] = ∂F^i_a/∂μ_b``."""
         if self.noise_forces_jacobian is not None:
             return np.asarray(self.noise_forces_jacobian(mu), dtype=np.float64)
-        return _central_differences(self.noise_forces, mu)
+        return roughpaths.central_jacobian(self.noise_forces, mu)
 
     def forces(self, mu) -> np.ndarray:
         r""":math:`F^0(\mu)`, shape ``(..., n)`` (zero without ``force``)."""

@@ -94,7 +94,7 @@ import numpy as np
 from ..validation import as_float_array, check_memory, check_positive_int
 from ._area_kernels import _scale_accumulate
 from ._random import PathStreams, _fast_streams_ok
-from .areas import DEFAULT_SUBSTEPS, _Sampler
+from .areas import _Sampler
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from ..paths.rough_path import RoughPath
 from .refinement import RefinedBrownianDriver

@@ -13,9 +13,9 @@ from .euler import Euler, Heun
 from .integrate import SOLVERS, NonFiniteStateError, Solution, solve
 from .linear_fields import LinearVectorFields
 from .logode import LogODE, LogODE3
-from .vector_fields import LinearDrift, VectorFields
+from .vector_fields import LinearDrift, VectorFields, central_jacobian
 
 __all__ = [
     "Solver", "Davie", "Davie3", "Euler", "Heun", "SOLVERS", "NonFiniteStateError", "Solution", "solve",
-    "LinearVectorFields", "LogODE", "LogODE3", "LinearDrift", "VectorFields",
+    "LinearVectorFields", "LogODE", "LogODE3", "LinearDrift", "VectorFields", "central_jacobian",
 ]

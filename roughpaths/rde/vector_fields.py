@@ -43,7 +43,7 @@ from ._field_callables import (_Autonomous, _Bracket, _Frozen, _FrizOberhauserDr
 from .._linalg import matvec
 from ..validation import as_float_array, check_antisymmetric
 
-__all__ = ["VectorFields", "LinearDrift", "FD_STEP"]
+__all__ = ["VectorFields", "LinearDrift", "FD_STEP", "central_jacobian"]
 
 #: Relative central-difference step, :math:`\varepsilon^{1/3}` with :math:`\varepsilon` the float64 epsilon.
 FD_STEP = float(np.finfo(np.float64).eps ** (1.0 / 3.0))
@@ -266,7 +266,7 @@ class VectorFields:
         if self._jac is not None:
             return np.asarray(self._jac(t, y), dtype=np.float64)
         # central differences; J[..., a, i, b] then moved to [..., i, a, b]
-        return np.moveaxis(_central_jacobian(_Frozen(self._fields, t), y), -2, -3)
+        return np.moveaxis(central_jacobian(_Frozen(self._fields, t), y), -2, -3)
 
     def drift_jacobian(self, y, t=None) -> np.ndarray:
         r""":math:`\partial_b V_0^a(t, y)`, shape ``(..., e, e)``."""
@@ -276,7 +276,7 @@ class VectorFields:
         t = self._time(t)
         if self._drift_jac is not None:
             return np.asarray(self._drift_jac(t, y), dtype=np.float64)
-        return _central_jacobian(_Frozen(self._drift, t), y)
+        return central_jacobian(_Frozen(self._drift, t), y)
 
     # ------------------------------------------------------------------ brackets
     def _check_index(self, i, name):
@@ -383,8 +383,12 @@ def _linear_part(drift):
     return None
 
 
-def _central_jacobian(f, y):
-    """Central differences of ``f: (..., e) -> (..., *out)``; returns ``(..., *out, e)``."""
+def central_jacobian(f, y):
+    """Central differences of ``f: (..., e) -> (..., *out)``; returns ``(..., *out, e)``.
+
+    Step ``FD_STEP·max(1, |y_b|)`` per coordinate (the Jacobian that :class:`VectorFields` and
+    ``mechanics.LiePoissonSystem``'s forces use when none is given).
+    """
     e = y.shape[-1]
     h = FD_STEP * np.maximum(1.0, np.abs(y))                          # (..., e)
     cols = []
