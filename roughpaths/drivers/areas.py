@@ -24,7 +24,7 @@ they mean something: :class:`~roughpaths.BrownianDriver`, :func:`~roughpaths.bro
 "Order vs Brownian" is the strong order of the order-1 schemes (Davie, log-ODE, the coadjoint
 Heun) against the Brownian motion whose increments are sampled: a per-step area error of ``h^{3/2}``
 (or an exact law) keeps order 1; Davie's and Foster's areas, whose per-step error is of order
-``h``, bring it down to ½ (tested in ``tests/roughpaths/rde/test_strong_order_default_driver.py``).
+``h``, bring it down to ½ (tested in ``tests/roughpaths/rde/test_strong_order_against_brownian_motion.py``).
 Details, derivations and law errors: :mod:`roughpaths.drivers.brownian` (``"davie"``, ``"foster"``),
 :mod:`roughpaths.drivers.levy_area` (the Fourier methods and the ``d = 2`` exact sampler).
 """
