@@ -237,12 +237,31 @@ def _fspath(path):
     return p
 
 
+def _remove_stale_temporaries(target: Path) -> None:
+    """Delete ``.NAME.PID.*.tmp`` files that a writer of ``target`` killed mid-write left (its PID is gone)."""
+    for stale in target.parent.glob(f".{target.name}.*.tmp"):
+        pid = stale.name[len(target.name) + 2:].split(".", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid), 0)                  # raises if no such process: its temporary is stale
+        except ProcessLookupError:
+            try:
+                stale.unlink()
+            except OSError:
+                pass
+        except OSError:                           # it exists (another user's): leave its file alone
+            pass
+
+
 def atomic_savez(target, arrays: dict) -> Path:
     """Write ``arrays`` to the ``.npz`` file ``target`` atomically (a temporary file in the same folder,
     flushed to disk, then renamed over ``target``): a crash or kill never leaves a partial file under
-    the name. Returns the path written."""
+    the name; the temporary of a writer killed mid-write is removed by the next write. Returns the path
+    written."""
     target = Path(os.fspath(target))
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    _remove_stale_temporaries(target)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp", dir=target.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
             np.savez(fh, **arrays)

@@ -160,3 +160,20 @@ def test_random_metadata_and_headers_give_an_object_or_a_clear_error(tmp_path_fa
             assert str(p) in str(exc)
         else:
             assert isinstance(out, rp.RoughPath)
+
+
+def test_a_writer_killed_mid_write_leaves_nothing_after_the_next_write(tmp_path, saved):
+    """The temporary of a dead writer (its PID gone) is removed by the next save to the same name; a live
+    writer's is kept."""
+    import subprocess
+    import sys
+
+    X, _ = saved
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    stale = tmp_path / f".y.npz.{int(dead.stdout)}.abc.tmp"
+    stale.write_bytes(b"half")
+    live = tmp_path / f".y.npz.{os.getppid()}.def.tmp"
+    live.write_bytes(b"in progress")
+    rp.save(X, tmp_path / "y.npz")
+    assert not stale.exists() and live.exists()
+    assert rp.load(tmp_path / "y.npz") == X
