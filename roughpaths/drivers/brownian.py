@@ -360,9 +360,6 @@ class BrownianDriver(SeededDriver):
                  levy_area_error=None):
         self._init_common(dim, seed, times, dt, n_steps, t0, batch_shape, block_bytes)
         self._sampler = _Sampler(levy_area, self.dim, self._h, substeps, levy_area_error)
-        self.levy_area = self._sampler.name
-        self.substeps = self._sampler.substeps
-        self.levy_area_error = levy_area_error
         self.kind = _check_kind(kind)
         self.level = 1 if self.levy_area is None else 2
         self._x0 = np.zeros(self.dim) if x0 is None else self._check_start(x0, "x0", self.dim)
@@ -372,6 +369,12 @@ class BrownianDriver(SeededDriver):
 
     def _starts(self) -> dict:
         return {"_x0": self.dim}
+
+    # the area method, as resolved by the one dispatch (roughpaths.drivers.areas)
+    levy_area = property(lambda self: self._sampler.name, doc="The Lévy-area method (None: increments only).")
+    substeps = property(lambda self: self._sampler.substeps, doc="Substeps of 'davie' / 'foster'.")
+    levy_area_error = property(lambda self: self._sampler.levy_area_error,
+                               doc="The per-step L² error asked of the error-controlled methods (None: h^1.5).")
 
     # ------------------------------------------------------------------ layout
     @property
