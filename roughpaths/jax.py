@@ -1,0 +1,225 @@
+r"""JAX front end: the library's signatures and signature kernels as differentiable JAX functions.
+
+``import roughpaths.jax as rpj`` (needs the ``jax`` extra: ``pip install 'roughpaths-mechanics[jax]'``;
+``import roughpaths`` alone never imports jax). Each function is a :func:`jax.custom_vjp` whose
+forward and backward passes are :func:`jax.pure_callback` calls of the library's numpy API and its
+vector–Jacobian product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation.
+They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad`` (and their compositions):
+
+* **vmap** is one batched call, not a loop: the callbacks are declared with
+  ``vmap_method="broadcast_all"``, so a mapped axis arrives as a leading batch axis, which the numpy
+  API takes as it takes any batch axis.
+* **Precision.** float32 (JAX's default) and float64 (with ``jax_enable_x64``) inputs; the
+  computation is float64 either way and the result is rounded to the input's dtype. Integer and
+  half-precision inputs are refused with a ``TypeError``.
+* **Devices.** The callbacks run on the host; arrays on an accelerator are copied to the host and back
+  by JAX (correct, but the copy costs what it costs).
+* **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
+  (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a callback.
+* **Cost.** A callback costs tens of microseconds on top of the kernels; measured against the
+  kernels in ``benchmarks/bench_frameworks.py``, which is why this is a callback rather than an
+  XLA FFI custom call (see that script's output).
+
+Examples
+--------
+>>> import jax, jax.numpy as jnp
+>>> import roughpaths.jax as rpj
+>>> x = jnp.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+>>> rpj.signature(x, 2)                        # the L-shaped path: area ∫ X¹ dX² = 1
+Array([1. , 1. , 0.5, 1. , 0. , 0.5], dtype=float32)
+>>> jax.grad(lambda x: rpj.signature(x, 2)[3])(x)
+Array([[-1. , -0.5],
+       [ 0.5, -0.5],
+       [ 0.5,  1. ]], dtype=float32)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import jax
+import jax.numpy as jnp
+
+import roughpaths as _rp
+
+__all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable"]
+
+
+def _as_jax(x, name: str):
+    """``x`` as a JAX array (or tracer) of float32 or float64, with a clear error otherwise."""
+    if isinstance(x, (str, bytes)) or x is None:
+        raise TypeError(f"{name} must be an array of floats, got {type(x).__name__}; pass a jax or numpy array.")
+    x = jnp.asarray(x)
+    if x.dtype not in (jnp.float32, jnp.float64):
+        raise TypeError(f"{name} has dtype {x.dtype}; roughpaths.jax takes float32 or float64 arrays: pass "
+                        f"{name}.astype(jnp.float32) (or float64 with jax_enable_x64).")
+    return x
+
+
+def _batch_broadcast(arrays: list, core: tuple) -> list:
+    """Broadcast the leading (batch) axes of several inputs; ``core[i]`` trailing axes of input ``i`` are kept."""
+    if len(arrays) == 1:
+        return arrays
+    batch = np.broadcast_shapes(*(a.shape[:a.ndim - c] for a, c in zip(arrays, core)))
+    return [np.broadcast_to(a, batch + a.shape[a.ndim - c:]) for a, c in zip(arrays, core)]
+
+
+def _sum_to(g: np.ndarray, shape: tuple) -> np.ndarray:
+    """Sum a cotangent over the axes that broadcasting added or stretched, back to ``shape``."""
+    if g.shape == shape:
+        return g
+    g = g.sum(axis=tuple(range(g.ndim - len(shape))))
+    axes = tuple(k for k, (a, b) in enumerate(zip(shape, g.shape)) if a == 1 and b != 1)
+    return g.sum(axis=axes, keepdims=True) if axes else g
+
+
+def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
+    """Build a differentiable, jit- and vmap-able JAX function from a numpy map and its vector–Jacobian product.
+
+    Parameters
+    ----------
+    forward : callable
+        ``forward(*arrays, **params) -> ndarray`` on float64 numpy arrays, batched over leading axes.
+    vjp : callable
+        ``vjp(*arrays, grad_output, **params)``: the cotangent of each array (one array, or a tuple).
+    out_shape : callable
+        ``out_shape(batch, cores, **params) -> tuple``: the result's shape given the broadcast batch
+        shape and the trailing (core) shapes of the inputs.
+    names : tuple of str
+        The arguments' names, for error messages.
+    core : tuple of int
+        How many trailing axes of each input are not batch axes; the batch axes broadcast.
+
+    Returns
+    -------
+    callable
+        ``f(*arrays, **params)``, in the inputs' floating dtype (computed in float64).
+
+    Examples
+    --------
+    >>> import jax, jax.numpy as jnp
+    >>> square = differentiable(lambda a: a ** 2, lambda a, g: 2 * a * g, lambda b, c: b + c[0],
+    ...                         names=("a",), core=(0,))
+    >>> jax.grad(lambda a: square(a).sum())(jnp.array([3.0]))
+    Array([6.], dtype=float32)
+    """
+
+    def apply(*xs, **params):
+        xs = [_as_jax(x, n) for x, n in zip(xs, names)]
+        for x, n, c in zip(xs, names, core):
+            if x.ndim < c:
+                raise ValueError(f"{n} must have at least {c} axes, got shape {x.shape}.")
+        dtype = jnp.result_type(*xs)
+        xs = [x.astype(dtype) for x in xs]
+        batch = np.broadcast_shapes(*(x.shape[:x.ndim - c] for x, c in zip(xs, core)))
+        cores = [x.shape[x.ndim - c:] for x, c in zip(xs, core)]
+        result = jax.ShapeDtypeStruct(tuple(out_shape(batch, cores, **params)), dtype)
+
+        def forward_cb(*arrs):
+            arrays = _batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
+            return np.asarray(forward(*arrays, **params), dtype=dtype)
+
+        def backward_cb(*arrs):
+            *arrs, g = arrs
+            shapes = [a.shape for a in arrs]        # as received: with vmap's axes in front
+            arrays = _batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
+            grads = vjp(*arrays, np.asarray(g, dtype=np.float64), **params)
+            grads = (grads,) if len(arrs) == 1 else tuple(grads)
+            return tuple(np.asarray(_sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
+
+        @jax.custom_vjp
+        def f(*args):
+            return jax.pure_callback(forward_cb, result, *args, vmap_method="broadcast_all")
+
+        def f_fwd(*args):
+            return f(*args), args
+
+        def f_bwd(args, g):
+            structs = tuple(jax.ShapeDtypeStruct(a.shape, a.dtype) for a in args)
+            return tuple(jax.pure_callback(backward_cb, structs, *args, g, vmap_method="broadcast_all"))
+
+        f.defvjp(f_fwd, f_bwd)
+        return f(*xs)
+
+    return apply
+
+
+def _kernel_api(name: str):
+    """``roughpaths.<name>``, looked up at call time (the signature kernels are a separate part of the library)."""
+    f = getattr(_rp, name, None)
+    if f is None:
+        raise NotImplementedError(f"roughpaths.{name} is not available in this version of roughpaths "
+                                  f"({_rp.__version__}); upgrade roughpaths to use the signature kernels.")
+    return f
+
+
+def _paths_core(cores, name="paths"):
+    (n, d), = cores
+    if n < 1 or d < 1:
+        raise ValueError(f"{name} needs shape (..., n, d) with n >= 1 and d >= 1, got trailing shape {(n, d)}.")
+    return d
+
+
+_signature = differentiable(lambda x, depth: _rp.signature(x, depth),
+                            lambda x, g, depth: _rp.signature_vjp(x, depth, g),
+                            lambda batch, cores, depth: batch + (_rp.sigdim(_paths_core(cores), depth),),
+                            names=("paths",), core=(2,))
+_logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
+                               lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
+                               lambda batch, cores, depth: batch + (_rp.logsigdim(_paths_core(cores), depth),),
+                               names=("paths",), core=(2,))
+_kernel = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel")(x, y, **kw),
+                         lambda x, y, g, **kw: _kernel_api("signature_kernel_vjp")(x, y, g, **kw),
+                         lambda batch, cores, **kw: batch,
+                         names=("x", "y"), core=(2, 2))
+_gram = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel_gram")(x, y, **kw),
+                       lambda x, y, g, **kw: _kernel_api("signature_kernel_gram_vjp")(x, y, g, **kw),
+                       lambda batch, cores, **kw: batch + (cores[0][0], cores[1][0]),
+                       names=("X", "Y"), core=(3, 3))
+
+
+def signature(paths, depth: int):
+    r"""Differentiable :func:`roughpaths.signature` of ``(..., n, d)`` arrays → ``(..., sigdim(d, depth))``.
+
+    Backward: :func:`roughpaths.signature_vjp`. float32 or float64 in, the same dtype out (computed in float64).
+
+    Examples
+    --------
+    >>> import jax, jax.numpy as jnp
+    >>> x = jnp.zeros((5, 4, 10, 3))
+    >>> jax.jit(signature, static_argnums=1)(x, 3).shape          # batch axes as in the numpy API
+    (5, 4, 39)
+    >>> jax.vmap(lambda p: signature(p, 3))(x).shape               # one batched callback, not a loop
+    (5, 4, 39)
+    """
+    return _signature(paths, depth=depth)
+
+
+def logsignature(paths, depth: int):
+    r"""Differentiable :func:`roughpaths.logsignature` (Lyndon coordinates) of ``(..., n, d)`` arrays.
+
+    Backward: :func:`roughpaths.logsignature_vjp`. float32 or float64 in, the same dtype out (computed in float64).
+
+    Examples
+    --------
+    >>> import jax.numpy as jnp
+    >>> logsignature(jnp.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), 2)   # increment (1, 1), Lévy area ½
+    Array([1. , 1. , 0.5], dtype=float32)
+    """
+    return _logsignature(paths, depth=depth)
+
+
+def signature_kernel(x, y, *, dyadic_order: int = 0, static_kernel=None):
+    r"""Differentiable ``roughpaths.signature_kernel``: ``x`` ``(..., n, d)``, ``y`` ``(..., m, d)`` → ``(...)``.
+
+    The batch axes of ``x`` and ``y`` broadcast; the keywords are passed through unchanged (they are
+    static under ``jit``). Backward: ``roughpaths.signature_kernel_vjp``.
+    """
+    return _kernel(x, y, dyadic_order=dyadic_order, static_kernel=static_kernel)
+
+
+def signature_kernel_gram(X, Y, *, dyadic_order: int = 0, static_kernel=None):
+    r"""Differentiable ``roughpaths.signature_kernel_gram``: ``X`` ``(..., a, n, d)``, ``Y`` ``(..., b, m, d)`` → ``(..., a, b)``.
+
+    Backward: ``roughpaths.signature_kernel_gram_vjp``.
+    """
+    return _gram(X, Y, dyadic_order=dyadic_order, static_kernel=static_kernel)

@@ -1,0 +1,232 @@
+r"""PyTorch front end: the library's signatures and signature kernels as differentiable torch operations.
+
+``import roughpaths.torch as rpt`` (needs the ``torch`` extra: ``pip install 'roughpaths-mechanics[torch]'``;
+``import roughpaths`` alone never imports torch). Each function is a :class:`torch.autograd.Function`
+whose forward pass calls the library's numpy API and whose backward pass calls its vector–Jacobian
+product; there is no second implementation:
+
+======================================  ========================================  ===========================================
+function                                forward                                   backward
+======================================  ========================================  ===========================================
+:func:`signature`                       :func:`roughpaths.signature`              :func:`roughpaths.signature_vjp`
+:func:`logsignature`                    :func:`roughpaths.logsignature`           :func:`roughpaths.logsignature_vjp`
+:func:`signature_kernel`                ``roughpaths.signature_kernel``           ``roughpaths.signature_kernel_vjp``
+:func:`signature_kernel_gram`           ``roughpaths.signature_kernel_gram``      ``roughpaths.signature_kernel_gram_vjp``
+======================================  ========================================  ===========================================
+
+Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`` paths, the
+``iisignature`` layout, the Lyndon basis). What the wrappers add, and what they do not:
+
+* **Devices.** The kernels run on the CPU: a CUDA, MPS or meta tensor is refused with a ``ValueError``
+  saying to pass ``x.cpu()`` (and to move the result back with ``.to(device)``); nothing is copied
+  between devices behind the caller's back.
+* **Precision.** float32 and float64 tensors are accepted. The computation is always float64 (the
+  kernels are float64 only): a float32 input is widened, the result (and the gradient) rounded back
+  to float32, so float32 in gives float32 out, about as accurate as float32 can hold. Other dtypes
+  (integers, float16, bfloat16, complex) are refused with a ``TypeError`` naming the fix.
+* **Gradients.** First derivatives only: the backward pass is not itself differentiable (a second
+  ``backward`` through it raises torch's error for ``once_differentiable`` functions), and
+  ``torch.func`` transforms (``vmap``, ``jacrev``) are not supported; batch with leading axes instead,
+  which runs as one call of the compiled kernels.
+* **Cost.** Forward and backward each convert the tensors to numpy without a copy (float64 in) or with
+  one cast (float32), so the overhead is a few microseconds per call (``benchmarks/bench_frameworks.py``).
+
+Examples
+--------
+>>> import torch
+>>> import roughpaths.torch as rpt
+>>> x = torch.tensor([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], dtype=torch.float64, requires_grad=True)
+>>> s = rpt.signature(x, 2)                    # the L-shaped path: area ∫ X¹ dX² = 1
+>>> s
+tensor([1.0000, 1.0000, 0.5000, 1.0000, 0.0000, 0.5000], dtype=torch.float64,
+       grad_fn=<_SignatureBackward>)
+>>> s[3].backward()
+>>> x.grad
+tensor([[-1.0000, -0.5000],
+        [ 0.5000, -0.5000],
+        [ 0.5000,  1.0000]], dtype=torch.float64)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from torch.autograd.function import once_differentiable
+
+import roughpaths as _rp
+
+__all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable"]
+
+_DTYPES = (torch.float32, torch.float64)
+
+
+def _as_numpy(t, name: str) -> np.ndarray:
+    """The float64 numpy view (or float32 → float64 copy) of a CPU tensor, with clear errors otherwise."""
+    if not isinstance(t, torch.Tensor):
+        raise TypeError(f"{name} must be a torch.Tensor, got {type(t).__name__}; wrap it with "
+                        f"torch.as_tensor({name}), or call the numpy API (roughpaths.signature, ...) on arrays directly.")
+    if t.device.type == "meta":
+        raise ValueError(f"{name} is a meta tensor (a shape without data); roughpaths.torch computes on CPU data: "
+                         f"pass a CPU tensor (torch.empty_like({name}, device='cpu') filled with the values).")
+    if t.device.type != "cpu":
+        raise ValueError(f"{name} is on device {t.device}; roughpaths.torch runs its compiled kernels on the CPU: "
+                         f"pass {name}.cpu() (and move the result back with .to({name}.device)).")
+    if t.dtype not in _DTYPES:
+        raise TypeError(f"{name} has dtype {t.dtype}; roughpaths.torch takes float32 or float64 tensors: pass "
+                        f"{name}.double() (or {name}.float()).")
+    return t.detach().numpy().astype(np.float64, copy=False)
+
+
+def _batch_broadcast(arrays: list, core: tuple) -> list:
+    """Broadcast the leading (batch) axes of several inputs; ``core[i]`` trailing axes of input ``i`` are kept."""
+    if len(arrays) == 1:
+        return arrays
+    batch = np.broadcast_shapes(*(a.shape[:a.ndim - c] for a, c in zip(arrays, core)))
+    return [np.broadcast_to(a, batch + a.shape[a.ndim - c:]) for a, c in zip(arrays, core)]
+
+
+def _sum_to(g: np.ndarray, shape: tuple) -> np.ndarray:
+    """Sum a cotangent over the axes that broadcasting added or stretched, back to ``shape``."""
+    if g.shape == shape:
+        return g
+    g = g.sum(axis=tuple(range(g.ndim - len(shape))))
+    axes = tuple(k for k, (a, b) in enumerate(zip(shape, g.shape)) if a == 1 and b != 1)
+    return g.sum(axis=axes, keepdims=True) if axes else g
+
+
+def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
+    """Build a differentiable torch function from a numpy forward map and its vector–Jacobian product.
+
+    Parameters
+    ----------
+    forward : callable
+        ``forward(*arrays, **params) -> ndarray``, on float64 numpy arrays.
+    vjp : callable
+        ``vjp(*arrays, grad_output, **params)``: the cotangent of each array (one array, or a tuple of
+        them for several inputs).
+    names : tuple of str
+        The tensor arguments' names, for error messages.
+    core : tuple of int
+        How many trailing axes of each input are not batch axes (``2`` for ``(..., n, d)`` paths);
+        the batch axes of several inputs are broadcast against each other.
+    label : str
+        The name of the autograd node (``grad_fn=<labelBackward>``).
+
+    Returns
+    -------
+    callable
+        ``f(*tensors, **params) -> torch.Tensor`` in the inputs' dtype (float32 or float64; computed
+        in float64), differentiable once with respect to every tensor.
+
+    Examples
+    --------
+    >>> import numpy as np, torch
+    >>> square = differentiable(lambda a: a ** 2, lambda a, g: 2 * a * g, names=("a",), core=(0,), label="Square")
+    >>> a = torch.tensor([3.0], requires_grad=True)
+    >>> square(a).sum().backward()
+    >>> a.grad
+    tensor([6.])
+    """
+
+    def _forward(ctx, params, *tensors):
+        arrays = _batch_broadcast([_as_numpy(t, n) for t, n in zip(tensors, names)], core)
+        out = np.asarray(forward(*arrays, **params), dtype=np.float64)
+        ctx.params = params
+        ctx.save_for_backward(*tensors)
+        return torch.from_numpy(np.ascontiguousarray(out)).to(tensors[0].dtype)
+
+    @once_differentiable
+    def _backward(ctx, grad):
+        tensors = ctx.saved_tensors
+        arrays = _batch_broadcast([_as_numpy(t, n) for t, n in zip(tensors, names)], core)
+        g = grad.detach().cpu().numpy().astype(np.float64, copy=False)
+        grads = vjp(*arrays, np.broadcast_to(g, g.shape), **ctx.params)
+        grads = (grads,) if len(tensors) == 1 else tuple(grads)
+        return (None,) + tuple(
+            torch.from_numpy(np.ascontiguousarray(_sum_to(np.asarray(gr), tuple(t.shape)))).to(t.dtype)
+            if need else None for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
+
+    fn = type(label, (torch.autograd.Function,),
+              {"forward": staticmethod(_forward), "backward": staticmethod(_backward)})
+
+    def apply(*tensors, **params):
+        for t, n in zip(tensors, names):
+            _as_numpy(t, n)          # refuse a wrong device or dtype before autograd sees it
+        dtypes = {t.dtype for t in tensors}
+        if len(dtypes) > 1:
+            raise TypeError(f"{' and '.join(names)} have different dtypes {sorted(map(str, dtypes))}; "
+                            f"convert them to one (e.g. .double()).")
+        return fn.apply(params, *tensors)
+
+    return apply
+
+
+def _kernel_api(name: str):
+    """``roughpaths.<name>``, looked up at call time (the signature kernels are a separate part of the library)."""
+    f = getattr(_rp, name, None)
+    if f is None:
+        raise NotImplementedError(f"roughpaths.{name} is not available in this version of roughpaths "
+                                  f"({_rp.__version__}); upgrade roughpaths to use the signature kernels.")
+    return f
+
+
+_signature = differentiable(lambda x, depth: _rp.signature(x, depth),
+                            lambda x, g, depth: _rp.signature_vjp(x, depth, g),
+                            names=("paths",), core=(2,), label="_Signature")
+_logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
+                               lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
+                               names=("paths",), core=(2,), label="_LogSignature")
+_kernel = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel")(x, y, **kw),
+                         lambda x, y, g, **kw: _kernel_api("signature_kernel_vjp")(x, y, g, **kw),
+                         names=("x", "y"), core=(2, 2), label="_SignatureKernel")
+_gram = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel_gram")(x, y, **kw),
+                       lambda x, y, g, **kw: _kernel_api("signature_kernel_gram_vjp")(x, y, g, **kw),
+                       names=("X", "Y"), core=(3, 3), label="_SignatureKernelGram")
+
+
+def signature(paths: torch.Tensor, depth: int) -> torch.Tensor:
+    r"""Differentiable :func:`roughpaths.signature` of CPU tensors ``(..., n, d)`` → ``(..., sigdim(d, depth))``.
+
+    Backward: :func:`roughpaths.signature_vjp`. float32 or float64 in, the same dtype out (computed in float64).
+
+    Examples
+    --------
+    >>> import torch
+    >>> x = torch.zeros(4, 10, 3, requires_grad=True)       # float32 in, float32 out
+    >>> signature(x, 3).shape, signature(x, 3).dtype
+    (torch.Size([4, 39]), torch.float32)
+    """
+    return _signature(paths, depth=depth)
+
+
+def logsignature(paths: torch.Tensor, depth: int) -> torch.Tensor:
+    r"""Differentiable :func:`roughpaths.logsignature` (Lyndon coordinates) of CPU tensors ``(..., n, d)``.
+
+    Backward: :func:`roughpaths.logsignature_vjp`. float32 or float64 in, the same dtype out (computed in float64).
+
+    Examples
+    --------
+    >>> import torch
+    >>> logsignature(torch.tensor([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), 2)   # increment (1, 1), Lévy area ½
+    tensor([1.0000, 1.0000, 0.5000])
+    """
+    return _logsignature(paths, depth=depth)
+
+
+def signature_kernel(x: torch.Tensor, y: torch.Tensor, *, dyadic_order: int = 0, static_kernel=None) -> torch.Tensor:
+    r"""Differentiable ``roughpaths.signature_kernel``: ``x`` ``(..., n, d)``, ``y`` ``(..., m, d)`` → ``(...)``.
+
+    The batch axes of ``x`` and ``y`` broadcast; the keywords are passed through unchanged. Backward:
+    ``roughpaths.signature_kernel_vjp``. float32 or float64 in, the same dtype out (computed in float64).
+    """
+    return _kernel(x, y, dyadic_order=dyadic_order, static_kernel=static_kernel)
+
+
+def signature_kernel_gram(X: torch.Tensor, Y: torch.Tensor, *, dyadic_order: int = 0,
+                          static_kernel=None) -> torch.Tensor:
+    r"""Differentiable ``roughpaths.signature_kernel_gram``: ``X`` ``(..., a, n, d)``, ``Y`` ``(..., b, m, d)`` → ``(..., a, b)``.
+
+    Backward: ``roughpaths.signature_kernel_gram_vjp``. float32 or float64 in, the same dtype out
+    (computed in float64).
+    """
+    return _gram(X, Y, dyadic_order=dyadic_order, static_kernel=static_kernel)
