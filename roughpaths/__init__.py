@@ -30,8 +30,8 @@ from .norms import (area_holder_seminorm, area_p_variation, holder_distance, hol
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
 from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
                   NonFiniteStateError, Solution, Solver, VectorFields, central_jacobian, solve)
-from .signatures import (logsignature, logsignature_vjp, rough_path_signature, rough_path_signature_vjp, signature,
-                         signature_vjp)
+from .signatures import (brownian_expected_signature, logsignature, logsignature_vjp, rough_path_signature,
+                         rough_path_signature_vjp, signature, signature_vjp)
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
@@ -56,6 +56,6 @@ __all__ = [
     "rough_path_p_variation", "holder_distance",
     # signatures and the tensor algebra
     "signature", "logsignature", "signature_vjp", "logsignature_vjp", "rough_path_signature_vjp",
-    "rough_path_signature", "sigdim", "logsigdim", "tensor_product", "tensor_inverse", "tensor_exp", "tensor_log",
+    "rough_path_signature", "brownian_expected_signature", "sigdim", "logsigdim", "tensor_product", "tensor_inverse", "tensor_exp", "tensor_log",
     "to_level2", "from_level2", "lyndon_basis", "lyndon_coordinates", "from_lyndon_coordinates",
 ]
