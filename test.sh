@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Set up the environment (first run only; with the test, docs and dask extras, so the scale-out test runs)
+# Set up the environment (first run only; with the test, docs and dask extras, so the scale-out test runs,
+# and the torch and jax extras, so the framework front ends roughpaths.torch / roughpaths.jax are tested)
 # and run the test suite. Extra arguments go to pytest,
 # e.g. ./test.sh -m slow  (the long statistical runs), ./test.sh -x -q tests/roughpaths/paths/test_chen_identity.py
 set -euo pipefail
 cd "$(dirname "$0")"
-PY="$(tools/setup_env.sh test,docs,dask | tail -n 1)"
+PY="$(tools/setup_env.sh test,docs,dask,torch,jax | tail -n 1)"
 # KaTeX for the documentation site (npm package, pinned) and Debian's chromium for the browser test;
 # both no-ops when present. Where they cannot be had (no npm, not root), the tests that need them skip,
 # except under CI=true, where they fail.

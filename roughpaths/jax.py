@@ -103,17 +103,7 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
     Array([6.], dtype=float32)
     """
 
-    def apply(*xs, **params):
-        xs = [_as_jax(x, n) for x, n in zip(xs, names)]
-        for x, n, c in zip(xs, names, core):
-            if x.ndim < c:
-                raise ValueError(f"{n} must have at least {c} axes, got shape {x.shape}.")
-        dtype = jnp.result_type(*xs)
-        xs = [x.astype(dtype) for x in xs]
-        batch = np.broadcast_shapes(*(x.shape[:x.ndim - c] for x, c in zip(xs, core)))
-        cores = [x.shape[x.ndim - c:] for x, c in zip(xs, core)]
-        result = jax.ShapeDtypeStruct(tuple(out_shape(batch, cores, **params)), dtype)
-
+    def build(params: dict, dtype):
         def forward_cb(*arrs):
             arrays = _batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             return np.asarray(forward(*arrays, **params), dtype=dtype)
@@ -128,6 +118,9 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
 
         @jax.custom_vjp
         def f(*args):
+            batch = np.broadcast_shapes(*(a.shape[:a.ndim - c] for a, c in zip(args, core)))
+            cores = [a.shape[a.ndim - c:] for a, c in zip(args, core)]
+            result = jax.ShapeDtypeStruct(tuple(out_shape(batch, cores, **params)), dtype)
             return jax.pure_callback(forward_cb, result, *args, vmap_method="broadcast_all")
 
         def f_fwd(*args):
@@ -138,6 +131,26 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
             return tuple(jax.pure_callback(backward_cb, structs, *args, g, vmap_method="broadcast_all"))
 
         f.defvjp(f_fwd, f_bwd)
+        return jax.jit(f)
+
+    cache = {}
+
+    def apply(*xs, **params):
+        xs = [_as_jax(x, n) for x, n in zip(xs, names)]
+        for x, n, c in zip(xs, names, core):
+            if x.ndim < c:
+                raise ValueError(f"{n} must have at least {c} axes, got shape {x.shape}.")
+        dtype = jnp.result_type(*xs)
+        xs = [x.astype(dtype) for x in xs]
+        batch = np.broadcast_shapes(*(x.shape[:x.ndim - c] for x, c in zip(xs, core)))
+        out_shape(batch, [x.shape[x.ndim - c:] for x, c in zip(xs, core)], **params)   # checks, before tracing
+        key = (tuple(sorted(params.items())), np.dtype(dtype).name)
+        try:
+            f = cache.get(key)
+        except TypeError:                            # an unhashable parameter: no reuse
+            return build(params, dtype)(*xs)
+        if f is None:
+            f = cache[key] = build(params, dtype)
         return f(*xs)
 
     return apply

@@ -5,21 +5,17 @@ r"""PyTorch front end: the library's signatures and signature kernels as differe
 whose forward pass calls the library's numpy API and whose backward pass calls its vector–Jacobian
 product; there is no second implementation:
 
-======================================  ========================================  ===========================================
-function                                forward                                   backward
-======================================  ========================================  ===========================================
-:func:`signature`                       :func:`roughpaths.signature`              :func:`roughpaths.signature_vjp`
-:func:`logsignature`                    :func:`roughpaths.logsignature`           :func:`roughpaths.logsignature_vjp`
-:func:`signature_kernel`                ``roughpaths.signature_kernel``           ``roughpaths.signature_kernel_vjp``
-:func:`signature_kernel_gram`           ``roughpaths.signature_kernel_gram``      ``roughpaths.signature_kernel_gram_vjp``
-======================================  ========================================  ===========================================
+* :func:`signature`: forward :func:`roughpaths.signature`, backward :func:`roughpaths.signature_vjp`;
+* :func:`logsignature`: :func:`roughpaths.logsignature`, :func:`roughpaths.logsignature_vjp`;
+* :func:`signature_kernel`: ``roughpaths.signature_kernel``, ``roughpaths.signature_kernel_vjp``;
+* :func:`signature_kernel_gram`: ``roughpaths.signature_kernel_gram``, ``roughpaths.signature_kernel_gram_vjp``.
 
 Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`` paths, the
 ``iisignature`` layout, the Lyndon basis). What the wrappers add, and what they do not:
 
-* **Devices.** The kernels run on the CPU: a CUDA, MPS or meta tensor is refused with a ``ValueError``
-  saying to pass ``x.cpu()`` (and to move the result back with ``.to(device)``); nothing is copied
-  between devices behind the caller's back.
+* **Devices.** The kernels run on the CPU: a CUDA or MPS tensor is refused with a ``ValueError``
+  saying to pass ``x.cpu()`` (and to move the result back with ``.to(device)``), a meta tensor (no
+  data) likewise; nothing is copied between devices behind the caller's back.
 * **Precision.** float32 and float64 tensors are accepted. The computation is always float64 (the
   kernels are float64 only): a float32 input is widened, the result (and the gradient) rounded back
   to float32, so float32 in gives float32 out, about as accurate as float32 can hold. Other dtypes

@@ -1,0 +1,179 @@
+"""``roughpaths.jax``: the numpy signatures as ``custom_vjp`` functions over ``pure_callback``.
+
+Claims: with x64 the values are the numpy API's to 1e-12, eagerly, under ``jit`` and under ``vmap``
+(which calls the numpy function once, with the mapped axis in front, not once per element); float32
+in gives float32 out; ``jax.test_util.check_grads`` (reverse mode, float64) passes and the
+gradients are the numpy VJPs, also under ``jit(vmap(grad))``; a few gradient steps lower a loss;
+integer inputs are refused. The signature-kernel wrappers are checked when
+``roughpaths.signature_kernel`` exists, and their plumbing against a stand-in kernel either way.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+
+import numpy as np
+import pytest
+
+import roughpaths as rp
+
+if os.environ.get("CI") and importlib.util.find_spec("jax") is None:
+    raise ImportError("jax is not installed under CI=true; ./test.sh installs the jax extra")
+jax = pytest.importorskip("jax", reason="the jax extra is not installed (pip install -e '.[jax]')")
+rpj = pytest.importorskip("roughpaths.jax")
+import jax.numpy as jnp  # noqa: E402
+from jax.test_util import check_grads  # noqa: E402
+
+HAS_KERNEL = hasattr(rp, "signature_kernel")
+needs_kernel = pytest.mark.skipif(not HAS_KERNEL, reason="roughpaths.signature_kernel is not in this version "
+                                                        "(the wrappers follow its contract; run after it lands)")
+
+
+@pytest.fixture
+def x64():
+    """jax_enable_x64 for one test, restored afterwards (it is process-wide)."""
+    old = jax.config.read("jax_enable_x64")
+    jax.config.update("jax_enable_x64", True)
+    yield
+    jax.config.update("jax_enable_x64", old)
+
+
+def _paths(shape, seed=0):
+    return np.random.default_rng(seed).standard_normal(shape).cumsum(axis=-2) * 0.5
+
+
+@pytest.mark.parametrize("name, depth", [("signature", 3), ("logsignature", 4)])
+def test_eager_jit_vmap_equal_numpy(x64, name, depth):
+    x = _paths((4, 7, 3))
+    want = getattr(rp, name)(x, depth)
+    fn = getattr(rpj, name)
+    for got in (fn(x, depth), jax.jit(fn, static_argnums=1)(x, depth), jax.vmap(lambda p: fn(p, depth))(x),
+                jax.jit(jax.vmap(lambda p: fn(p, depth)))(x)):
+        assert got.dtype == jnp.float64 and got.shape == want.shape
+        np.testing.assert_allclose(np.asarray(got), want, rtol=0, atol=1e-12)
+
+
+def test_vmap_is_one_batched_call(monkeypatch):
+    calls = []
+    real = rp.signature
+    monkeypatch.setattr(rp, "signature", lambda x, depth: calls.append(x.shape) or real(x, depth))
+    out = jax.vmap(jax.vmap(lambda p: rpj.signature(p, 2)))(jnp.zeros((3, 5, 4, 2)))
+    assert out.shape == (3, 5, 6) and calls == [(3, 5, 4, 2)]
+
+
+def test_float32_in_float32_out():
+    x = _paths((3, 6, 2)).astype(np.float32)
+    got = rpj.signature(x, 3)
+    assert got.dtype == jnp.float32
+    np.testing.assert_allclose(np.asarray(got), rp.signature(x, 3), rtol=1e-6, atol=1e-6)
+    g = jax.grad(lambda p: rpj.logsignature(p, 3).sum())(jnp.asarray(x))
+    assert g.dtype == jnp.float32 and g.shape == x.shape
+
+
+@pytest.mark.parametrize("name, depth", [("signature", 2), ("signature", 4), ("logsignature", 3)])
+def test_check_grads_and_numpy_vjp(x64, name, depth):
+    x = jnp.asarray(_paths((2, 5, 2), seed=1))
+    fn = getattr(rpj, name)
+    check_grads(lambda p: fn(p, depth), (x,), order=1, modes=["rev"])
+    g = np.random.default_rng(2).standard_normal(fn(x, depth).shape)
+    want = getattr(rp, name + "_vjp")(np.asarray(x), depth, g)
+    got = jax.vjp(lambda p: fn(p, depth), x)[1](jnp.asarray(g))[0]
+    np.testing.assert_allclose(np.asarray(got), want, rtol=0, atol=1e-12)
+    per_path = jax.jit(jax.vmap(jax.grad(lambda p, gi: jnp.vdot(fn(p, depth), gi))))(x, jnp.asarray(g))
+    np.testing.assert_allclose(np.asarray(per_path), want, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["signature", "logsignature"])
+def test_gradient_steps_lower_a_loss(name):
+    fn = getattr(rpj, name)
+    target = fn(_paths((6, 2), seed=3), 3)
+    loss = jax.jit(lambda p: jnp.sum((fn(p, 3) - target) ** 2))
+    x = jnp.asarray(_paths((6, 2), seed=4), dtype=jnp.float32)
+    first = loss(x)
+    step = jax.jit(lambda p: p - 0.02 * jax.grad(loss)(p))
+    for _ in range(15):
+        x = step(x)
+    assert loss(x) < 0.5 * first, (float(first), float(loss(x)))
+
+
+@pytest.mark.parametrize("bad, exc, words", [
+    (np.zeros((3, 2), dtype=np.int32), TypeError, ["int32", "float32 or float64"]),
+    ("paths", TypeError, ["array of floats"]),
+    (np.zeros(3), ValueError, ["at least 2 axes"]),
+])
+def test_bad_input_is_refused(bad, exc, words):
+    with pytest.raises(exc) as info:
+        rpj.signature(bad, 2)
+    for w in words:
+        assert w in str(info.value)
+
+
+# ------------------------------------------------------------------ signature kernels
+def _fake_kernel(x, y, *, dyadic_order=0, static_kernel=None):
+    """Stand-in with the kernels' contract: 1 + <S(x), S(y)> at depth 2 (+ dyadic_order, to see it arrive)."""
+    return 1.0 + dyadic_order + np.einsum("...i,...i->...", rp.signature(x, 2), rp.signature(y, 2))
+
+
+def _fake_kernel_vjp(x, y, g, *, dyadic_order=0, static_kernel=None):
+    sx, sy = rp.signature(x, 2), rp.signature(y, 2)
+    return rp.signature_vjp(x, 2, g[..., None] * sy), rp.signature_vjp(y, 2, g[..., None] * sx)
+
+
+def _fake_gram(X, Y, *, dyadic_order=0, static_kernel=None):
+    return _fake_kernel(X[..., :, None, :, :], Y[..., None, :, :, :], dyadic_order=dyadic_order)
+
+
+def _fake_gram_vjp(X, Y, g, *, dyadic_order=0, static_kernel=None):
+    sx, sy = rp.signature(X, 2), rp.signature(Y, 2)
+    return (rp.signature_vjp(X, 2, np.einsum("...ab,...bk->...ak", g, sy)),
+            rp.signature_vjp(Y, 2, np.einsum("...ab,...ak->...bk", g, sx)))
+
+
+@pytest.fixture
+def stand_in_kernels(monkeypatch):
+    for name, f in [("signature_kernel", _fake_kernel), ("signature_kernel_vjp", _fake_kernel_vjp),
+                    ("signature_kernel_gram", _fake_gram), ("signature_kernel_gram_vjp", _fake_gram_vjp)]:
+        monkeypatch.setattr(rp, name, f, raising=False)
+
+
+def test_kernel_plumbing_with_a_stand_in(x64, stand_in_kernels):
+    x, y = jnp.asarray(_paths((3, 5, 2), seed=5)), jnp.asarray(_paths((6, 2), seed=6))   # y broadcasts
+    k = jax.jit(lambda a, b: rpj.signature_kernel(a, b, dyadic_order=2))(x, y)
+    assert k.shape == (3,)
+    np.testing.assert_allclose(np.asarray(k), 3.0 + rp.signature(np.asarray(x), 2) @ rp.signature(np.asarray(y), 2),
+                               rtol=1e-13)
+    check_grads(lambda a, b: rpj.signature_kernel(a, b), (x, y), order=1, modes=["rev"])
+    X, Y = jnp.asarray(_paths((2, 3, 4, 2), seed=7)), jnp.asarray(_paths((2, 5, 6, 2), seed=8))
+    assert jax.vmap(rpj.signature_kernel_gram)(X, Y).shape == (2, 3, 5)
+    check_grads(lambda a, b: rpj.signature_kernel_gram(a, b), (X, Y), order=1, modes=["rev"])
+
+
+@needs_kernel
+def test_kernels_equal_numpy_jit_vmap_and_check_grads(x64):
+    x, y = _paths((2, 5, 2), seed=9), _paths((2, 4, 2), seed=10)
+    X, Y = _paths((3, 5, 2), seed=11), _paths((2, 4, 2), seed=12)
+    for order in (0, 1):
+        want = rp.signature_kernel(x, y, dyadic_order=order)
+        for got in (rpj.signature_kernel(x, y, dyadic_order=order),
+                    jax.jit(lambda a, b: rpj.signature_kernel(a, b, dyadic_order=order))(x, y),
+                    jax.vmap(lambda a, b: rpj.signature_kernel(a, b, dyadic_order=order))(x, y)):
+            np.testing.assert_allclose(np.asarray(got), want, rtol=0, atol=1e-12)
+        got = jax.jit(lambda a, b: rpj.signature_kernel_gram(a, b, dyadic_order=order))(X, Y)
+        np.testing.assert_allclose(np.asarray(got), rp.signature_kernel_gram(X, Y, dyadic_order=order), rtol=0,
+                                   atol=1e-12)
+    check_grads(lambda a, b: rpj.signature_kernel(a, b, dyadic_order=1), (jnp.asarray(x), jnp.asarray(y)),
+                order=1, modes=["rev"])
+    check_grads(lambda a, b: rpj.signature_kernel_gram(a, b), (jnp.asarray(X), jnp.asarray(Y)), order=1,
+                modes=["rev"])
+
+
+@needs_kernel
+def test_kernel_gradient_steps_lower_a_loss():
+    y = jnp.asarray(_paths((4, 6, 2), seed=13), dtype=jnp.float32)
+    loss = jax.jit(lambda p: jnp.sum(rpj.signature_kernel(p, p) - 2 * rpj.signature_kernel(p, y)))
+    x = jnp.asarray(_paths((4, 6, 2), seed=14), dtype=jnp.float32)
+    first = loss(x)
+    for _ in range(10):
+        x = x - 0.01 * jax.grad(loss)(x)
+    assert loss(x) < first

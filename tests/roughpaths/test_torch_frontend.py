@@ -1,0 +1,176 @@
+"""``roughpaths.torch``: the numpy signatures as torch autograd functions.
+
+Claims: the forward values are the numpy API's (1e-12 in float64, float32 rounding in float32);
+the gradients pass ``torch.autograd.gradcheck`` (central differences, float64) and are the numpy
+VJPs; a few Adam steps through each function lower a loss; bad tensors (non-tensor, meta device,
+integer or half dtype, mixed dtypes) are refused with the fix named. The signature-kernel wrappers
+are checked the same way when ``roughpaths.signature_kernel`` exists (skipped otherwise), and their
+plumbing (keywords, broadcasting, the gradients' shapes) against a stand-in kernel either way.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+
+import numpy as np
+import pytest
+
+import roughpaths as rp
+
+if os.environ.get("CI") and importlib.util.find_spec("torch") is None:
+    raise ImportError("torch is not installed under CI=true; ./test.sh installs the torch extra")
+torch = pytest.importorskip("torch", reason="the torch extra is not installed (pip install -e '.[torch]')")
+rpt = pytest.importorskip("roughpaths.torch")
+
+HAS_KERNEL = hasattr(rp, "signature_kernel")
+needs_kernel = pytest.mark.skipif(not HAS_KERNEL, reason="roughpaths.signature_kernel is not in this version "
+                                                        "(the wrappers follow its contract; run after it lands)")
+
+
+def _paths(shape, seed=0):
+    return np.random.default_rng(seed).standard_normal(shape).cumsum(axis=-2) * 0.5
+
+
+@pytest.mark.parametrize("name, depth", [("signature", 1), ("signature", 3), ("logsignature", 2),
+                                         ("logsignature", 4)])
+def test_forward_equals_numpy(name, depth):
+    x = _paths((2, 3, 7, 3))
+    got = getattr(rpt, name)(torch.from_numpy(x), depth)
+    want = getattr(rp, name)(x, depth)
+    assert got.dtype == torch.float64 and got.shape == want.shape
+    np.testing.assert_allclose(got.numpy(), want, rtol=0, atol=1e-12)
+    got32 = getattr(rpt, name)(torch.from_numpy(x).float(), depth)
+    assert got32.dtype == torch.float32
+    np.testing.assert_allclose(got32.numpy(), getattr(rp, name)(x.astype(np.float32), depth), rtol=1e-6, atol=1e-6)
+
+
+@pytest.mark.parametrize("name, depth", [("signature", 2), ("signature", 4), ("logsignature", 3)])
+def test_gradcheck_and_numpy_vjp(name, depth):
+    x = torch.from_numpy(_paths((2, 5, 2), seed=1)).requires_grad_()
+    fn = getattr(rpt, name)
+    assert torch.autograd.gradcheck(lambda p: fn(p, depth), (x,), eps=1e-6, atol=1e-7)
+    g = np.random.default_rng(2).standard_normal(fn(x, depth).shape)
+    fn(x, depth).backward(torch.from_numpy(g))
+    want = getattr(rp, name + "_vjp")(x.detach().numpy(), depth, g)
+    np.testing.assert_allclose(x.grad.numpy(), want, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["signature", "logsignature"])
+def test_adam_steps_lower_a_loss(name):
+    """Move a path so that its depth-3 (log-)signature approaches another path's."""
+    fn = getattr(rpt, name)
+    target = fn(torch.from_numpy(_paths((6, 2), seed=3)), 3)
+    x = torch.from_numpy(_paths((6, 2), seed=4)).float().requires_grad_()
+    opt = torch.optim.Adam([x], lr=0.05)
+    losses = []
+    for _ in range(15):
+        opt.zero_grad()
+        loss = ((fn(x, 3) - target.float()) ** 2).sum()
+        loss.backward()
+        opt.step()
+        losses.append(loss.item())
+    assert x.grad.dtype == torch.float32
+    assert losses[-1] < 0.5 * losses[0], losses
+
+
+def test_no_grad_and_second_derivative():
+    x = torch.from_numpy(_paths((4, 2))).requires_grad_()
+    with torch.no_grad():
+        assert not rpt.signature(x, 2).requires_grad
+    (g,) = torch.autograd.grad(rpt.signature(x, 2).sum(), x, create_graph=True)
+    with pytest.raises(RuntimeError, match="once_differentiable|does not require grad"):
+        g.sum().backward()
+
+
+@pytest.mark.parametrize("make, exc, words", [
+    (lambda: np.zeros((3, 2)), TypeError, ["paths must be a torch.Tensor", "torch.as_tensor"]),
+    (lambda: torch.zeros(3, 2, device="meta"), ValueError, ["meta", "CPU"]),
+    (lambda: torch.zeros(3, 2, dtype=torch.int64), TypeError, ["torch.int64", "paths.double()"]),
+    (lambda: torch.zeros(3, 2, dtype=torch.float16), TypeError, ["torch.float16", "float32 or float64"]),
+])
+def test_bad_tensors_are_refused(make, exc, words):
+    with pytest.raises(exc) as info:
+        rpt.signature(make(), 2)
+    for w in words:
+        assert w in str(info.value)
+
+
+# ------------------------------------------------------------------ signature kernels
+def _fake_kernel(x, y, *, dyadic_order=0, static_kernel=None):
+    """Stand-in with the kernels' contract: 1 + <S(x), S(y)> at depth 2 (+ dyadic_order, to see it arrive)."""
+    return 1.0 + dyadic_order + np.einsum("...i,...i->...", rp.signature(x, 2), rp.signature(y, 2))
+
+
+def _fake_kernel_vjp(x, y, g, *, dyadic_order=0, static_kernel=None):
+    sx, sy = rp.signature(x, 2), rp.signature(y, 2)
+    return rp.signature_vjp(x, 2, g[..., None] * sy), rp.signature_vjp(y, 2, g[..., None] * sx)
+
+
+def _fake_gram(X, Y, *, dyadic_order=0, static_kernel=None):
+    return _fake_kernel(X[..., :, None, :, :], Y[..., None, :, :, :], dyadic_order=dyadic_order)
+
+
+def _fake_gram_vjp(X, Y, g, *, dyadic_order=0, static_kernel=None):
+    sx, sy = rp.signature(X, 2), rp.signature(Y, 2)
+    return (rp.signature_vjp(X, 2, np.einsum("...ab,...bk->...ak", g, sy)),
+            rp.signature_vjp(Y, 2, np.einsum("...ab,...ak->...bk", g, sx)))
+
+
+@pytest.fixture
+def stand_in_kernels(monkeypatch):
+    for name, f in [("signature_kernel", _fake_kernel), ("signature_kernel_vjp", _fake_kernel_vjp),
+                    ("signature_kernel_gram", _fake_gram), ("signature_kernel_gram_vjp", _fake_gram_vjp)]:
+        monkeypatch.setattr(rp, name, f, raising=False)
+
+
+def test_kernel_plumbing_with_a_stand_in(stand_in_kernels):
+    x = torch.from_numpy(_paths((3, 5, 2), seed=5)).requires_grad_()
+    y = torch.from_numpy(_paths((6, 2), seed=6)).requires_grad_()        # broadcast against x's batch
+    k = rpt.signature_kernel(x, y, dyadic_order=2)
+    assert k.shape == (3,)
+    np.testing.assert_allclose(k.detach().numpy(), 3.0 + rp.signature(x.detach().numpy(), 2)
+                               @ rp.signature(y.detach().numpy(), 2), rtol=1e-13)
+    assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel(a, b), (x, y))
+    X = torch.from_numpy(_paths((2, 3, 4, 2), seed=7)).requires_grad_()
+    Y = torch.from_numpy(_paths((2, 5, 6, 2), seed=8)).requires_grad_()
+    assert rpt.signature_kernel_gram(X, Y).shape == (2, 3, 5)
+    assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel_gram(a, b), (X, Y))
+
+
+def test_missing_kernels_say_so(monkeypatch):
+    monkeypatch.delattr(rp, "signature_kernel", raising=False)
+    with pytest.raises(NotImplementedError, match="signature_kernel is not available"):
+        rpt.signature_kernel(torch.zeros(3, 2), torch.zeros(3, 2))
+
+
+@needs_kernel
+def test_kernels_equal_numpy_and_gradcheck():
+    x, y = _paths((2, 5, 2), seed=9), _paths((2, 4, 2), seed=10)
+    X, Y = _paths((3, 5, 2), seed=11), _paths((2, 4, 2), seed=12)
+    for order in (0, 1):
+        got = rpt.signature_kernel(torch.from_numpy(x), torch.from_numpy(y), dyadic_order=order)
+        np.testing.assert_allclose(got.numpy(), rp.signature_kernel(x, y, dyadic_order=order), rtol=0, atol=1e-12)
+        got = rpt.signature_kernel_gram(torch.from_numpy(X), torch.from_numpy(Y), dyadic_order=order)
+        np.testing.assert_allclose(got.numpy(), rp.signature_kernel_gram(X, Y, dyadic_order=order), rtol=0,
+                                   atol=1e-12)
+    tx, ty = torch.from_numpy(x).requires_grad_(), torch.from_numpy(y).requires_grad_()
+    assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel(a, b, dyadic_order=1), (tx, ty))
+    tX, tY = torch.from_numpy(X).requires_grad_(), torch.from_numpy(Y).requires_grad_()
+    assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel_gram(a, b), (tX, tY))
+
+
+@needs_kernel
+def test_kernel_adam_steps_lower_a_loss():
+    """Pull a batch of paths towards a reference in the kernel's distance k(x,x) - 2 k(x,y) + k(y,y)."""
+    y = torch.from_numpy(_paths((4, 6, 2), seed=13)).float()
+    x = torch.from_numpy(_paths((4, 6, 2), seed=14)).float().requires_grad_()
+    opt = torch.optim.Adam([x], lr=0.05)
+    losses = []
+    for _ in range(10):
+        opt.zero_grad()
+        loss = (rpt.signature_kernel(x, x) - 2 * rpt.signature_kernel(x, y)).sum()
+        loss.backward()
+        opt.step()
+        losses.append(loss.item())
+    assert losses[-1] < losses[0], losses
