@@ -125,7 +125,8 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     """
 
     def _forward(ctx, params, *tensors):
-        arrays = _batch_broadcast([_as_numpy(t, n) for t, n in zip(tensors, names)], core)
+        # checked by apply() below: CPU tensors of one float dtype
+        arrays = _batch_broadcast([t.detach().numpy().astype(np.float64, copy=False) for t in tensors], core)
         out = np.asarray(forward(*arrays, **params), dtype=np.float64)
         ctx.params = params
         ctx.save_for_backward(*tensors)
@@ -134,7 +135,7 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     @once_differentiable
     def _backward(ctx, grad):
         tensors = ctx.saved_tensors
-        arrays = _batch_broadcast([_as_numpy(t, n) for t, n in zip(tensors, names)], core)
+        arrays = _batch_broadcast([t.detach().numpy().astype(np.float64, copy=False) for t in tensors], core)
         g = grad.detach().cpu().numpy().astype(np.float64, copy=False)
         grads = vjp(*arrays, np.broadcast_to(g, g.shape), **ctx.params)
         grads = (grads,) if len(tensors) == 1 else tuple(grads)

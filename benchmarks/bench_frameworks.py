@@ -1,0 +1,143 @@
+"""Benchmark: the torch and JAX front ends, forward plus backward, against pysiglib's torch and JAX APIs.
+
+Everything is timed in one run on the same data, in CPU time (``time.process_time``: the machine is
+shared, and CPU time does not count the time other processes hold the cores); each cell is the
+median over ``--repeats`` interleaved pairs (ours, peer, ours, peer, ...), each timed call right
+after an untimed call of the same function. "ratio" is ours / peer (below 1: ours is cheaper).
+
+1. torch, forward + backward of ``sum(sig * G)`` with respect to the points, float64, batch of
+   ``--batch`` paths of ``--length`` points, d = 3, 5, 8, depths 2-4: ``roughpaths.torch.signature``
+   against ``pysiglib.torch_api.sig`` (``n_jobs=-1``); also the log-signature (Lyndon basis,
+   pysiglib ``method=2``). Both libraries get the machine's threads; torch's own intra-op threads are
+   set to 1 (``torch.set_num_threads(1)``) for both, since their idle spinning after a torch operation
+   is counted as CPU time and is nobody's kernel.
+2. The wrapper's own cost: ``roughpaths.torch`` forward + backward against the bare numpy calls
+   ``roughpaths.signature`` + ``roughpaths.signature_vjp`` on the same array.
+3. JAX: a jitted ``roughpaths.jax.signature`` (``pure_callback``) forward + backward against the bare
+   numpy calls, at a tiny and a moderate size, and against pysiglib's JAX API (an XLA FFI custom call)
+   where it loads: what a callback costs per call, and so whether an FFI custom call would pay.
+
+Usage: ``python benchmarks/bench_frameworks.py [--repeats 7] [--batch 32] [--length 128]``
+(with ``PYTHONPATH`` putting this checkout first; needs torch, jax and pysiglib: the ``bench`` extra).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+
+def cpu_medians(fns, repeats: int) -> list:
+    """Median CPU times of several functions timed in turn (ours, peer, ours, peer, ...)."""
+    for fn in fns:
+        fn()                                    # warm-up (compilation, caches)
+    times = [[] for _ in fns]
+    for _ in range(max(1, repeats)):
+        for i, fn in enumerate(fns):
+            fn()
+            t0 = time.process_time()
+            fn()
+            times[i].append(time.process_time() - t0)
+    return [float(np.median(t)) for t in times]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--batch", type=int, default=32)
+    parser.add_argument("--length", type=int, default=128)
+    args = parser.parse_args()
+
+    import numba
+    import pysiglib
+    import pysiglib.torch_api as pst
+    import torch
+
+    import roughpaths as rp
+    import roughpaths.torch as rpt
+
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(2026)
+    B, n = args.batch, args.length
+    print(f"numba threads {numba.get_num_threads()}, cpu count {os.cpu_count()}, load average "
+          f"{os.getloadavg()[0]:.1f}; torch {torch.__version__}, pysiglib {pysiglib.__version__}")
+    print(f"batch {B} paths x {n} points, float64; CPU-time medians of {args.repeats} interleaved pairs, in ms; "
+          f"ratio = ours / peer (below 1: ours cheaper)\n")
+
+    def fwd_bwd(fn, x, g):
+        def run():
+            xt = x.detach().requires_grad_()
+            out = fn(xt)
+            out.backward(g)
+            return xt.grad
+        return run
+
+    for kind in ("signature", "log-signature"):
+        print(f"1. torch, forward + backward, {kind}")
+        print(f"{'d':>3}{'depth':>7}{'ours':>10}{'pysiglib':>10}{'ratio':>8}{'max |Δgrad|':>14}")
+        for d in (3, 5, 8):
+            x = torch.from_numpy(np.cumsum(rng.standard_normal((B, n, d)), axis=1) / np.sqrt(n))
+            for depth in (2, 3, 4):
+                if kind == "signature":
+                    ours = lambda p, m=depth: rpt.signature(p, m)
+                    peer = lambda p, m=depth: pst.sig(p, m, n_jobs=-1)
+                    width = rp.sigdim(d, depth)
+                else:
+                    pysiglib.prepare_log_sig(d, depth, method=2)
+                    ours = lambda p, m=depth: rpt.logsignature(p, m)
+                    peer = lambda p, m=depth: pst.log_sig(p, m, method=2, n_jobs=-1)
+                    width = rp.logsigdim(d, depth)
+                g = torch.from_numpy(rng.standard_normal((B, width)))
+                f_o, f_p = fwd_bwd(ours, x, g), fwd_bwd(peer, x, g)
+                t_o, t_p = cpu_medians((f_o, f_p), args.repeats)
+                diff = float((f_o() - f_p()).abs().max())
+                print(f"{d:>3}{depth:>7}{1e3 * t_o:>10.2f}{1e3 * t_p:>10.2f}{t_o / t_p:>8.2f}{diff:>14.1e}", flush=True)
+        print()
+
+    print("2. the torch wrapper's own cost: rpt.signature forward + backward vs rp.signature + rp.signature_vjp")
+    print(f"{'d':>3}{'depth':>7}{'wrapper':>10}{'numpy':>10}{'ratio':>8}")
+    for d, depth in ((3, 2), (3, 4), (8, 4)):
+        xn = np.cumsum(rng.standard_normal((B, n, d)), axis=1) / np.sqrt(n)
+        gn = rng.standard_normal((B, rp.sigdim(d, depth)))
+        f_o = fwd_bwd(lambda p, m=depth: rpt.signature(p, m), torch.from_numpy(xn), torch.from_numpy(gn))
+        f_n = lambda m=depth: (rp.signature(xn, m), rp.signature_vjp(xn, m, gn))
+        t_o, t_n = cpu_medians((f_o, f_n), args.repeats)
+        print(f"{d:>3}{depth:>7}{1e3 * t_o:>10.3f}{1e3 * t_n:>10.3f}{t_o / t_n:>8.2f}", flush=True)
+    print()
+
+    import jax
+    import jax.numpy as jnp
+
+    import roughpaths.jax as rpj
+
+    jax.config.update("jax_enable_x64", True)
+    try:
+        import pysiglib.jax_api as psj
+        psj.sig(jnp.zeros((2, 4, 3)), 2)
+    except Exception as exc:                    # the FFI plugin may not load with this jax
+        psj = None
+        print(f"(pysiglib's JAX API did not load: {type(exc).__name__}: {str(exc)[:100]})")
+    print("3. JAX, jitted forward + backward (value_and_grad of sum(sig * G)), depth 3")
+    print(f"{'case':<22}{'callback':>10}{'numpy':>10}{'overhead':>10}{'pysiglib FFI':>14}{'ratio/FFI':>11}")
+    for B3, n3, d in ((1, 8, 3), (B, n, 3), (B, n, 8)):
+        xn = np.cumsum(rng.standard_normal((B3, n3, d)), axis=1) / np.sqrt(n3)
+        gn = rng.standard_normal((B3, rp.sigdim(d, 3)))
+        xj, gj = jnp.asarray(xn), jnp.asarray(gn)
+        ours = jax.jit(jax.value_and_grad(lambda p: jnp.sum(rpj.signature(p, 3) * gj)))
+        f_o = lambda: jax.block_until_ready(ours(xj))
+        f_n = lambda: (rp.signature(xn, 3), rp.signature_vjp(xn, 3, gn))
+        fns = [f_o, f_n]
+        if psj is not None:
+            peer = jax.jit(jax.value_and_grad(lambda p: jnp.sum(psj.sig(p, 3, n_jobs=-1) * gj)))
+            fns.append(lambda: jax.block_until_ready(peer(xj)))
+        t = cpu_medians(fns, args.repeats)
+        name = f"{B3} x {n3}, d={d}"
+        ffi = f"{1e3 * t[2]:>14.3f}{t[0] / t[2]:>11.2f}" if psj is not None else f"{'-':>14}{'-':>11}"
+        print(f"{name:<22}{1e3 * t[0]:>10.3f}{1e3 * t[1]:>10.3f}{1e3 * (t[0] - t[1]):>10.3f}{ffi}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
