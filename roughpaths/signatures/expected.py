@@ -49,7 +49,7 @@ def brownian_expected_signature(dim: int, depth: int, t: float = 1.0) -> np.ndar
     of every level :math:`k \ge 1` are Itô integrals of square-integrable adapted integrands, hence
     martingales started at 0: the expected Itô signature is 1 at level 0 and **exactly 0 at every
     level** :math:`k \ge 1`. At level 2 the two differ by :math:`\tfrac t2 I`, the
-    :math:`\mathbb{X}^{Itô} = \mathbb{X}^{Strat} - \tfrac12 (t - s) I` of ``docs/conventions.md``;
+    :math:`\mathbb{X}^{\text{Itô}} = \mathbb{X}^{\text{Strat}} - \tfrac12 (t - s) I` of ``docs/conventions.md``;
     at higher levels the Stratonovich iterated integrals add, to the Itô ones, every way of
     contracting adjacent equal letters :math:`(i\,i)` into :math:`\tfrac12\,dt`, and only the full
     contractions survive in expectation, which is the formula above.
