@@ -1,0 +1,151 @@
+"""BrownianTree: Chen across subdivisions, order independence, bounded cache, Brownian law deep in the tree.
+
+Oracles: Chen's identity written out here (``XX_{s,t} = XX_{s,u} + XX_{u,t} + X_{s,u} ⊗ X_{u,t}``); the
+exact laws N(0, h) of the increment and Lévy's law of the d = 2 area, whose characteristic function is
+``1/cosh(λh/2)`` (CDF of ``A/h``: ``(2/π) arctan(exp(π a))``, variance 1/4, fourth moment 5/16).
+"""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+import roughpaths as rp
+
+
+
+def _sech_cdf(a):
+    return 2.0 / np.pi * np.arctan(np.exp(np.pi * a))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_chen_holds_across_random_subdivisions(dim):
+    tree = rp.BrownianTree(dim, seed=5, t0=-0.5, t1=2.0, batch_shape=(3, 2))
+    rng = np.random.default_rng(1)
+    worst = 0.0
+    for _ in range(12):
+        s, u, t = np.sort(rng.uniform(-0.5, 2.0, 3))
+        x1, xx1 = tree.increment(s, u), tree.area(s, u)
+        x2, xx2 = tree.increment(u, t), tree.area(u, t)
+        x, xx = tree.increment(s, t), tree.area(s, t)
+        assert x.shape == (3, 2, dim) and xx.shape == (3, 2, dim, dim)
+        worst = max(worst, np.abs(x - x1 - x2).max(),
+                    np.abs(xx - (xx1 + xx2 + x1[..., :, None] * x2[..., None, :])).max())
+    assert worst < 1e-12
+    # geometric: Sym(XX) = ½ X ⊗ X, and the Lévy area is Alt(XX)
+    assert np.allclose(xx + np.swapaxes(xx, -1, -2), x[..., :, None] * x[..., None, :], atol=1e-13)
+    assert np.allclose(tree.levy_area(s, t), 0.5 * (xx - np.swapaxes(xx, -1, -2)), atol=1e-14)
+
+
+def test_answers_do_not_depend_on_query_order_or_cache():
+    rng = np.random.default_rng(2)
+    queries = [tuple(np.sort(rng.uniform(0, 1, 2))) for _ in range(8)]
+    a = rp.BrownianTree(2, seed=9, batch_shape=(4,))
+    first = [(a.increment(s, t), a.area(s, t)) for s, t in queries]
+    b = rp.BrownianTree(2, seed=9, batch_shape=(4,), cache_size=0)          # recomputes from the root
+    for s, t in rng.uniform(0, 1, (5, 2)):
+        b.area(min(s, t), max(s, t))                                          # unrelated earlier queries
+    second = [(b.increment(s, t), b.area(s, t)) for s, t in reversed(queries)][::-1]
+    for (x, xx), (y, yy) in zip(first, second):
+        assert np.array_equal(x, y) and np.array_equal(xx, yy)
+    # a member's path depends on its index only, not on the batch it is drawn with
+    c = rp.BrownianTree(2, seed=9, batch_shape=(2,))
+    assert np.array_equal(c.area(*queries[0]), first[0][1][:2])
+    assert not np.array_equal(rp.BrownianTree(2, seed=10, batch_shape=(4,)).area(*queries[0]), first[0][1])
+
+
+def test_cache_stays_bounded():
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(2,), cache_size=40, resolution=30)
+    rng = np.random.default_rng(3)
+    for _ in range(60):
+        s, t = np.sort(rng.uniform(0, 1, 2))
+        tree.area(s, t)
+        assert tree.cached_nodes <= 40
+    assert tree.cached_nodes == 40
+    default = rp.BrownianTree(2, seed=0, batch_shape=(20000,))
+    assert 2 <= default.cache_size and default.cache_size * default.node_bytes <= 2 ** 26
+
+
+def test_rough_path_on_a_grid_matches_the_queries():
+    tree = rp.BrownianTree(2, seed=4, batch_shape=(3,))
+    times = np.array([0.0, 0.1, 0.37, 0.5, 0.93, 1.0])
+    X = tree.rough_path(times)
+    assert X.increments.shape == (3, 5, 2) and X.kind == "geometric"
+    for k in range(5):
+        assert np.array_equal(X.increments[:, k], tree.increment(times[k], times[k + 1]))
+        assert np.allclose(X.areas[:, k], tree.area(times[k], times[k + 1]), atol=1e-15)
+    assert np.allclose(X.area(0.1, 0.93), tree.area(0.1, 0.93), atol=1e-12)     # RoughPath's own Chen
+
+
+def test_one_dimension_and_scalar_batch():
+    tree = rp.BrownianTree(1, seed=1)
+    x, xx = tree.increment(0.2, 0.9), tree.area(0.2, 0.9)
+    assert x.shape == (1,) and xx.shape == (1, 1)
+    assert np.isclose(xx[0, 0], 0.5 * x[0] ** 2, atol=1e-15) and tree.levy_area(0.2, 0.9)[0, 0] == 0.0
+    assert np.array_equal(tree.increment(0.3, 0.3), np.zeros(1))
+
+
+def _law_checks(P, seed):
+    tree = rp.BrownianTree(2, seed=seed, batch_shape=(P,))
+    s, t = 0.61803, 0.61803 + 1.5e-3                       # non-dyadic, about depth 9.4
+    h = t - s
+    x = tree.increment(s, t)
+    a = tree.levy_area(s, t)[:, 0, 1] / h
+    assert stats.kstest(x.ravel() / np.sqrt(h), "norm").pvalue > 1e-3
+    assert stats.kstest(a, _sech_cdf).pvalue > 1e-3
+    for k, value in ((2, 0.25), (4, 5.0 / 16.0)):
+        m = a ** k
+        assert abs(m.mean() - value) < 4 * m.std() / np.sqrt(P), (k, m.mean(), value)
+    y = tree.increment(0.3, s)                              # independent increments
+    prod = (x * y).sum(axis=1) / np.sqrt(h * (s - 0.3))
+    assert abs(prod.mean()) < 4 * prod.std() / np.sqrt(P)
+
+
+def test_law_on_a_short_nondyadic_interval():
+    _law_checks(4000, seed=21)
+
+
+@pytest.mark.slow
+def test_law_on_a_short_nondyadic_interval_full():
+    _law_checks(20000, seed=22)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("m", [2, 3])
+def test_area_law_error_does_not_grow_with_depth(m):
+    P = 20000
+    tree = rp.BrownianTree(2, seed=30 + m, batch_shape=(P,), polygon_levels=m, cache_size=64)
+    ks = {}
+    for depth in (1, 5, 10, 20):
+        h = 2.0 ** -depth
+        j = int(0.61803 / h)
+        a = tree.levy_area(j * h, (j + 1) * h)[:, 0, 1] / h
+        ks[depth] = stats.kstest(a, _sech_cdf).statistic
+    noise = 1.63 / np.sqrt(P)                              # the 1 % point of the KS statistic
+    assert max(ks.values()) < noise, ks
+    assert ks[20] < ks[1] + 0.5 * noise, ks
+
+
+def test_bad_input_is_refused_with_the_fix():
+    with pytest.raises(ValueError, match="t1"):
+        rp.BrownianTree(2, seed=0, t0=1.0, t1=1.0)
+    with pytest.raises(ValueError, match="levy_area"):
+        rp.BrownianTree(2, seed=0, levy_area=None)
+    with pytest.raises(ValueError, match="levy_area"):
+        rp.BrownianTree(2, seed=0, levy_area="nope")
+    with pytest.raises(ValueError, match="exact"):
+        rp.BrownianTree(3, seed=0, levy_area="exact")
+    with pytest.raises(ValueError, match="polygon_levels"):
+        rp.BrownianTree(2, seed=0, polygon_levels=9)
+    with pytest.raises(ValueError, match="resolution"):
+        rp.BrownianTree(2, seed=0, resolution=63)
+    with pytest.raises(TypeError, match="seed"):
+        rp.BrownianTree(2, seed=np.random.default_rng(0))
+    tree = rp.BrownianTree(2, seed=0)
+    with pytest.raises(ValueError, match="swap"):
+        tree.area(0.5, 0.2)
+    with pytest.raises(ValueError, match=r"\[t0, t1\]"):
+        tree.increment(0.5, 1.5)
+    with pytest.raises(TypeError, match="s must be a real number"):
+        tree.increment("a", 0.5)
+    with pytest.raises(ValueError, match="strictly increasing"):
+        tree.rough_path([0.0, 0.5, 0.5])
