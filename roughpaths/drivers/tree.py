@@ -62,7 +62,6 @@ nodes (default: as many as fit in 64 MiB, at most 8192), which does not grow wit
 
 from __future__ import annotations
 
-import numbers
 from collections import OrderedDict
 
 import numpy as np
@@ -100,10 +99,12 @@ class BrownianTree:
     batch_shape : tuple of int
         Independent paths; answers have shape ``batch_shape + (d,)`` or ``batch_shape + (d, d)``.
     levy_area : str
-        Sampler of the root's Lévy area (a method of :data:`~roughpaths.LEVY_AREA_METHODS`, default
-        ``"auto"``: exact in law for ``d <= 2``, L² error ``levy_area_error`` for ``d >= 3``).
+        Sampler of the Lévy areas of the root's ``2^m`` segments (a method of
+        :data:`~roughpaths.LEVY_AREA_METHODS`, default ``"auto"``: exact in law for ``d <= 2``, L² error
+        ``levy_area_error`` for ``d >= 3``); the splits below the root are the tree's own.
     levy_area_error : float, optional
-        Error of the root's area for the error-controlled methods (default ``(t1 - t0)^{3/2}``).
+        Error per root segment of the error-controlled methods (default :math:`\delta^{3/2}`,
+        :math:`\delta = (t_1 - t_0)2^{-m}`).
     polygon_levels : int
         ``m``: each node carries ``2^m`` segments (default 3; the tail is ``2^-m`` of the area variance).
     resolution : int
