@@ -47,7 +47,8 @@ from numba import njit
 
 from ._bridge import _pair_solve
 
-__all__ = ["split_width", "refine_segments", "refine_segments_fast", "polygon_area", "antisym_from_normals"]
+__all__ = ["split_width", "refine_segments", "refine_segments_fast", "polygon_area", "reduce_node",
+           "antisym_from_normals"]
 
 
 def split_width(n: int, d: int) -> int:
@@ -291,3 +292,35 @@ def refine_segments_fast(w, G, delta, z):
     _refine_segments_nb(np.ascontiguousarray(w), np.ascontiguousarray(G), float(delta), np.ascontiguousarray(z),
                         fine, GL, GR)
     return fine, GL, GR
+
+
+@njit(cache=True, nogil=True)
+def _reduce_nb(w, G, W, A):
+    """``W = Σ_i w_i`` and ``A = ½ Σ_{i<j} w_i ∧ w_j + G`` per path (compiled :func:`polygon_area` plus ``G``)."""
+    P, n, d = w.shape
+    S = np.empty(d)
+    for r in range(P):
+        for a in range(d):
+            S[a] = 0.0
+        for a in range(d):
+            for b in range(d):
+                A[r, a, b] = G[r, a, b]
+        for i in range(n):
+            for a in range(d):
+                for b in range(a + 1, d):
+                    v = 0.5 * (S[a] * w[r, i, b] - S[b] * w[r, i, a])
+                    A[r, a, b] += v
+                    A[r, b, a] -= v
+            for a in range(d):
+                S[a] += w[r, i, a]
+        for a in range(d):
+            W[r, a] = S[a]
+
+
+def reduce_node(w, G):
+    """``(W (P, d), A (P, d, d))`` of a node state ``(w (P, n, d), G (P, d, d))``: Chen over its polygon."""
+    P, n, d = w.shape
+    W = np.empty((P, d))
+    A = np.empty((P, d, d))
+    _reduce_nb(w, G, W, A)
+    return W, A

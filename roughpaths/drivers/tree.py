@@ -70,7 +70,7 @@ from ..paths.rough_path import RoughPath
 from ..validation import as_float_array, check_batch_shape, check_positive_int, check_real
 from ._random import PathStreams
 from ._seeded import check_seed
-from ._tree_kernels import polygon_area, refine_segments_fast, split_width
+from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, split_width
 from .areas import _Sampler
 
 __all__ = ["BrownianTree"]
@@ -81,8 +81,7 @@ _CACHE_BYTES = 64 * 2 ** 20
 
 def _reduce(node):
     """``(W, A)`` of a node state ``(w, G)``: Chen's identity over its polygon."""
-    w, G = node
-    return w.sum(axis=1), polygon_area(w) + G
+    return reduce_node(*node)
 
 
 class BrownianTree:

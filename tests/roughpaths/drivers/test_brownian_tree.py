@@ -168,7 +168,8 @@ def test_conditional_area_variance_given_the_increment(dim):
 
 
 def test_compiled_split_matches_the_numpy_reference_and_keeps_chen():
-    from roughpaths.drivers._tree_kernels import polygon_area, refine_segments, refine_segments_fast, split_width
+    from roughpaths.drivers._tree_kernels import (polygon_area, reduce_node, refine_segments, refine_segments_fast,
+                                                  split_width)
 
     rng = np.random.default_rng(6)
     for d, n in ((2, 1), (2, 8), (3, 4)):
@@ -187,3 +188,6 @@ def test_compiled_split_matches_the_numpy_reference_and_keeps_chen():
         parent = (naive(w) if n > 1 else 0.0) + G
         assert np.allclose(naive(fine) + GL + GR, parent, atol=1e-14)
         assert np.allclose(polygon_area(fine), naive(fine), atol=1e-15)
+        W, A = reduce_node(fine[:, n:], GR)                               # a non-contiguous view, as cached
+        assert np.allclose(W, fine[:, n:].sum(axis=1), atol=1e-15)
+        assert np.allclose(A, naive(fine[:, n:]) + GR, atol=1e-15)
