@@ -17,8 +17,8 @@ from ._version import __version__
 from .algebra import (from_level2, from_lyndon_coordinates, level2_exp, level2_inv, level2_log, level2_mul,
                       logsigdim, lyndon_basis, lyndon_coordinates, sigdim, tensor_exp, tensor_inverse, tensor_log,
                       tensor_product, to_level2)
-from .drivers import (DEFAULT_SUBSTEPS, LEVY_AREA_METHODS, BrownianDriver, ColouredNoiseDriver, ColouredNoiseLimit,
-                      ColouredNoiseSample, Driver, ResolutionWarning, brownian_increments_and_areas,
+from .drivers import (DEFAULT_SUBSTEPS, LEVY_AREA_METHODS, BrownianDriver, BrownianTree, ColouredNoiseDriver,
+                      ColouredNoiseLimit, ColouredNoiseSample, Driver, ResolutionWarning, brownian_increments_and_areas,
                       brownian_rough_path, choose_levy_area_method, coloured_noise_limit, coloured_noise_limit_path,
                       expected_area_rate, fbm, fbm_rough_path, fgn_autocovariance, iter_coloured_noise,
                       levy_area_normals, levy_area_terms, levy_areas_from_normals, lift_area_rate, ou_step_law,
@@ -48,7 +48,8 @@ __all__ = [
     # level-N rough paths, fractional Brownian motion
     "RoughPathN", "fbm", "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift",
     # Brownian motion and Lévy areas
-    "brownian_rough_path", "BrownianDriver", "brownian_increments_and_areas", "refine", "DEFAULT_SUBSTEPS",
+    "brownian_rough_path", "BrownianDriver", "BrownianTree", "brownian_increments_and_areas", "refine",
+    "DEFAULT_SUBSTEPS",
     "sample_levy_areas", "levy_areas_from_normals", "levy_area_terms", "levy_area_normals",
     "choose_levy_area_method", "LEVY_AREA_METHODS",
     # norms

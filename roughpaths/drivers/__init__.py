@@ -3,8 +3,9 @@
 * :mod:`~roughpaths.drivers.base`: the :class:`Driver` contract.
 * :mod:`~roughpaths.drivers.brownian`: Brownian motion with Lévy areas (:class:`BrownianDriver`),
   :mod:`~roughpaths.drivers.areas` (every Lévy-area method behind one ``levy_area``),
-  :mod:`~roughpaths.drivers.levy_area` (the error-controlled and exact samplers) and
-  :mod:`~roughpaths.drivers.refinement` (the same path on a finer grid).
+  :mod:`~roughpaths.drivers.levy_area` (the error-controlled and exact samplers),
+  :mod:`~roughpaths.drivers.refinement` (the same path on a finer grid) and
+  :mod:`~roughpaths.drivers.tree` (the same path on any interval: :class:`BrownianTree`).
 * :mod:`~roughpaths.drivers.coloured_noise` (and its law, :mod:`~roughpaths.drivers.coloured_noise_law`):
   Ornstein–Uhlenbeck coloured noise and its Wong–Zakai limit.
 * :mod:`~roughpaths.drivers.fractional`: fractional Brownian motion and its rough-path lift.
@@ -23,6 +24,7 @@ from .fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linea
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals)
 from .refinement import RefinedBrownianDriver, refine
+from .tree import BrownianTree
 
 __all__ = [
     "Driver", "DEFAULT_SUBSTEPS", "BrownianDriver", "brownian_increments_and_areas", "brownian_rough_path",
@@ -31,5 +33,5 @@ __all__ = [
     "expected_area_rate", "lift_area_rate", "ou_step_law", "paper_coloured_noise_matrices", "fbm",
     "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift", "LEVY_AREA_METHODS",
     "choose_levy_area_method", "levy_area_normals", "levy_area_terms", "levy_areas_from_normals",
-    "sample_levy_areas", "RefinedBrownianDriver", "refine",
+    "sample_levy_areas", "RefinedBrownianDriver", "refine", "BrownianTree",
 ]
