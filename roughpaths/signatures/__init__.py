@@ -11,11 +11,12 @@ kernels (:mod:`~roughpaths.signatures.static_kernels`) and the two-sample test o
 
 from .gradients import logsignature_vjp, rough_path_signature_vjp, signature_vjp
 from .kernel import signature_kernel, signature_kernel_gram, signature_kernel_gram_vjp, signature_kernel_vjp
+from .mmd import MMDTestResult, sig_mmd_test
 from .signature import logsignature, rough_path_signature, signature
 from .static_kernels import LinearKernel, RBFKernel
 
 __all__ = [
     "logsignature_vjp", "rough_path_signature_vjp", "signature_vjp", "logsignature", "rough_path_signature",
     "signature", "signature_kernel", "signature_kernel_gram", "signature_kernel_vjp", "signature_kernel_gram_vjp",
-    "LinearKernel", "RBFKernel",
+    "LinearKernel", "RBFKernel", "sig_mmd_test", "MMDTestResult",
 ]
