@@ -35,7 +35,11 @@ _MAX_ORDER = 20
 
 
 def _check_order(dyadic_order) -> int:
-    return check_positive_int(dyadic_order, "dyadic_order", minimum=0)
+    try:
+        return check_positive_int(dyadic_order, "dyadic_order", minimum=0)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{exc} Pass an integer >= 0: each step of both paths is refined 2**dyadic_order "
+                        f"times in the PDE grid (0: the paths' own grid; 2 to 4 is typical).") from None
 
 
 def _check_pair(x, y, names: tuple, axes: int) -> tuple:

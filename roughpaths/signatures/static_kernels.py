@@ -41,7 +41,7 @@ class LinearKernel:
     scale: float = 1.0
 
     def __post_init__(self):
-        object.__setattr__(self, "scale", check_positive_real(self.scale, "scale"))
+        object.__setattr__(self, "scale", _positive(self.scale, "scale", "the factor applied to both paths"))
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,15 @@ class RBFKernel:
     sigma: float
 
     def __post_init__(self):
-        object.__setattr__(self, "sigma", check_positive_real(self.sigma, "sigma"))
+        object.__setattr__(self, "sigma", _positive(self.sigma, "sigma", "the RBF length scale, in the units of "
+                                                      "the paths' values"))
+
+
+def _positive(value, name: str, what: str) -> float:
+    try:
+        return check_positive_real(value, name)
+    except ValueError as exc:
+        raise ValueError(f"{exc} Pass a positive float: {name} is {what}.") from None
 
 
 def _resolve(static_kernel) -> tuple:
