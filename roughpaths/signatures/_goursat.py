@@ -226,11 +226,11 @@ def vjp_groups(X, Y, ia, ib, rbf, order, gout, g_lo, g_hi, gx, gy):
     xg, yg = np.empty(n * d * L), np.empty(m * d * L)
     dx, dy = np.empty(n * d * L), np.empty(m * d * L)
     kap = np.empty((2, m * L))
-    G, A, NB = np.zeros(m * L), np.zeros(m * L), np.zeros(m * L)
-    An, NBn, dA, NdB = np.zeros(m * L), np.zeros(m * L), np.zeros(m * L), np.zeros(m * L)
+    G, dA, NdB = np.zeros(m * L), np.zeros(m * L), np.zeros(m * L)
+    A2, NB2 = np.zeros((2, m * L)), np.zeros((2, m * L))      # coefficients of coarse row p in slot p & 1
     dG = np.empty(m * L)
     ck = np.empty((n - 1, M * L))
-    blk = np.empty((S + 1, M * L))
+    blk = np.empty((S + 1, M * L))           # blk[0] unused: row p S is ck[p]
     tmp = np.empty((2, M * L))
     lam = np.empty((2, (M + 1) * L))
     go = np.empty(L)
@@ -249,42 +249,40 @@ def vjp_groups(X, Y, ia, ib, rbf, order, gout, g_lo, g_hi, gx, gy):
         for p in range(n - 2):
             if rbf:
                 _kappa_row(xg, yg, p + 1, d, kap[(p + 1) & 1])
+            A, NB = A2[0], NB2[0]
             _coarse_row(dx, dy, kap, p, d, rbf, frac, G, A, NB)
-            tmp[0, :] = ck[p]
-            cur = 0
-            for _ in range(S):
-                _sweep(tmp[cur], tmp[1 - cur], A, NB, m - 1, S)
-                cur = 1 - cur
-            ck[p + 1, :] = tmp[cur]
+            for s in range(S):                   # ck[p] -> tmp[0] -> tmp[1] -> ... -> ck[p + 1], no copies
+                src = ck[p] if s == 0 else tmp[(s - 1) & 1]
+                dst = ck[p + 1] if s == S - 1 else tmp[s & 1]
+                _sweep(src, dst, A, NB, m - 1, S)
         # backward pass, coarse row by coarse row, recomputing its refined rows from the checkpoint
         if rbf:
             _kappa_row(xg, yg, n - 1, d, kap[(n - 1) & 1])
-        An[:] = 0.0
-        NBn[:] = 0.0
+        A2[(n - 1) & 1, :] = 0.0                 # "coarse row n - 1": below the grid, zero
+        NB2[(n - 1) & 1, :] = 0.0
         lam[:, :] = 0.0
         nxt = 0
         for p in range(n - 2, -1, -1):
             if rbf:
                 _kappa_row(xg, yg, p, d, kap[p & 1])
+            A, NB, An, NBn = A2[p & 1], NB2[p & 1], A2[(p + 1) & 1], NB2[(p + 1) & 1]
             _coarse_row(dx, dy, kap, p, d, rbf, frac, G, A, NB)
             for q in range(m - 1):
                 ndb = vmul(vmul(vmul(vload(G, q * L), fv), sixth), fv)     # -dB/dG
                 vstore(NdB, q * L, ndb)
                 vstore(dA, q * L, vadd(vmul(vsplat(0.5), fv), ndb))        # dA/dG
-            blk[0, :] = ck[p]
-            for s in range(S):
+            _sweep(ck[p], blk[1], A, NB, m - 1, S)          # blk[s] = K[p S + s]; K[p S] is ck[p]
+            for s in range(1, S):
                 _sweep(blk[s], blk[s + 1], A, NB, m - 1, S)
             dG[:] = 0.0
             for s in range(S, 0, -1):
                 cur = 1 - nxt
                 last = s == S
                 seed = vload(go, 0) if (last and p == n - 2) else vsplat(0.0)
-                _adjoint_row(lam[cur], lam[nxt], blk[s], blk[s - 1], A, An if last else A, NBn if last else NB,
-                             dA, NdB, order, S, m, seed, dG)
+                _adjoint_row(lam[cur], lam[nxt], blk[s], ck[p] if s == 1 else blk[s - 1], A, An if last else A,
+                             NBn if last else NB, dA, NdB, order, S, m, seed, dG)
                 nxt = cur
             _scatter(xg, yg, dx, dy, kap, p, d, rbf, dG, gxs, gys)
-            An[:] = A
-            NBn[:] = NB
         for l in range(L):
             k = first + l
             if k < P:
