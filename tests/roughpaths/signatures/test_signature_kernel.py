@@ -128,6 +128,16 @@ def test_matches_pysiglib(order, sigma):
     np.testing.assert_allclose(ours, theirs, rtol=1e-8)
 
 
+def test_vjp_matches_pysiglib():
+    pysiglib = pytest.importorskip("pysiglib")
+    x, y = _paths((4, 10, 3), 20, 0.3), _paths((4, 8, 3), 21, 0.3)
+    w = np.array([1.0, -0.5, 2.0, 0.3])
+    ours = rp.signature_kernel_vjp(x, y, w, dyadic_order=2)
+    theirs = pysiglib.sig_kernel_backprop(w, x, y, dyadic_order=2, left_deriv=True, right_deriv=True)
+    for a, b in zip(ours, theirs):
+        np.testing.assert_allclose(a, b, rtol=1e-8, atol=1e-12 * np.abs(b).max())
+
+
 @pytest.mark.parametrize("call,match", [
     (lambda: rp.signature_kernel(np.zeros((4, 2)), np.zeros((4, 3))), "d=2 coordinates.*y has d=3"),
     (lambda: rp.signature_kernel(np.zeros((4, 2)), np.zeros((4, 2)), dyadic_order=-1), "dyadic_order"),
