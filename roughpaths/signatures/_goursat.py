@@ -16,7 +16,11 @@ index innermost in every buffer (``(…, LANES)``): the row sweep has a serial d
 (``K[r, c]`` needs ``K[r, c-1]``), so one pair at a time is latency-bound; ``LANES`` independent pairs
 side by side fill packed SIMD registers and hide the latency. Every lane runs the same instructions, so
 a pair's value does not depend on which lane, group or thread computed it (padding lanes repeat a
-real pair and are discarded).
+real pair and are discarded). The lane arithmetic uses the packed intrinsics of ``_simd`` (rounded per
+operation, no fused multiply-add): with plain ``for l in range(LANES)`` loops numba emitted scalar
+``vmulsd`` code, 67 ms for 32 pairs of 256 x 5 paths at order 2 on one thread, against 24 ms now
+(pysiglib: 82 ms). ``B`` is stored negated (``NB = -B``) so that ``x - y * B`` is ``x + y * NB``, the same
+rounding without a subtraction intrinsic.
 
 Memory: the forward pass keeps two grid rows (``O(m 2**order)`` per pair). The adjoint keeps the grid
 rows at the coarse rows (checkpoints, ``O(n m 2**order)``) and recomputes the ``2**order`` refined rows of
