@@ -30,8 +30,10 @@ from .norms import (area_holder_seminorm, area_p_variation, holder_distance, hol
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
 from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
                   NonFiniteStateError, Solution, Solver, VectorFields, central_jacobian, solve)
-from .signatures import (brownian_expected_signature, logsignature, logsignature_vjp, rough_path_signature,
-                         rough_path_signature_vjp, signature, signature_vjp)
+from .signatures import (LinearKernel, MMDTestResult, RBFKernel, brownian_expected_signature, logsignature,
+                         logsignature_vjp, rough_path_signature, rough_path_signature_vjp, sig_mmd_test, signature,
+                         signature_kernel, signature_kernel_gram, signature_kernel_gram_vjp, signature_kernel_vjp,
+                         signature_vjp)
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
@@ -59,4 +61,7 @@ __all__ = [
     "signature", "logsignature", "signature_vjp", "logsignature_vjp", "rough_path_signature_vjp",
     "rough_path_signature", "brownian_expected_signature", "sigdim", "logsigdim", "tensor_product", "tensor_inverse", "tensor_exp", "tensor_log",
     "to_level2", "from_level2", "lyndon_basis", "lyndon_coordinates", "from_lyndon_coordinates",
+    # signature kernels and the two-sample test
+    "signature_kernel", "signature_kernel_gram", "signature_kernel_vjp", "signature_kernel_gram_vjp",
+    "LinearKernel", "RBFKernel", "sig_mmd_test", "MMDTestResult",
 ]

@@ -90,3 +90,21 @@ def parse_bracket(label, first_letter=1):
     out = tree()
     assert pos == len(tokens), label
     return out
+
+
+def naive_signature_kernel(x, y, order, sigma=None):
+    """Signature kernel of one pair by a full-grid solve of the Goursat scheme of pysiglib/sigkernel
+    (``K = (K_left + K_below) A - K_diag B``), plain Python loops; ``sigma``: RBF static kernel."""
+    if sigma is None:
+        G = np.diff(x, axis=0) @ np.diff(y, axis=0).T
+    else:
+        kap = np.exp(-((x[:, None, :] - y[None, :, :]) ** 2).sum(-1) / (2 * sigma ** 2))
+        G = kap[1:, 1:] - kap[1:, :-1] - kap[:-1, 1:] + kap[:-1, :-1]
+    S = 2 ** order
+    N, M = (x.shape[0] - 1) * S, (y.shape[0] - 1) * S
+    K = np.ones((N + 1, M + 1))
+    for r in range(1, N + 1):
+        for c in range(1, M + 1):
+            g = G[(r - 1) // S, (c - 1) // S] / S ** 2
+            K[r, c] = (K[r, c - 1] + K[r - 1, c]) * (1 + g / 2 + g * g / 12) - K[r - 1, c - 1] * (1 - g * g / 12)
+    return K[N, M]
