@@ -58,7 +58,7 @@ from roughpaths.validation import as_float_array, check_positive_int
 
 from ..systems.lie_algebra import SE3Algebra, SO3Algebra
 from ..systems.lie_poisson import LiePoissonSystem
-from . import _se3_kernels, _so3_kernels
+from . import _generic_kernels, _se3_kernels, _so3_kernels
 from ._chord import chord_solve
 from ._forced import forced_sigma_and_state
 
@@ -221,6 +221,18 @@ class CoadjointSolver(Solver):
                 dXX, dts, save, stop_on_failure)
             y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
             chord = (reason == _se3_kernels.CHORD_FAILED).reshape(batch)
+        elif plain:
+            nb = int(np.prod(batch, dtype=np.int64))
+            d = dX.shape[-1]
+            dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
+            if dXX is not None:
+                dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
+                                           dtype=np.float64)
+            y2, saved, first_bad, reason = _generic_kernels.integrate_generic(
+                system, self._code, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1), y.reshape(nb, n), dX,
+                dXX, dts, save, stop_on_failure)
+            y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
+            chord = (reason == _generic_kernels.CHORD_FAILED).reshape(batch)
         else:
             saved = np.full(batch + (nsave, n), np.nan)
             first_bad = np.full(batch, -1, dtype=np.int64)

@@ -1,0 +1,521 @@
+r"""Compiled coadjoint kernels for any Lie algebra given by its structure constants (quadratic Hamiltonian).
+
+:meth:`~mechanics.integrators.base.CoadjointSolver.integrate` selects them for every algebra without a
+hand-written kernel (:mod:`._so3_kernels`, :mod:`._se3_kernels`) when the Hamiltonian is quadratic and
+the system has no forces. Same schemes as the numpy path (:mod:`mechanics.integrators.base`), same
+contract as the hand-written kernels (``first_bad``, ``reason`` NON_FINITE / CHORD_FAILED, saved steps).
+
+What the kernels are given (arrays, never closures: one compiled kernel serves every algebra)
+------------------------------------------------------------------------------------------------
+* the structure constants as a list of their non-zero entries ``(i, j, k, c[i, j, k])``, so that
+  :math:`(\mathrm{ad}^*_x\mu)_j = \sum x_i\mu_k c^k_{ij}` costs one multiply-add per non-zero (6 for
+  so(3), 18 for se(3)) and no ``n × n`` matrix is formed on the fast path;
+* ``cnorm[i]`` :math:`= \max_j\sum_k|c^k_{ij}|`, so :math:`\theta = \sum_i|\sigma_i|\,\mathrm{cnorm}_i
+  \ge\|\mathrm{ad}^*_\sigma\|_\infty`, a per-member bound read from the member's own ``σ``;
+* the drift velocity :math:`w(\mu) = g + \vartheta M^{-1}\mathrm{ad}^*_{g+f}\mu`, :math:`g = Q\mu + b'`
+  (:meth:`~mechanics.systems.lie_poisson.LiePoissonSystem.quadratic_velocity_data`).
+
+The coadjoint action :math:`e^{\mathrm{ad}^*_\sigma}\mu`, per member
+---------------------------------------------------------------------
+* :math:`\theta\le` :data:`THETA_VECTOR` (every step of a sane run): the Taylor series applied to the
+  vector, :math:`\sum_{r\le m}(\mathrm{ad}^*_\sigma)^r\mu/r!`, with the degree ``m`` the smallest for
+  which :math:`\theta^{m+1}/(m+1)!\le 2^{-55}` (table :data:`DEGREE_THETA`): the truncation is below
+  round-off relative to :math:`|\mu|`, so the Casimirs are kept to round-off. The degree is the
+  member's own (a member of a block computes the higher terms its neighbours need but does not add
+  them: ``select``, not a multiplication by 0), so its bits never depend on the batch.
+* larger :math:`\theta` (or non-finite): the scalar path, matrix scaling and squaring: :math:`A =
+  \mathrm{ad}^*_\sigma/2^s` with :math:`\theta/2^s\le\tfrac12`, Taylor of the degree of the table, then
+  ``s`` squarings, times ``μ``.
+
+Layout: a block of up to :data:`BLOCK` members lives as ``(n, BLOCK)`` rows (structure of arrays);
+each operation is a loop over the members of the block, pure arithmetic, so LLVM vectorises it
+(no fast-math: vector and scalar loops round alike). Blocks run in parallel (``numba.prange``, numba's
+threads: ``numba.set_num_threads`` / ``NUMBA_NUM_THREADS``); a member's result does not depend on its
+block, its neighbours or the thread. The implicit midpoint rule runs the chord iteration member by member
+(scalar code, as the hand-written kernels do).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
+#: Members per block (structure-of-arrays rows; the unit of the thread split).
+BLOCK = 128
+#: Largest Taylor degree of the vector path.
+MAX_DEGREE = 18
+_TOL = 2.0 ** -55
+
+
+def _degree_table():
+    th = np.empty(MAX_DEGREE + 1)
+    fact = 1.0
+    for m in range(MAX_DEGREE + 1):
+        fact *= m + 1                                          # (m + 1)!
+        th[m] = (_TOL * fact) ** (1.0 / (m + 1))
+    return th
+
+
+#: ``DEGREE_THETA[m]``: the largest θ for which Taylor degree ``m`` is below round-off (increasing).
+DEGREE_THETA = _degree_table()
+#: Members with θ above this take the scalar scaling-and-squaring path.
+THETA_VECTOR = float(DEGREE_THETA[MAX_DEGREE])
+_THETA_SCALED = 0.5
+_MAX_SQUARINGS = 1100
+
+
+def algebra_tables(c):
+    """Non-zero structure constants ``(ti, tj, tk, tv)`` and ``cnorm (n,)`` of ``c (n, n, n)``."""
+    c = np.asarray(c, dtype=np.float64)
+    ti, tj, tk = np.nonzero(c)
+    order = np.lexsort((tk, ti, tj))                           # grouped by output component j
+    ti, tj, tk = ti[order], tj[order], tk[order]
+    tv = np.ascontiguousarray(c[ti, tj, tk])
+    cnorm = np.ascontiguousarray(np.max(np.sum(np.abs(c), axis=2), axis=1)) if c.size else np.zeros(0)
+    return ti.astype(np.int64), tj.astype(np.int64), tk.astype(np.int64), tv, cnorm
+
+
+# ---------------------------------------------------------------------- block (structure-of-arrays) operations
+@numba.njit(cache=True, inline="always")
+def _ad_star_rows(x, mu, out, ti, tj, tk, tv, bc):
+    """out[j, p] = (ad*_{x[:, p]} mu[:, p])_j for p < bc."""
+    for j in range(out.shape[0]):
+        for p in range(bc):
+            out[j, p] = 0.0
+    for t in range(tv.shape[0]):
+        i, j, k, v = ti[t], tj[t], tk[t], tv[t]
+        for p in range(bc):
+            out[j, p] += v * x[i, p] * mu[k, p]
+
+
+@numba.njit(cache=True, inline="always")
+def _velocity_rows(mu, q, lin, f, mth, theta, g, t1, t2, out, ti, tj, tk, tv, bc):
+    """out = w(mu) = g + θ M⁻¹ ad*_{g+f} mu, g = Q mu + lin (``mth`` = θ M⁻¹, rows as above)."""
+    n = mu.shape[0]
+    for i in range(n):
+        li = lin[i]
+        for p in range(bc):
+            g[i, p] = li
+        for j in range(n):
+            qij = q[i, j]
+            for p in range(bc):
+                g[i, p] += qij * mu[j, p]
+    if theta == 0.0:
+        for i in range(n):
+            for p in range(bc):
+                out[i, p] = g[i, p]
+        return
+    for i in range(n):
+        fi = f[i]
+        for p in range(bc):
+            t1[i, p] = g[i, p] + fi
+    _ad_star_rows(t1, mu, t2, ti, tj, tk, tv, bc)
+    for i in range(n):
+        for p in range(bc):
+            out[i, p] = g[i, p]
+        for j in range(n):
+            mij = mth[i, j]
+            for p in range(bc):
+                out[i, p] += mij * t2[j, p]
+
+
+# ---------------------------------------------------------------------- one member (scalar) operations
+@numba.njit(cache=True, inline="always")
+def _ad_star1(x, mu, out, ti, tj, tk, tv):
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for t in range(tv.shape[0]):
+        out[tj[t]] += tv[t] * x[ti[t]] * mu[tk[t]]
+
+
+@numba.njit(cache=True)
+def _velocity1(mu, q, lin, f, mth, theta, g, t1, t2, out, ti, tj, tk, tv):
+    n = mu.shape[0]
+    for i in range(n):
+        acc = lin[i]
+        for j in range(n):
+            acc += q[i, j] * mu[j]
+        g[i] = acc
+    if theta == 0.0:
+        for i in range(n):
+            out[i] = g[i]
+        return
+    for i in range(n):
+        t1[i] = g[i] + f[i]
+    _ad_star1(t1, mu, t2, ti, tj, tk, tv)
+    for i in range(n):
+        acc = g[i]
+        for j in range(n):
+            acc += mth[i, j] * t2[j]
+        out[i] = acc
+
+
+@numba.njit(cache=True)
+def _theta_bound(s, cnorm):
+    th = 0.0
+    for i in range(s.shape[0]):
+        th += abs(s[i]) * cnorm[i]
+    return th
+
+
+@numba.njit(cache=True)
+def _exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
+    """out = exp(ad*_s) mu for one member; False if not finite. Vector Taylor for θ ≤ THETA_VECTOR
+    (bit for bit the block path's arithmetic), else matrix scaling and squaring."""
+    n = mu.shape[0]
+    th = _theta_bound(s, cnorm)
+    if not math.isfinite(th):
+        return False
+    if th <= degth[degth.shape[0] - 1]:
+        for j in range(n):
+            out[j] = mu[j]
+            term[j] = mu[j]
+        r = 1
+        while th > degth[r - 1]:
+            _ad_star1(s, term, term2, ti, tj, tk, tv)
+            inv = 1.0 / r
+            for j in range(n):
+                term[j] = term2[j] * inv
+                out[j] = out[j] + term[j]
+            r += 1
+    else:
+        nsq = 0
+        scale = 1.0
+        while th > 0.5:
+            th *= 0.5
+            scale *= 0.5
+            nsq += 1
+            if nsq > 1100:
+                return False
+        for j in range(n):
+            for k in range(n):
+                A[j, k] = 0.0
+        for t in range(tv.shape[0]):
+            A[tj[t], tk[t]] += tv[t] * s[ti[t]] * scale
+        m = 0
+        while th > degth[m]:
+            m += 1
+        for j in range(n):                              # Horner: E = I + A E / r, r = m .. 1
+            for k in range(n):
+                E[j, k] = 1.0 if j == k else 0.0
+        for r in range(m, 0, -1):
+            inv = 1.0 / r
+            for j in range(n):
+                for k in range(n):
+                    acc = 0.0
+                    for l in range(n):
+                        acc += A[j, l] * E[l, k]
+                    T[j, k] = acc * inv
+            for j in range(n):
+                for k in range(n):
+                    E[j, k] = T[j, k] + (1.0 if j == k else 0.0)
+        for _ in range(nsq):
+            for j in range(n):
+                for k in range(n):
+                    acc = 0.0
+                    for l in range(n):
+                        acc += E[j, l] * E[l, k]
+                    T[j, k] = acc
+            for j in range(n):
+                for k in range(n):
+                    E[j, k] = T[j, k]
+        for j in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += E[j, k] * mu[k]
+            out[j] = acc
+    for j in range(n):
+        if not math.isfinite(out[j]):
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def _invert(J, Ji, W):
+    """Ji = J⁻¹ (n × n) by Gauss–Jordan elimination with partial pivoting; False if singular / not finite."""
+    n = J.shape[0]
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = J[i, j]
+            W[i, n + j] = 1.0 if i == j else 0.0
+    for c in range(n):
+        piv = c
+        best = abs(W[c, c])
+        for r in range(c + 1, n):
+            v = abs(W[r, c])
+            if v > best:
+                best, piv = v, r
+        if not (best > 0.0 and best < np.inf):
+            return False
+        if piv != c:
+            for j in range(2 * n):
+                W[c, j], W[piv, j] = W[piv, j], W[c, j]
+        inv = 1.0 / W[c, c]
+        for j in range(2 * n):
+            W[c, j] *= inv
+        for r in range(n):
+            if r != c:
+                fr = W[r, c]
+                if fr != 0.0:
+                    for j in range(2 * n):
+                        W[r, j] -= fr * W[c, j]
+    for i in range(n):
+        for j in range(n):
+            v = W[i, n + j]
+            if not math.isfinite(v):
+                return False
+            Ji[i, j] = v
+    return True
+
+
+@numba.njit(cache=True)
+def _chord1(mu, e, s, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm, degth, w):
+    """Chord iteration of the implicit midpoint rule for one member (``s`` in/out, started at
+    w(mu) dt + e): J = I - dt/2 Dw(mu) L(mu), frozen; stops when max|Δσ| ≤ tol (1 + |σ|_∞)."""
+    n = mu.shape[0]
+    L, Dw, J, Ji, W, A, E, T = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]
+    g, t1, t2, m1, mid, u, term, term2 = w[8][0], w[8][1], w[8][2], w[8][3], w[8][4], w[8][5], w[8][6], w[8][7]
+    for j in range(n):                                 # L[j, i] = mu_k c[i, j, k]: δ ↦ ad*_δ mu
+        for i in range(n):
+            L[j, i] = 0.0
+    for t in range(tv.shape[0]):
+        L[tj[t], ti[t]] += tv[t] * mu[tk[t]]
+    for i in range(n):
+        for j in range(n):
+            Dw[i, j] = q[i, j]
+    if theta != 0.0:
+        for i in range(n):                             # gradient inside the double bracket, g + f
+            acc = lin[i] + f[i]
+            for j in range(n):
+                acc += q[i, j] * mu[j]
+            g[i] = acc
+        for j in range(n):                             # A = ad*_{g+f} (matrix) + L(mu) Q
+            for k in range(n):
+                acc = 0.0
+                for l in range(n):
+                    acc += L[j, l] * q[l, k]
+                A[j, k] = acc
+        for t in range(tv.shape[0]):
+            A[tj[t], tk[t]] += tv[t] * g[ti[t]]
+        for i in range(n):                             # Dw = Q + θ M⁻¹ A
+            for j in range(n):
+                acc = 0.0
+                for l in range(n):
+                    acc += mth[i, l] * A[l, j]
+                Dw[i, j] += acc
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for l in range(n):
+                acc += Dw[i, l] * L[l, j]
+            J[i, j] = (1.0 if i == j else 0.0) - 0.5 * dt * acc
+    if not _invert(J, Ji, W):
+        return False
+    for it in range(max_iter):
+        if not _exp1(s, mu, m1, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
+            return False
+        for i in range(n):
+            mid[i] = 0.5 * (mu[i] + m1[i])
+        _velocity1(mid, q, lin, f, mth, theta, g, t1, t2, u, ti, tj, tk, tv)
+        for i in range(n):
+            t1[i] = s[i] - u[i] * dt - e[i]
+        err = 0.0
+        smax = 0.0
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += Ji[i, j] * t1[j]
+            t2[i] = acc
+        for i in range(n):
+            s[i] -= t2[i]
+            err = max(err, abs(t2[i]))
+            smax = max(smax, abs(s[i]))
+        if not (math.isfinite(err) and math.isfinite(smax)):
+            return False
+        if err <= tol * (1.0 + smax):
+            return True
+    return False
+
+
+@numba.njit(cache=True)
+def _eta_rows(dX, dXX, area, lo, bc, k, xi, brk, pi, pj, e):
+    """e[:, p] = Σ_r dX_r ξ_r + Σ_{i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for members lo .. lo+bc-1, step k."""
+    n = e.shape[0]
+    nm = dX.shape[2]
+    for p in range(bc):
+        for i in range(n):
+            acc = 0.0
+            for r in range(nm):
+                acc += dX[lo + p, k, r] * xi[r, i]
+            e[i, p] = acc
+        if area:
+            for r in range(pi.shape[0]):
+                a = 0.5 * (dXX[lo + p, k, pi[r], pj[r]] - dXX[lo + p, k, pj[r], pi[r]])
+                for i in range(n):
+                    e[i, p] += a * brk[r, i]
+
+
+@numba.njit(cache=True)
+def _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
+               degth, save, out, first_bad, reason, stop, lo, hi):
+    """Members lo .. hi-1 over every step of the block; returns the number of members that failed."""
+    n = y.shape[1]
+    bc = hi - lo
+    nk = dX.shape[1]
+    area = dXX.shape[0] > 0
+    mu, e, w0, s = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
+    a1, a2, pred, w1 = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
+    g, t1, t2, term, term2 = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
+    th = np.empty(bc)
+    big = np.empty(bc, dtype=np.bool_)
+    work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, 2 * n)),
+            np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
+    vs, vm, vo, ve = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    lim = degth[degth.shape[0] - 1]
+    for p in range(bc):
+        for i in range(n):
+            mu[i, p] = y[lo + p, i]
+    nfail = 0
+    slot = 0
+    for k in range(nk):
+        dt = dts[k]
+        _eta_rows(dX, dXX, area, lo, bc, k, xi, brk, pi, pj, e)
+        nbig = 0
+        if code == 2:
+            for p in range(bc):
+                big[p] = True
+            nbig = bc
+        else:
+            _velocity_rows(mu, q, lin, f, mth, theta, g, t1, t2, w0, ti, tj, tk, tv, bc)
+            for i in range(n):
+                for p in range(bc):
+                    s[i, p] = w0[i, p] * dt + e[i, p]
+            if code == 1:
+                # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
+                _ad_star_rows(s, mu, a1, ti, tj, tk, tv, bc)
+                _ad_star_rows(s, a1, a2, ti, tj, tk, tv, bc)
+                for i in range(n):
+                    for p in range(bc):
+                        pred[i, p] = mu[i, p] + a1[i, p] + 0.5 * a2[i, p]
+                _velocity_rows(pred, q, lin, f, mth, theta, g, t1, t2, w1, ti, tj, tk, tv, bc)
+                for i in range(n):
+                    for p in range(bc):
+                        s[i, p] = 0.5 * (w0[i, p] + w1[i, p]) * dt + e[i, p]
+            # exp(ad*_s) mu: Taylor on the vector, each member to its own degree (select, not multiply)
+            for p in range(bc):
+                th[p] = 0.0
+            for i in range(n):
+                ci = cnorm[i]
+                for p in range(bc):
+                    th[p] += abs(s[i, p]) * ci
+            thmax = 0.0
+            for p in range(bc):
+                b = not (th[p] <= lim)                 # NaN too: the scalar path diagnoses it
+                big[p] = b
+                nbig += b
+                if not b:
+                    thmax = max(thmax, th[p])
+            for i in range(n):
+                for p in range(bc):
+                    a1[i, p] = mu[i, p]                # a1: the sum, term: the current term
+                    term[i, p] = mu[i, p]
+            r = 1
+            while thmax > degth[r - 1]:
+                _ad_star_rows(s, term, term2, ti, tj, tk, tv, bc)
+                inv = 1.0 / r
+                lev = degth[r - 1]
+                for i in range(n):
+                    for p in range(bc):
+                        term[i, p] = term2[i, p] * inv
+                        a1[i, p] = a1[i, p] + term[i, p] if th[p] > lev else a1[i, p]
+                r += 1
+            for i in range(n):
+                for p in range(bc):
+                    mu[i, p] = a1[i, p] if not big[p] else mu[i, p]
+        if nbig > 0:
+            for p in range(bc):
+                if not big[p]:
+                    continue
+                finite_in = True
+                for i in range(n):
+                    vm[i] = mu[i, p]
+                    ve[i] = e[i, p]
+                    vs[i] = s[i, p]
+                    if not (math.isfinite(vm[i]) and math.isfinite(ve[i])):
+                        finite_in = False
+                ok = False
+                chord_failed = False
+                if finite_in:
+                    if code == 2:
+                        _velocity1(vm, q, lin, f, mth, theta, work[8][0], work[8][1], work[8][2], vo, ti, tj, tk,
+                                   tv)
+                        for i in range(n):
+                            vs[i] = vo[i] * dt + ve[i]
+                        chord_failed = not _chord1(vm, ve, vs, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk,
+                                                   tv, cnorm, degth, work)
+                    if not chord_failed:
+                        ok = _exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
+                                   cnorm, degth)
+                if ok:
+                    for i in range(n):
+                        mu[i, p] = vo[i]
+                else:
+                    for i in range(n):
+                        mu[i, p] = np.nan
+                    if first_bad[lo + p] < 0:
+                        first_bad[lo + p] = k
+                        reason[lo + p] = CHORD_FAILED if chord_failed else NON_FINITE
+                        nfail += 1
+        if save[k]:
+            for p in range(bc):
+                for i in range(n):
+                    out[lo + p, slot, i] = mu[i, p]
+            slot += 1
+        if stop and nfail > 0:
+            break
+    for p in range(bc):
+        for i in range(n):
+            y[lo + p, i] = mu[i, p]
+    return nfail
+
+
+@numba.njit(cache=True, parallel=True)
+def _run_blocks(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
+                degth, save, out, first_bad, reason, stop, block):
+    nb = y.shape[0]
+    nblk = (nb + block - 1) // block
+    nfail = 0
+    for b in numba.prange(nblk):
+        lo = b * block
+        hi = min(lo + block, nb)
+        nfail += _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk,
+                            tv, cnorm, degth, save, out, first_bad, reason, stop, lo, hi)
+    return nfail
+
+
+def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
+    """Run the generic kernel on ``y`` (B, n) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
+
+    Returns ``(y, saved (B, S, n), first_bad (B,), reason (B,))``.
+    """
+    data = system.quadratic_velocity_data()
+    ti, tj, tk, tv, cnorm = algebra_tables(system.algebra.structure_constants)
+    nb, n = y.shape
+    nm = dX.shape[-1]
+    pi, pj = np.triu_indices(nm, 1)
+    brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
+    y = np.array(y, dtype=np.float64, order="C")
+    out = np.full((nb, int(np.count_nonzero(save)), n), np.nan)
+    first_bad = np.full(nb, -1, dtype=np.int64)
+    reason = np.zeros(nb, dtype=np.int8)
+    theta = float(data["theta"])
+    mth = np.ascontiguousarray(theta * data["metric_inv"].T)
+    _run_blocks(y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
+                pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64), int(code),
+                data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
+                mth, theta, float(tol), int(max_iter), ti, tj, tk, tv, cnorm, DEGREE_THETA,
+                np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure), BLOCK)
+    return y, out, first_bad, reason
