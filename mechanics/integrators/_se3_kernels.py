@@ -265,7 +265,8 @@ def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slo
 
 
 @numba.njit(cache=True)
-def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop):
+def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop,
+               lo, hi):
     """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
     (code 0) or Lie–Heun (code 1). A failed member gets ``first_bad`` and ``reason``. Returns the
     number of members that failed."""
@@ -274,7 +275,7 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
     mu, e, w0, w1, s = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     a1, a2, pred, g, t1, t2, new = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     nfail = 0
-    for p in range(nb):
+    for p in range(lo, hi):
         for i in range(6):
             mu[i] = y[p, i]
         slot = 0
@@ -304,7 +305,7 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
 
 @numba.njit(cache=True)
 def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
-                        first_bad, reason, stop):
+                        first_bad, reason, stop, lo, hi):
     """As :func:`_se3_block` for the implicit midpoint rule: sigma from the chord iteration
     (:func:`_se3_chord`); a member whose iteration fails gets ``reason = CHORD_FAILED``. A separate
     kernel, so that the explicit schemes do not compile the chord."""
@@ -315,7 +316,7 @@ def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta
     L, Dw, J, Ji, W = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12))
     m1, mid, u = np.empty(6), np.empty(6), np.empty(6)
     nfail = 0
-    for p in range(nb):
+    for p in range(lo, hi):
         for i in range(6):
             mu[i] = y[p, i]
         slot = 0
@@ -346,6 +347,29 @@ def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta
     return nfail
 
 
+#: Members per block of the thread split.
+BLOCK = 64
+
+
+@numba.njit(cache=True, parallel=True)
+def _se3_blocks(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, tol, max_iter, save, out, first_bad,
+                reason, stop, block):
+    """Blocks of ``block`` members in parallel (numba's threads); members are independent."""
+    nb = y.shape[0]
+    nblk = (nb + block - 1) // block
+    nfail = 0
+    for b in numba.prange(nblk):
+        lo = b * block
+        hi = min(lo + block, nb)
+        if code == 2:
+            nfail += _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter,
+                                         save, out, first_bad, reason, stop, lo, hi)
+        else:
+            nfail += _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out,
+                                first_bad, reason, stop, lo, hi)
+    return nfail
+
+
 def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
     """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
 
@@ -365,8 +389,5 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     consts = (data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
               data["metric_inv"], float(data["theta"]))
     tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
-    if code == 2:
-        _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail)
-    else:
-        _se3_block(*args, int(code), *consts, *tail)
+    _se3_blocks(*args, int(code), *consts, float(tol), int(max_iter), *tail, BLOCK)
     return y, out, first_bad, reason
