@@ -92,7 +92,7 @@ def sparse_rows(m):
 # ---------------------------------------------------------------------- block (structure-of-arrays) operations
 # Every output row is written in passes over the block's members (measured: one non-zero per pass is
 # faster than two per pass here: 2.7 against 4.6 ns per member for so(3)'s ad*, 3.7 with a zeroing pass).
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _ad_star_rows(x, mu, out, ti, tk, tv, start, bc):
     """out[j, p] = (ad*_{x[:, p]} mu[:, p])_j for p < bc (terms grouped by j: ``start[j] .. start[j+1]``;
     one pass per non-zero, the first one of a row writing it)."""
@@ -112,7 +112,7 @@ def _ad_star_rows(x, mu, out, ti, tk, tv, start, bc):
                     o[p] += va * xa[p] * ma[p]
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _affine_rows(base, const, cols, vals, start, x, out, bc, use_base):
     """out[i, p] = ((base[i, p] if use_base) + const[i]) + Σ_t vals[t] x[cols[t], p] over the row's non-zeros
     (one pass per non-zero; the first also writes the constant)."""
@@ -141,7 +141,7 @@ def _affine_rows(base, const, cols, vals, start, x, out, bc, use_base):
                     o[p] += va * xa[p]
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv, start, bc):
     """out = w(mu) = g + θ M⁻¹ ad*_{g+f} mu, g = Q mu + lin; ``qs``, ``mts``: the non-zeros of Q and θ M⁻¹."""
     _affine_rows(g, lin, qs[0], qs[1], qs[2], mu, g, bc, False)
@@ -558,30 +558,38 @@ def _run_blocks(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, t
     return nfail
 
 
-def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
-    """Run the generic kernel on ``y`` (B, n) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
+def _readonly(a):
+    """A read-only view: the kernels then compile one signature whether the driver's arrays are writable or not."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
 
-    Returns ``(y, saved (B, S, n), first_bad (B,), reason (B,))``.
+
+def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
+    """Run the generic kernel on ``y`` (B, n) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None (C-contiguous).
+
+    Returns ``(y, saved (B, S, n), first_bad (B,), reason (B,))``. Blocks of :data:`BLOCK` members run in
+    parallel on numba's threads (``numba.set_num_threads``); the result does not depend on their number.
     """
     data = system.quadratic_velocity_data()
     ti, tj, tk, tv, start, cnorm = algebra_tables(system.algebra.structure_constants)
     nb, n = y.shape
     nm = dX.shape[-1]
     pi, pj = np.triu_indices(nm, 1)
-    brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
+    brk = np.array(system.xi_brackets[pi, pj], dtype=np.float64, order="C")
     y = np.array(y, dtype=np.float64, order="C")
     out = np.full((nb, int(np.count_nonzero(save)), n), np.nan)
     first_bad = np.full(nb, -1, dtype=np.int64)
     reason = np.zeros(nb, dtype=np.int8)
     theta = float(data["theta"])
-    mth = np.ascontiguousarray(theta * data["metric_inv"].T)
-    f = np.ascontiguousarray(data["dissipation_change"])
+    mth = np.array(theta * data["metric_inv"].T, dtype=np.float64, order="C")
+    f = np.array(data["dissipation_change"], dtype=np.float64)
     qs = sparse_rows(data["q"])
     mts = sparse_rows(mth) + (np.zeros(n),)
-    _run_blocks(y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi), brk,
-                pi.astype(np.int64), pj.astype(np.int64), np.ascontiguousarray(dts, dtype=np.float64), int(code),
-                data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
-                mth, theta, float(tol), int(max_iter), ti, tj, tk, tv, cnorm, DEGREE_THETA,
-                np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure), BLOCK,
-                start, qs, mts, bool(np.any(f != 0.0)))
+    _run_blocks(y, _readonly(dX), _readonly(np.empty((0, 0, 0, 0)) if dXX is None else dXX),
+                np.array(system.xi, dtype=np.float64, order="C"), brk, pi.astype(np.int64), pj.astype(np.int64),
+                np.array(dts, dtype=np.float64), int(code), np.array(data["q"], dtype=np.float64, order="C"),
+                np.array(data["linear"], dtype=np.float64), f, mth, theta, float(tol), int(max_iter), ti, tj, tk,
+                tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
+                bool(stop_on_failure), BLOCK, start, qs, mts, bool(np.any(f != 0.0)))
     return y, out, first_bad, reason
