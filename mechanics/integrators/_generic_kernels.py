@@ -29,9 +29,9 @@ The coadjoint action :math:`e^{\mathrm{ad}^*_\sigma}\mu`, per member
 
 Layout: a block of up to :data:`BLOCK` members lives as ``(n, BLOCK)`` rows (structure of arrays);
 each operation is a loop over the members of the block, pure arithmetic, so LLVM vectorises it
-(no fast-math: vector and scalar loops round alike). Blocks run in parallel (``numba.prange``, numba's
-threads: ``numba.set_num_threads`` / ``NUMBA_NUM_THREADS``); a member's result does not depend on its
-block, its neighbours or the thread. The implicit midpoint rule runs the chord iteration member by member
+(no fast-math: vector and scalar loops round alike). Blocks run in parallel (:mod:`._blocks`, numba's
+number of threads: ``numba.set_num_threads`` / ``NUMBA_NUM_THREADS``); a member's result does not depend
+on its block, its neighbours or the thread. The implicit midpoint rule runs the chord iteration member by member
 (scalar code, as the hand-written kernels do).
 """
 
@@ -41,6 +41,8 @@ import math
 
 import numba
 import numpy as np
+
+from ._blocks import run_blocks
 
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
@@ -205,7 +207,9 @@ def _theta_bound(s, cnorm):
 @numba.njit(cache=True)
 def _exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
     """out = exp(ad*_s) mu for one member; False if not finite. Vector Taylor for θ ≤ THETA_VECTOR
-    (the block path's series, summed in order), else matrix scaling and squaring."""
+    (the block path's series, summed in order, stopped early once two terms in a row are below
+    2^-54 |out|_∞: the norm bound θ is often loose, and the chord iteration calls this every iteration),
+    else matrix scaling and squaring."""
     n = mu.shape[0]
     th = _theta_bound(s, cnorm)
     if not math.isfinite(th):
@@ -215,12 +219,20 @@ def _exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
             out[j] = mu[j]
             term[j] = mu[j]
         r = 1
+        prev = np.inf
         while th > degth[r - 1]:
             _ad_star1(s, term, term2, ti, tj, tk, tv)
             inv = 1.0 / r
+            tmax = 0.0
+            omax = 0.0
             for j in range(n):
                 term[j] = term2[j] * inv
                 out[j] = out[j] + term[j]
+                tmax = max(tmax, abs(term[j]))
+                omax = max(omax, abs(out[j]))
+            if prev + tmax <= _TOL * omax:         # two negligible terms in a row: the bound was loose
+                break
+            prev = tmax
             r += 1
     else:
         nsq = 0
@@ -317,13 +329,9 @@ def _chord1(mu, e, s, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, 
     """Chord iteration of the implicit midpoint rule for one member (``s`` in/out, started at
     w(mu) dt + e): J = I - dt/2 Dw(mu) L(mu), frozen; stops when max|Δσ| ≤ tol (1 + |σ|_∞)."""
     n = mu.shape[0]
-    L, Dw, J, Ji, W, A, E, T = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]
+    Dw, J, Ji, W, A, E, T = w[1], w[2], w[3], w[4], w[5], w[6], w[7]
     g, t1, t2, m1, mid, u, term, term2 = w[8][0], w[8][1], w[8][2], w[8][3], w[8][4], w[8][5], w[8][6], w[8][7]
-    for j in range(n):                                 # L[j, i] = mu_k c[i, j, k]: δ ↦ ad*_δ mu
-        for i in range(n):
-            L[j, i] = 0.0
-    for t in range(tv.shape[0]):
-        L[tj[t], ti[t]] += tv[t] * mu[tk[t]]
+    # L(mu) δ = ad*_δ mu, L[j, i] = Σ_k mu_k c[i, j, k], is applied through the non-zeros of c (never formed)
     for i in range(n):
         for j in range(n):
             Dw[i, j] = q[i, j]
@@ -333,12 +341,14 @@ def _chord1(mu, e, s, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, 
             for j in range(n):
                 acc += q[i, j] * mu[j]
             g[i] = acc
-        for j in range(n):                             # A = ad*_{g+f} (matrix) + L(mu) Q
+        for j in range(n):                             # A = L(mu) Q + ad*_{g+f} (matrix), L from the non-zeros
             for k in range(n):
-                acc = 0.0
-                for l in range(n):
-                    acc += L[j, l] * q[l, k]
-                A[j, k] = acc
+                A[j, k] = 0.0
+        for t in range(tv.shape[0]):
+            cf = tv[t] * mu[tk[t]]
+            j, i = tj[t], ti[t]
+            for k in range(n):
+                A[j, k] += cf * q[i, k]
         for t in range(tv.shape[0]):
             A[tj[t], tk[t]] += tv[t] * g[ti[t]]
         for i in range(n):                             # Dw = Q + θ M⁻¹ A
@@ -347,12 +357,17 @@ def _chord1(mu, e, s, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, 
                 for l in range(n):
                     acc += mth[i, l] * A[l, j]
                 Dw[i, j] += acc
+    for i in range(n):                                 # J = I - dt/2 Dw L, L from the non-zeros
+        for j in range(n):
+            J[i, j] = 0.0
+    for t in range(tv.shape[0]):
+        cf = tv[t] * mu[tk[t]]
+        j, i = tj[t], ti[t]
+        for a in range(n):
+            J[a, i] += Dw[a, j] * cf
     for i in range(n):
         for j in range(n):
-            acc = 0.0
-            for l in range(n):
-                acc += Dw[i, l] * L[l, j]
-            J[i, j] = (1.0 if i == j else 0.0) - 0.5 * dt * acc
+            J[i, j] = (1.0 if i == j else 0.0) - 0.5 * dt * J[i, j]
     if not _invert(J, Ji, W):
         return False
     for it in range(max_iter):
@@ -406,7 +421,7 @@ def _eta_rows(dX, dXX, area, lo, bc, k0, kc, xi, brk, pi, pj, e):
 STEPS = 16
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
                degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
     """Members lo .. hi-1 over every step of the block; returns the number of members that failed."""
@@ -544,20 +559,6 @@ def _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, to
     return nfail
 
 
-@numba.njit(cache=True, parallel=True)
-def _run_blocks(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
-                degth, save, out, first_bad, reason, stop, block, start, qs, mts, has_f):
-    nb = y.shape[0]
-    nblk = (nb + block - 1) // block
-    nfail = 0
-    for b in numba.prange(nblk):
-        lo = b * block
-        hi = min(lo + block, nb)
-        nfail += _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk,
-                            tv, cnorm, degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f)
-    return nfail
-
-
 def _readonly(a):
     """A read-only view: the kernels then compile one signature whether the driver's arrays are writable or not."""
     v = a.view()
@@ -586,10 +587,12 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
     f = np.array(data["dissipation_change"], dtype=np.float64)
     qs = sparse_rows(data["q"])
     mts = sparse_rows(mth) + (np.zeros(n),)
-    _run_blocks(y, _readonly(dX), _readonly(np.empty((0, 0, 0, 0)) if dXX is None else dXX),
-                np.array(system.xi, dtype=np.float64, order="C"), brk, pi.astype(np.int64), pj.astype(np.int64),
-                np.array(dts, dtype=np.float64), int(code), np.array(data["q"], dtype=np.float64, order="C"),
-                np.array(data["linear"], dtype=np.float64), f, mth, theta, float(tol), int(max_iter), ti, tj, tk,
-                tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
-                bool(stop_on_failure), BLOCK, start, qs, mts, bool(np.any(f != 0.0)))
+    args = (y, _readonly(dX), _readonly(np.empty((0, 0, 0, 0)) if dXX is None else dXX),
+            np.array(system.xi, dtype=np.float64, order="C"), brk, pi.astype(np.int64), pj.astype(np.int64),
+            np.array(dts, dtype=np.float64), int(code), np.array(data["q"], dtype=np.float64, order="C"),
+            np.array(data["linear"], dtype=np.float64), f, mth, theta, float(tol), int(max_iter), ti, tj, tk,
+            tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
+            bool(stop_on_failure))
+    tail = (start, qs, mts, bool(np.any(f != 0.0)))
+    run_blocks(lambda lo, hi: _run_block(*args, lo, hi, *tail), nb, BLOCK)
     return y, out, first_bad, reason

@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
+from ._blocks import run_blocks
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
@@ -264,7 +265,7 @@ def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slo
     return finite, slot, nfail
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop,
                lo, hi):
     """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
@@ -303,7 +304,7 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
     return nfail
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
                         first_bad, reason, stop, lo, hi):
     """As :func:`_se3_block` for the implicit midpoint rule: sigma from the chord iteration
@@ -351,29 +352,11 @@ def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta
 BLOCK = 64
 
 
-@numba.njit(cache=True, parallel=True)
-def _se3_blocks(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, tol, max_iter, save, out, first_bad,
-                reason, stop, block):
-    """Blocks of ``block`` members in parallel (numba's threads); members are independent."""
-    nb = y.shape[0]
-    nblk = (nb + block - 1) // block
-    nfail = 0
-    for b in numba.prange(nblk):
-        lo = b * block
-        hi = min(lo + block, nb)
-        if code == 2:
-            nfail += _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter,
-                                         save, out, first_bad, reason, stop, lo, hi)
-        else:
-            nfail += _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out,
-                                first_bad, reason, stop, lo, hi)
-    return nfail
-
-
 def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
     """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
 
-    Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``.
+    Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``. Blocks of :data:`BLOCK` members run in
+    parallel (:mod:`._blocks`; ``numba.set_num_threads``).
     """
     data = system.quadratic_velocity_data()
     nb = y.shape[0]
@@ -389,5 +372,9 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     consts = (data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
               data["metric_inv"], float(data["theta"]))
     tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
-    _se3_blocks(*args, int(code), *consts, float(tol), int(max_iter), *tail, BLOCK)
+    if code == 2:
+        run_blocks(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
+                   nb, BLOCK)
+    else:
+        run_blocks(lambda lo, hi: _se3_block(*args, int(code), *consts, *tail, lo, hi), nb, BLOCK)
     return y, out, first_bad, reason

@@ -23,6 +23,7 @@ import numba
 import numpy as np
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
+from ._blocks import run_blocks
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 
@@ -299,32 +300,27 @@ def _so3_eta_block(m, eta, dts, e, bad, coef, code, tol, max_iter, q, lin, minv,
 BLOCK = 256
 
 
-@numba.njit(cache=True, parallel=True)
-def _so3_blocks(y, eta, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out, first_bad, reason, stop,
-                block):
-    """Split the members of ``y`` (B, 3) into blocks of ``block`` and run :func:`_so3_eta_block` on each,
-    in parallel (numba's threads); a member's result does not depend on its block."""
-    nb = y.shape[0]
-    nblk = (nb + block - 1) // block
-    for b in numba.prange(nblk):
-        lo = b * block
-        hi = min(lo + block, nb)
-        bc = hi - lo
-        m = np.empty((3, bc))
-        for p in range(bc):
-            for i in range(3):
-                m[i, p] = y[lo + p, i]
-        _so3_eta_block(m, eta[lo:hi], dts, np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, code, tol,
-                       max_iter, q, lin, minv, theta, save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
-        for p in range(bc):
-            for i in range(3):
-                y[lo + p, i] = m[i, p]
+@numba.njit(cache=True, nogil=True)
+def _so3_range(y, eta, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out, first_bad, reason, stop, lo,
+               hi):
+    """Run :func:`_so3_eta_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
+    a member's result does not depend on its block)."""
+    bc = hi - lo
+    m = np.empty((3, bc))
+    for p in range(bc):
+        for i in range(3):
+            m[i, p] = y[lo + p, i]
+    _so3_eta_block(m, eta[lo:hi], dts, np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, code, tol,
+                   max_iter, q, lin, minv, theta, save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
+    for p in range(bc):
+        for i in range(3):
+            y[lo + p, i] = m[i, p]
 
 
 def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure):
     """Run the so(3) kernel on ``y`` (B, 3) with ``eta`` (B, K, 3); returns (y, saved, first_bad, reason).
 
-    Blocks of :data:`BLOCK` members run in parallel on numba's threads (``numba.set_num_threads``)."""
+    Blocks of :data:`BLOCK` members run in parallel (:mod:`._blocks`; ``numba.set_num_threads``)."""
     nb = y.shape[0]
     coef = coefficients(data)
     lin = np.concatenate([data["linear"], data["dissipation_change"]])
@@ -332,9 +328,10 @@ def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure)
     out = np.full((nb, int(np.count_nonzero(save)), 3), np.nan)
     first_bad = np.full(nb, -1, dtype=np.int64)
     reason = np.zeros(nb, dtype=np.int8)
-    _so3_blocks(y, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol),
-                int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
-                np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure), BLOCK)
+    args = (y, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol),
+            int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
+            np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
+    run_blocks(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
     return y, out, first_bad, reason
 
 
