@@ -84,9 +84,7 @@ def theta_bound(s, cnorm):
 @numba.njit(cache=True)
 def exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
     """out = exp(ad*_s) mu for one member; False if not finite. Vector Taylor for θ ≤ THETA_VECTOR
-    (the block path's series, summed in order, stopped early once two terms in a row are below
-    2^-54 |out|_∞: the norm bound θ is often loose, and the chord iteration calls this every iteration),
-    else matrix scaling and squaring."""
+    (the block path's series, to the degree of the table), else matrix scaling and squaring."""
     n = mu.shape[0]
     th = theta_bound(s, cnorm)
     if not math.isfinite(th):
@@ -96,20 +94,12 @@ def exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
             out[j] = mu[j]
             term[j] = mu[j]
         r = 1
-        prev = np.inf
         while th > degth[r - 1]:
             ad_star1(s, term, term2, ti, tj, tk, tv)
             inv = 1.0 / r
-            tmax = 0.0
-            omax = 0.0
             for j in range(n):
                 term[j] = term2[j] * inv
                 out[j] = out[j] + term[j]
-                tmax = max(tmax, abs(term[j]))
-                omax = max(omax, abs(out[j]))
-            if prev + tmax <= _TOL * omax:         # two negligible terms in a row: the bound was loose
-                break
-            prev = tmax
             r += 1
     else:
         nsq = 0
