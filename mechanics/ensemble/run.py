@@ -159,7 +159,7 @@ def _run_chunk(spec: _Spec, first: int, last: int):
         if first_ok <= step + k:
             window = states[:, first_ok - step::spec.average_every]
             if fast_moments:
-                accumulate_moments(acc, np.ascontiguousarray(window))
+                accumulate_moments(acc, window)                 # a strided view: no copy of the block's states
             else:
                 accumulate(acc, np.ascontiguousarray(_observe(spec.observable, window)))
             n_avg += window.shape[1]
