@@ -218,7 +218,7 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         numbers.
     block_steps : int, optional
         Steps per time block (default: the driver's cache-sized blocks, at least
-        :data:`MIN_BLOCK_STEPS`: each block is one ``solve`` call, whose fixed cost a longer block
+        256 steps (``MIN_BLOCK_STEPS``): each block is one ``solve`` call, whose fixed cost a longer block
         spreads over more steps). Changes memory use and speed, never the numbers.
     executor : concurrent.futures.Executor, optional
         Runs the chunks (default: serially in this process); e.g. ``dask.distributed``'s
