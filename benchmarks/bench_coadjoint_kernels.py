@@ -1,64 +1,148 @@
-"""Benchmark: compiled coadjoint kernels against the numpy scheme they implement (same run).
+"""Benchmark: the coadjoint kernels — hand-written (so(3), se(3)) against the generic one, and threads (same run).
 
-Problem: the dissipative heavy top on se(3)* (I = diag(1, 2, 3), χ = (0.1, −0.2, 1), σ = 0.2, θ = 0.3)
-and the rigid body on so(3)* (σ = 0.3, θ = 0.5), driven by one precomputed Brownian rough path with its
-Lévy area (dt = 0.01). For each solver (Lie–Euler, Lie–Heun, implicit midpoint with the chord
-iteration) ``roughpaths.solve`` takes the compiled path chosen by the algebra type; the numpy path is
-the same solver stepped by the generic ``roughpaths.Solver.integrate`` loop (one vectorised numpy step
-per time step). Reported: median wall time of ``--repeats`` runs after a warm-up (numba compile/cache
-load), µs per path-step, the ratio numpy / compiled, and the largest difference between the two
-(relative, per entry) and the largest Casimir drift of the compiled result.
+Problems (driven by one precomputed Brownian rough path with its Lévy area, dt = 0.01, θ > 0):
 
-Usage: ``python benchmarks/bench_coadjoint_kernels.py [--paths P] [--steps K] [--repeats R]``.
+* the rigid body on so(3)* (I = diag(1, 2, 3), σ = 0.3, θ = 0.5) and the heavy top on se(3)*
+  (χ = (0.1, −0.2, 1), σ = 0.2, θ = 0.3), each solved by its hand-written kernel and by the generic
+  kernel on the *same* problem (the algebra rebuilt as a plain ``LieAlgebra`` from its own structure
+  constants, so only the kernel differs);
+* su(2), sl(2, R) and so(4) (6-dimensional) with a diagonal inertia and three noise vectors: the generic
+  kernel against the numpy scheme (``roughpaths.Solver.integrate``'s loop, one vectorised numpy step per
+  time step), the path the library took for them before the generic kernel.
+
+For Lie–Euler, Lie–Heun and the chord implicit midpoint. Timings are medians of interleaved runs
+(A, B, A, B, ...) in process CPU time (``--clock wall`` for wall time) on one thread, in ns per
+path-step, with the ratio. Then one thread against all of numba's threads (``numba.set_num_threads``)
+on LieHeun, in wall *and* CPU time (the machine may be shared: the wall ratio is what the threads
+give, the CPU ratio what they cost), with a bitwise check that the results are equal. The largest
+relative difference generic/numpy and the largest Casimir drift are printed too.
+
+Usage: ``python benchmarks/bench_coadjoint_kernels.py [--paths P] [--steps K] [--repeats R] [--clock cpu|wall]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
+import time
 
+import numba
 import numpy as np
 
-from _timing import median_time
+
+def _so4():
+    from mechanics import LieAlgebra
+
+    pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    basis = np.zeros((6, 4, 4))
+    for r, (a, b) in enumerate(pairs):
+        basis[r, a, b], basis[r, b, a] = 1.0, -1.0
+    return LieAlgebra.from_matrix_basis(basis, name="so4")
+
+
+def _interleaved(fns, repeats, clock):
+    """Median time of each function, run interleaved (f0, f1, ..., f0, f1, ...) after one warm-up each."""
+    for f in fns:
+        f()
+    times = [[] for _ in fns]
+    for _ in range(repeats):
+        for t, f in zip(times, fns):
+            t0 = clock()
+            f()
+            t.append(clock() - t0)
+    return [statistics.median(t) for t in times]
 
 
 def main():
-    from mechanics import ImplicitMidpoint, LieEuler, LieHeun, heavy_top, rigid_body
+    from mechanics import ImplicitMidpoint, LieAlgebra, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body
+    from mechanics.systems.lie_algebra import sl2r, su2
     from roughpaths import BrownianDriver, Solver, solve
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--paths", type=int, default=1000)
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--clock", choices=("cpu", "wall"), default="cpu")
     a = ap.parse_args()
+    clock = time.process_time if a.clock == "cpu" else time.perf_counter
     P, K = a.paths, a.steps
+    all_threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    rb = rigid_body([1.0, 2.0, 3.0], sigma=0.3, theta=0.5)
+    top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.2, theta=0.3)
+
+    def generic_copy(system):
+        alg = system.algebra
+        plain = LieAlgebra(alg.structure_constants, name=alg.name + " (constants)", casimirs=alg.casimirs,
+                           check=False)
+        return LiePoissonSystem(plain, system.hamiltonian, system.xi, theta=system.theta)
+
     rng = np.random.default_rng(0)
-    systems = {
-        "se(3) heavy top": heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], sigma=0.2, theta=0.3),
-        "so(3) rigid body": rigid_body([1.0, 2.0, 3.0], sigma=0.3, theta=0.5),
-    }
-    print(f"{P} paths x {K} steps, dt = 0.01, medians of {a.repeats}")
-    print(f"{'system':18s} {'solver':18s} {'compiled µs/ps':>15s} {'numpy µs/ps':>12s} {'numpy/compiled':>15s} "
+    solvers = (LieEuler(), LieHeun(), ImplicitMidpoint())
+    print(f"{P} paths x {K} steps, dt = 0.01, with the Lévy area; {a.clock} time, medians of {a.repeats} "
+          f"interleaved runs, one thread; ns per path-step")
+    print(f"{'algebra':10s} {'solver':18s} {'hand-written':>13s} {'generic':>9s} {'generic/hand':>13s} "
           f"{'max rel diff':>13s} {'Casimir drift':>14s}")
-    for name, system in systems.items():
+    problems = {}
+    for name, system in (("so(3)", rb), ("se(3)", top)):
         mu0 = rng.standard_normal((P, system.dim))
         X = BrownianDriver(system.n_noise, seed=1, dt=0.01, n_steps=K, batch_shape=(P,)).rough_path()
-        save = np.ones(K, dtype=bool)
-        for solver in (LieEuler(), LieHeun(), ImplicitMidpoint()):
-            def compiled():
-                return solve(system, X, mu0, solver).states
-
-            def numpy_path():
-                _, saved, _ = Solver.integrate(solver, system, mu0.copy(), X.times, X.increments, X.areas, save)
-                return np.concatenate([mu0[:, None], saved], axis=1)
-
-            ta = median_time(compiled, a.repeats, warmup=True)
-            tb = median_time(numpy_path, a.repeats, warmup=True)
-            sa, sb = compiled(), numpy_path()
-            diff = float(np.max(np.abs(sa - sb) / np.maximum(1.0, np.abs(sb))))
+        gen = generic_copy(system)
+        problems[name] = (system, gen, mu0, X)
+        for solver in solvers:
+            th, tg = _interleaved([lambda: solve(system, X, mu0, solver), lambda: solve(gen, X, mu0, solver)],
+                                  a.repeats, clock)
+            sa, sb = solve(system, X, mu0, solver).states, solve(gen, X, mu0, solver).states
+            diff = float(np.max(np.abs(sa - sb) / np.maximum(1.0, np.abs(sa))))
             c0 = system.casimirs(mu0)[:, None]
-            drift = float(np.max(np.abs(system.casimirs(sa) - c0) / np.maximum(1.0, np.abs(c0))))
-            print(f"{name:18s} {repr(solver)[:18]:18s} {1e6 * ta / (P * K):15.3f} {1e6 * tb / (P * K):12.3f} "
-                  f"{tb / ta:15.1f} {diff:13.2e} {drift:14.2e}")
+            drift = float(np.max(np.abs(system.casimirs(sb) - c0) / np.maximum(1.0, np.abs(c0))))
+            print(f"{name:10s} {repr(solver)[:18]:18s} {1e9 * th / (P * K):13.1f} {1e9 * tg / (P * K):9.1f} "
+                  f"{tg / th:13.2f} {diff:13.2e} {drift:14.2e}")
+
+    print(f"\n{'algebra':10s} {'solver':18s} {'numpy':>13s} {'generic':>9s} {'numpy/generic':>13s} "
+          f"{'max rel diff':>13s} {'Casimir drift':>14s}")
+    save = np.ones(K, dtype=bool)
+    for alg in (su2(), sl2r(), _so4()):
+        n = alg.dim
+        system = LiePoissonSystem(alg, np.diag(1.0 + np.arange(n) / 2.0), 0.3 * rng.standard_normal((3, n)),
+                                  theta=0.3)
+        mu0 = rng.standard_normal((P, n))
+        X = BrownianDriver(3, seed=1, dt=0.01, n_steps=K, batch_shape=(P,)).rough_path()
+        problems[alg.name] = (None, system, mu0, X)
+        for solver in solvers:
+            def numpy_path():
+                return Solver.integrate(solver, system, mu0.copy(), X.times, X.increments, X.areas, save)[1]
+
+            tn, tg = _interleaved([numpy_path, lambda: solve(system, X, mu0, solver)], a.repeats, clock)
+            sa, sb = numpy_path(), solve(system, X, mu0, solver).states[:, 1:]
+            diff = float(np.max(np.abs(sa - sb) / np.maximum(1.0, np.abs(sa))))
+            c0 = system.casimirs(mu0)[:, None]
+            drift = float(np.max(np.abs(system.casimirs(sb) - c0) / np.maximum(1.0, np.abs(c0))))
+            print(f"{alg.name:10s} {repr(solver)[:18]:18s} {1e9 * tn / (P * K):13.1f} {1e9 * tg / (P * K):9.1f} "
+                  f"{tn / tg:13.1f} {diff:13.2e} {drift:14.2e}")
+
+    print(f"\nLieHeun, 1 thread against {all_threads} (numba.set_num_threads); ns per path-step")
+    print(f"{'problem':22s} {'wall 1':>8s} {'wall N':>8s} {'wall N/1':>9s} {'cpu 1':>8s} {'cpu N':>8s} "
+          f"{'cpu N/1':>8s} {'bitwise':>8s}")
+    for name, (hand, gen, mu0, X) in problems.items():
+        for label, system in (("hand-written", hand), ("generic", gen)):
+            if system is None:
+                continue
+            walls, cpus, outs = {1: [], all_threads: []}, {1: [], all_threads: []}, {}
+            for _ in range(a.repeats):
+                for t in (1, all_threads):
+                    numba.set_num_threads(t)
+                    w0, c0 = time.perf_counter(), time.process_time()
+                    outs[t] = solve(system, X, mu0, LieHeun()).states
+                    walls[t].append(time.perf_counter() - w0)
+                    cpus[t].append(time.process_time() - c0)
+            numba.set_num_threads(1)
+            w1, wn = (1e9 * statistics.median(walls[t]) / (P * K) for t in (1, all_threads))
+            c1, cn = (1e9 * statistics.median(cpus[t]) / (P * K) for t in (1, all_threads))
+            same = bool(np.array_equal(outs[1], outs[all_threads]))
+            print(f"{name + ' ' + label:22s} {w1:8.1f} {wn:8.1f} {wn / w1:9.2f} {c1:8.1f} {cn:8.1f} {cn / c1:8.2f} "
+                  f"{str(same):>8s}")
+    numba.set_num_threads(all_threads)
 
 
 if __name__ == "__main__":

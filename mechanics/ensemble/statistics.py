@@ -194,6 +194,24 @@ def accumulate_moments(acc, states):
     """``acc[c] += moment_observable(states[c, t])`` for ``t`` in order, without the temporary.
     ``acc (C, n + n(n+1)/2)``, ``states (C, T, n)``."""
     n = states.shape[2]
+    if n == 3:                       # so(3)*: nine running sums in registers (the same additions, in the same order)
+        for c in range(states.shape[0]):
+            a0, a1, a2, a3, a4, a5, a6, a7, a8 = (acc[c, 0], acc[c, 1], acc[c, 2], acc[c, 3], acc[c, 4], acc[c, 5],
+                                                  acc[c, 6], acc[c, 7], acc[c, 8])
+            for t in range(states.shape[1]):
+                x0, x1, x2 = states[c, t, 0], states[c, t, 1], states[c, t, 2]
+                a0 += x0
+                a1 += x1
+                a2 += x2
+                a3 += x0 * x0
+                a4 += x0 * x1
+                a5 += x0 * x2
+                a6 += x1 * x1
+                a7 += x1 * x2
+                a8 += x2 * x2
+            acc[c, 0], acc[c, 1], acc[c, 2], acc[c, 3], acc[c, 4] = a0, a1, a2, a3, a4
+            acc[c, 5], acc[c, 6], acc[c, 7], acc[c, 8] = a5, a6, a7, a8
+        return
     for c in range(states.shape[0]):
         for t in range(states.shape[1]):
             for i in range(n):

@@ -2,7 +2,9 @@ r"""Casimir-preserving coadjoint solvers for Lie–Poisson systems, under the :c
 
 ``roughpaths.solve(system, X, mu0, LieHeun())`` integrates a :class:`~mechanics.systems.lie_poisson.LiePoissonSystem`
 on a rough path or a driver and returns a :class:`roughpaths.Solution` (see :mod:`.base` for the
-schemes). Compiled so(3) and se(3) kernels are chosen inside the solvers by the type of the algebra.
+schemes). Compiled kernels are chosen inside the solvers: hand-written ones for so(3) and se(3) (by the type
+of the algebra), a generic one compiled from the structure constants for every other algebra; they run
+on numba's threads (``numba.set_num_threads``).
 """
 
 from .base import ChordConvergenceError, CoadjointSolver, ImplicitMidpoint, LieEuler, LieHeun, check_on_orbit

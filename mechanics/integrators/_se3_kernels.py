@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
+from ._blocks import run_blocks
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
@@ -264,8 +265,9 @@ def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slo
     return finite, slot, nfail
 
 
-@numba.njit(cache=True)
-def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop):
+@numba.njit(cache=True, nogil=True)
+def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop,
+               lo, hi):
     """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
     (code 0) or Lie–Heun (code 1). A failed member gets ``first_bad`` and ``reason``. Returns the
     number of members that failed."""
@@ -274,7 +276,7 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
     mu, e, w0, w1, s = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     a1, a2, pred, g, t1, t2, new = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     nfail = 0
-    for p in range(nb):
+    for p in range(lo, hi):
         for i in range(6):
             mu[i] = y[p, i]
         slot = 0
@@ -302,9 +304,9 @@ def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, s
     return nfail
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
-                        first_bad, reason, stop):
+                        first_bad, reason, stop, lo, hi):
     """As :func:`_se3_block` for the implicit midpoint rule: sigma from the chord iteration
     (:func:`_se3_chord`); a member whose iteration fails gets ``reason = CHORD_FAILED``. A separate
     kernel, so that the explicit schemes do not compile the chord."""
@@ -315,7 +317,7 @@ def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta
     L, Dw, J, Ji, W = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12))
     m1, mid, u = np.empty(6), np.empty(6), np.empty(6)
     nfail = 0
-    for p in range(nb):
+    for p in range(lo, hi):
         for i in range(6):
             mu[i] = y[p, i]
         slot = 0
@@ -346,10 +348,15 @@ def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta
     return nfail
 
 
+#: Members per block of the thread split.
+BLOCK = 64
+
+
 def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
     """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
 
-    Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``.
+    Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``. Blocks of :data:`BLOCK` members run in
+    parallel (:mod:`._blocks`; ``numba.set_num_threads``).
     """
     data = system.quadratic_velocity_data()
     nb = y.shape[0]
@@ -366,7 +373,8 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
               data["metric_inv"], float(data["theta"]))
     tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
     if code == 2:
-        _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail)
+        run_blocks(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
+                   nb, BLOCK)
     else:
-        _se3_block(*args, int(code), *consts, *tail)
+        run_blocks(lambda lo, hi: _se3_block(*args, int(code), *consts, *tail, lo, hi), nb, BLOCK)
     return y, out, first_bad, reason

@@ -23,6 +23,7 @@ import numba
 import numpy as np
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
+from ._blocks import run_blocks
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 
@@ -295,21 +296,43 @@ def _so3_eta_block(m, eta, dts, e, bad, coef, code, tol, max_iter, q, lin, minv,
     return eta.shape[1]
 
 
+#: Members per block of the thread split (each block runs all its steps on one thread).
+BLOCK = 256
+
+
+@numba.njit(cache=True, nogil=True)
+def _so3_range(y, eta, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out, first_bad, reason, stop, lo,
+               hi):
+    """Run :func:`_so3_eta_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
+    a member's result does not depend on its block)."""
+    bc = hi - lo
+    m = np.empty((3, bc))
+    for p in range(bc):
+        for i in range(3):
+            m[i, p] = y[lo + p, i]
+    _so3_eta_block(m, eta[lo:hi], dts, np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, code, tol,
+                   max_iter, q, lin, minv, theta, save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
+    for p in range(bc):
+        for i in range(3):
+            y[lo + p, i] = m[i, p]
+
+
 def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure):
-    """Run the so(3) kernel on ``y`` (B, 3) with ``eta`` (B, K, 3); returns (y, saved, first_bad, reason)."""
+    """Run the so(3) kernel on ``y`` (B, 3) with ``eta`` (B, K, 3); returns (y, saved, first_bad, reason).
+
+    Blocks of :data:`BLOCK` members run in parallel (:mod:`._blocks`; ``numba.set_num_threads``)."""
     nb = y.shape[0]
     coef = coefficients(data)
     lin = np.concatenate([data["linear"], data["dissipation_change"]])
-    m = np.ascontiguousarray(y.T)
+    y = np.array(y, dtype=np.float64, order="C")
     out = np.full((nb, int(np.count_nonzero(save)), 3), np.nan)
     first_bad = np.full(nb, -1, dtype=np.int64)
     reason = np.zeros(nb, dtype=np.int8)
-    _so3_eta_block(m, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64),
-                   np.empty((3, nb)), np.empty(nb, dtype=np.bool_), coef, code, float(tol), int(max_iter),
-                   data["q"], lin, data["metric_inv"],
-                   float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason,
-                   bool(stop_on_failure))
-    return np.ascontiguousarray(m.T), out, first_bad, reason
+    args = (y, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol),
+            int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
+            np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
+    run_blocks(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
+    return y, out, first_bad, reason
 
 
 @numba.njit(cache=True)

@@ -35,12 +35,19 @@ driver. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
 adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` to :math:`\sigma_n`: the
 discrete Proposition 2.1.
 
-Implementation: for a :class:`~mechanics.systems.lie_algebra.SO3Algebra` with a quadratic Hamiltonian,
-:meth:`CoadjointSolver.integrate` runs compiled block kernels (:mod:`mechanics.integrators._so3_kernels`),
-for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy top) those of
-:mod:`mechanics.integrators._se3_kernels`; otherwise a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3),
-:func:`roughpaths.expm_batched` per member otherwise). Either way a batch member's result depends
-on its own data only; a member that fails is reported through ``first_bad`` (contract item 8).
+Implementation: a system with a quadratic Hamiltonian and no forces runs compiled block kernels:
+for a :class:`~mechanics.systems.lie_algebra.SO3Algebra` the hand-written ones of
+:mod:`mechanics.integrators._so3_kernels`, for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy
+top) those of :mod:`mechanics.integrators._se3_kernels`, and for every other algebra the generic kernel of
+:mod:`mechanics.integrators._generic_kernels`, compiled once for all algebras (the structure constants are
+data: su(2), sl(2, R), so(4), semidirect products, a user's basis). Otherwise (forces, a non-quadratic
+Hamiltonian) a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3), :func:`roughpaths.expm_batched`
+per member otherwise). Either way a batch member's result depends on its own data only; a member that
+fails is reported through ``first_bad`` (contract item 8).
+
+Threads: the compiled kernels split the paths into blocks and run them on numba's threads; set their
+number with ``numba.set_num_threads(k)`` (or the environment variable ``NUMBA_NUM_THREADS`` before the
+first import). The results are bitwise the same for any number of threads.
 
 Forces (``force``, ``noise_forces`` of the system) are added outside the group update, on the numpy
 path, by :mod:`mechanics.integrators._forced` (orders and Casimirs stated there); the compiled
@@ -58,7 +65,7 @@ from roughpaths.validation import as_float_array, check_positive_int
 
 from ..systems.lie_algebra import SE3Algebra, SO3Algebra
 from ..systems.lie_poisson import LiePoissonSystem
-from . import _se3_kernels, _so3_kernels
+from . import _generic_kernels, _se3_kernels, _so3_kernels
 from ._chord import chord_solve
 from ._forced import forced_sigma_and_state
 
@@ -189,7 +196,7 @@ class CoadjointSolver(Solver):
         return self._advance(fields, y, float(dt), self._eta(fields, dX, dXX))[0]
 
     def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
-        """Advance a block of steps (contract item 8); compiled so(3)/se(3) kernels where they apply.
+        """Advance a block of steps (contract item 8); compiled kernels where they apply (module docstring).
 
         Raises :class:`ChordConvergenceError` (with ``stop_on_failure``) when a member's chord
         iteration fails; other failures are reported through ``first_bad``.
@@ -221,6 +228,18 @@ class CoadjointSolver(Solver):
                 dXX, dts, save, stop_on_failure)
             y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
             chord = (reason == _se3_kernels.CHORD_FAILED).reshape(batch)
+        elif plain:
+            nb = int(np.prod(batch, dtype=np.int64))
+            d = dX.shape[-1]
+            dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
+            if dXX is not None:
+                dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
+                                           dtype=np.float64)
+            y2, saved, first_bad, reason = _generic_kernels.integrate_generic(
+                system, self._code, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1), y.reshape(nb, n), dX,
+                dXX, dts, save, stop_on_failure)
+            y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
+            chord = (reason == _generic_kernels.CHORD_FAILED).reshape(batch)
         else:
             saved = np.full(batch + (nsave, n), np.nan)
             first_bad = np.full(batch, -1, dtype=np.int64)

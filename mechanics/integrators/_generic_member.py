@@ -1,0 +1,263 @@
+r"""One member of the generic coadjoint kernel (scalar code): the exponential, the velocity, the chord iteration.
+
+Used by :mod:`._generic_kernels` for the members its vectorised block path does not take (a large or
+non-finite :math:`\theta`) and for the implicit midpoint rule (the chord iteration runs member by
+member). Shapes: ``mu``, ``s``, ``e`` (n,); the structure constants as their non-zeros ``(ti, tj, tk, tv)``
+and ``cnorm`` (:func:`._generic_kernels.algebra_tables`).
+
+The Taylor degrees: ``DEGREE_THETA[m]`` is the largest :math:`\theta` for which the degree-``m`` Taylor
+polynomial of :math:`e^{A}` (:math:`\|A\|\le\theta`) leaves a remainder :math:`\theta^{m+1}/(m+1)!\le 2^{-54}`
+(relative to :math:`|\mu|`; :math:`e^\theta\le 3` is absorbed by the rounding of the sum).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+_TOL = 2.0 ** -54
+
+#: Largest Taylor degree of the vector path.
+MAX_DEGREE = 18
+
+
+def _degree_table():
+    th = np.empty(MAX_DEGREE + 1)
+    fact = 1.0
+    for m in range(MAX_DEGREE + 1):
+        fact *= m + 1                                          # (m + 1)!
+        th[m] = (_TOL * fact) ** (1.0 / (m + 1))
+    return th
+
+
+#: ``DEGREE_THETA[m]``: the largest θ for which Taylor degree ``m`` is below round-off (increasing).
+DEGREE_THETA = _degree_table()
+#: Members with θ above this take the scalar scaling-and-squaring path.
+THETA_VECTOR = float(DEGREE_THETA[MAX_DEGREE])
+_THETA_SCALED = 0.5
+_MAX_SQUARINGS = 1100
+
+
+@numba.njit(cache=True, inline="always")
+def ad_star1(x, mu, out, ti, tj, tk, tv):
+    """out = ad*_x mu from the non-zeros of the structure constants."""
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for t in range(tv.shape[0]):
+        out[tj[t]] += tv[t] * x[ti[t]] * mu[tk[t]]
+
+
+@numba.njit(cache=True)
+def velocity1(mu, q, lin, f, mth, theta, g, t1, t2, out, ti, tj, tk, tv):
+    """out = w(mu) = g + θ M⁻¹ ad*_{g+f} mu, g = Q mu + lin (``mth`` = θ M⁻¹; g, t1, t2: work)."""
+    n = mu.shape[0]
+    for i in range(n):
+        acc = lin[i]
+        for j in range(n):
+            acc += q[i, j] * mu[j]
+        g[i] = acc
+    if theta == 0.0:
+        for i in range(n):
+            out[i] = g[i]
+        return
+    for i in range(n):
+        t1[i] = g[i] + f[i]
+    ad_star1(t1, mu, t2, ti, tj, tk, tv)
+    for i in range(n):
+        acc = g[i]
+        for j in range(n):
+            acc += mth[i, j] * t2[j]
+        out[i] = acc
+
+
+@numba.njit(cache=True)
+def theta_bound(s, cnorm):
+    """θ = Σ_i |s_i| cnorm_i ≥ ‖ad*_s‖_∞."""
+    th = 0.0
+    for i in range(s.shape[0]):
+        th += abs(s[i]) * cnorm[i]
+    return th
+
+
+@numba.njit(cache=True)
+def exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
+    """out = exp(ad*_s) mu for one member; False if not finite. Vector Taylor for θ ≤ THETA_VECTOR
+    (the block path's series, to the degree of the table), else matrix scaling and squaring."""
+    n = mu.shape[0]
+    th = theta_bound(s, cnorm)
+    if not math.isfinite(th):
+        return False
+    if th <= degth[degth.shape[0] - 1]:
+        for j in range(n):
+            out[j] = mu[j]
+            term[j] = mu[j]
+        r = 1
+        while th > degth[r - 1]:
+            ad_star1(s, term, term2, ti, tj, tk, tv)
+            inv = 1.0 / r
+            for j in range(n):
+                term[j] = term2[j] * inv
+                out[j] = out[j] + term[j]
+            r += 1
+    else:
+        nsq = 0
+        scale = 1.0
+        while th > _THETA_SCALED:
+            th *= 0.5
+            scale *= 0.5
+            nsq += 1
+            if nsq > _MAX_SQUARINGS:
+                return False
+        for j in range(n):
+            for k in range(n):
+                A[j, k] = 0.0
+        for t in range(tv.shape[0]):
+            A[tj[t], tk[t]] += tv[t] * s[ti[t]] * scale
+        m = 0
+        while th > degth[m]:
+            m += 1
+        for j in range(n):                              # Horner: E = I + A E / r, r = m .. 1
+            for k in range(n):
+                E[j, k] = 1.0 if j == k else 0.0
+        for r in range(m, 0, -1):
+            inv = 1.0 / r
+            for j in range(n):
+                for k in range(n):
+                    acc = 0.0
+                    for l in range(n):
+                        acc += A[j, l] * E[l, k]
+                    T[j, k] = acc * inv
+            for j in range(n):
+                for k in range(n):
+                    E[j, k] = T[j, k] + (1.0 if j == k else 0.0)
+        for _ in range(nsq):
+            for j in range(n):
+                for k in range(n):
+                    acc = 0.0
+                    for l in range(n):
+                        acc += E[j, l] * E[l, k]
+                    T[j, k] = acc
+            for j in range(n):
+                for k in range(n):
+                    E[j, k] = T[j, k]
+        for j in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += E[j, k] * mu[k]
+            out[j] = acc
+    for j in range(n):
+        if not math.isfinite(out[j]):
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def invert(J, Ji, W):
+    """Ji = J⁻¹ (n × n) by Gauss–Jordan elimination with partial pivoting; False if singular / not finite."""
+    n = J.shape[0]
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = J[i, j]
+            W[i, n + j] = 1.0 if i == j else 0.0
+    for c in range(n):
+        piv = c
+        best = abs(W[c, c])
+        for r in range(c + 1, n):
+            v = abs(W[r, c])
+            if v > best:
+                best, piv = v, r
+        if not (best > 0.0 and best < np.inf):
+            return False
+        if piv != c:
+            for j in range(2 * n):
+                W[c, j], W[piv, j] = W[piv, j], W[c, j]
+        inv = 1.0 / W[c, c]
+        for j in range(2 * n):
+            W[c, j] *= inv
+        for r in range(n):
+            if r != c:
+                fr = W[r, c]
+                if fr != 0.0:
+                    for j in range(2 * n):
+                        W[r, j] -= fr * W[c, j]
+    for i in range(n):
+        for j in range(n):
+            v = W[i, n + j]
+            if not math.isfinite(v):
+                return False
+            Ji[i, j] = v
+    return True
+
+
+@numba.njit(cache=True)
+def chord1(mu, e, s, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm, degth, w):
+    """Chord iteration of the implicit midpoint rule for one member (``s`` in/out, started at
+    w(mu) dt + e): J = I - dt/2 Dw(mu) L(mu), frozen; stops when max|Δσ| ≤ tol (1 + |σ|_∞)."""
+    n = mu.shape[0]
+    Dw, J, Ji, W, A, E, T = w[1], w[2], w[3], w[4], w[5], w[6], w[7]
+    g, t1, t2, m1, mid, u, term, term2 = w[8][0], w[8][1], w[8][2], w[8][3], w[8][4], w[8][5], w[8][6], w[8][7]
+    # L(mu) δ = ad*_δ mu, L[j, i] = Σ_k mu_k c[i, j, k], is applied through the non-zeros of c (never formed)
+    for i in range(n):
+        for j in range(n):
+            Dw[i, j] = q[i, j]
+    if theta != 0.0:
+        for i in range(n):                             # gradient inside the double bracket, g + f
+            acc = lin[i] + f[i]
+            for j in range(n):
+                acc += q[i, j] * mu[j]
+            g[i] = acc
+        for j in range(n):                             # A = L(mu) Q + ad*_{g+f} (matrix), L from the non-zeros
+            for k in range(n):
+                A[j, k] = 0.0
+        for t in range(tv.shape[0]):
+            cf = tv[t] * mu[tk[t]]
+            j, i = tj[t], ti[t]
+            for k in range(n):
+                A[j, k] += cf * q[i, k]
+        for t in range(tv.shape[0]):
+            A[tj[t], tk[t]] += tv[t] * g[ti[t]]
+        for i in range(n):                             # Dw = Q + θ M⁻¹ A
+            for j in range(n):
+                acc = 0.0
+                for l in range(n):
+                    acc += mth[i, l] * A[l, j]
+                Dw[i, j] += acc
+    for i in range(n):                                 # J = I - dt/2 Dw L, L from the non-zeros
+        for j in range(n):
+            J[i, j] = 0.0
+    for t in range(tv.shape[0]):
+        cf = tv[t] * mu[tk[t]]
+        j, i = tj[t], ti[t]
+        for a in range(n):
+            J[a, i] += Dw[a, j] * cf
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = (1.0 if i == j else 0.0) - 0.5 * dt * J[i, j]
+    if not invert(J, Ji, W):
+        return False
+    for it in range(max_iter):
+        if not exp1(s, mu, m1, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth):
+            return False
+        for i in range(n):
+            mid[i] = 0.5 * (mu[i] + m1[i])
+        velocity1(mid, q, lin, f, mth, theta, g, t1, t2, u, ti, tj, tk, tv)
+        for i in range(n):
+            t1[i] = s[i] - u[i] * dt - e[i]
+        err = 0.0
+        smax = 0.0
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += Ji[i, j] * t1[j]
+            t2[i] = acc
+        for i in range(n):
+            s[i] -= t2[i]
+            err = max(err, abs(t2[i]))
+            smax = max(smax, abs(s[i]))
+        if not (math.isfinite(err) and math.isfinite(smax)):
+            return False
+        if err <= tol * (1.0 + smax):
+            return True
+    return False
