@@ -71,7 +71,7 @@ fi
 
 # Compile the numba kernels once (cached on disk by numba): the main job's, at tiny sizes, and the
 # signature kernels (tools/warm_kernels.py); afterwards the first call of a user does not wait for the compiler.
-echo "Compiling the numba kernels once (about a minute) ..." >&2
+echo "Compiling the numba kernels once (a few minutes) ..." >&2
 WARM="$(mktemp -d)"
 rc=0
 "$PY" -m mechanics --tiny --quiet --output "$WARM/run" >>"$LOG" 2>&1 || rc=$?
