@@ -238,3 +238,49 @@ def logsig2_glue(part, nb, nchunks, d):
         for r in range(d, width):
             out[b, r] = 0.5 * tot[r]
     return out
+
+
+@njit(**_NOGIL)
+def sig2_vjp_rows(x, g, lo, hi, gx):
+    """Cotangent ``gx`` (B, n, d) of the points of paths ``lo..hi-1`` given ``g`` (B, d + d*d), the
+    row-major cotangent of their level-2 signatures (``n >= 2``).
+
+    With ``c_k`` the cotangent of the increment ``Δ_k``: ``c_k = G_1 + G_2 X + A (Y_{k-1} + Y_k) / 2``,
+    ``X`` the total increment, ``Y_k`` the point ``k`` minus the first, ``A = G_2^T - G_2``. So an
+    interior point gets ``c_k - c_{k+1} = -A (x_{k+1} - x_{k-1}) / 2``: ``d^2`` operations a point.
+    """
+    n = x.shape[1]
+    d = x.shape[2]
+    at = np.empty((d, d))                                   # at[j, a] = A[a, j]
+    c = np.empty(d)
+    w0 = np.empty(d)
+    w1 = np.empty(d)
+    for b in range(lo, hi):
+        for j in range(d):
+            for a in range(d):
+                at[j, a] = g[b, d + j * d + a] - g[b, d + a * d + j]
+        for a in range(d):
+            acc = g[b, a]
+            for j in range(d):
+                acc += g[b, d + a * d + j] * (x[b, n - 1, j] - x[b, 0, j])
+            c[a] = acc
+        row = gx[b]
+        for k in range(n):
+            for a in range(d):
+                row[k, a] = 0.0
+        for k in range(1, n - 1):
+            for j in range(d):
+                w = -0.5 * (x[b, k + 1, j] - x[b, k - 1, j])
+                for a in range(d):
+                    row[k, a] += at[j, a] * w
+        for j in range(d):
+            w0[j] = 0.5 * (x[b, 1, j] - x[b, 0, j])
+            w1[j] = (x[b, n - 1, j] - x[b, 0, j]) - 0.5 * (x[b, n - 1, j] - x[b, n - 2, j])
+        for a in range(d):
+            s0 = c[a]
+            s1 = c[a]
+            for j in range(d):
+                s0 += at[j, a] * w0[j]
+                s1 += at[j, a] * w1[j]
+            row[0, a] = -s0
+            row[n - 1, a] = s1

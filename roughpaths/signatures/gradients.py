@@ -16,6 +16,7 @@ from ..algebra.flat import lyndon_flat_vjp
 from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
+from . import _level2 as _l2
 from . import _vjp
 from ._engine import (_check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array, _offsets,
                       _reversed_parts, _reversed_to_rowmajor, _sigdim, _signature_flat, _split_units, _units)
@@ -49,6 +50,11 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
         gx = np.zeros(x.shape)
         gx[:, -1] += g_row
         gx[:, 0] -= g_row
+        return gx
+    if depth == 2:                                # closed form, d^2 operations a point
+        gx = np.empty(x.shape)
+        g2 = _kernel_array(g_row, g_row.shape)
+        _threads.run(lambda lo, hi: _l2.sig2_vjp_rows(x, g2, lo, hi, gx), _threads.ranges(nb, n * d * d))
         return gx
     off = _offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
@@ -96,7 +102,8 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     segment is recovered as :math:`S \otimes \exp(-\Delta)` (nothing of the forward pass is
     stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} \rhd G,
     \exp(\Delta)\rangle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
-    signatures per path. Long paths are cut into the same chunks as :func:`signature`.
+    signatures per path. Long paths are cut into the same chunks as :func:`signature`. At depth 2
+    the cotangent has a closed form, ``d^2`` operations a point (``roughpaths.signatures._level2``).
 
     Examples
     --------

@@ -3,7 +3,7 @@
 * ``signature`` / ``logsignature`` equal ``iisignature.sig`` / ``logsig`` to 1e-12 at d = 6, 8, 20
   (the one-unit kernel that every d >= 6 runs) and depths 2..8 where the sizes stay small;
 * ``signature_vjp`` / ``logsignature_vjp`` equal ``iisignature.sigbackprop`` / ``logsigbackprop``
-  at d = 6 and 8;
+  at d = 6, 8 and (depth 2, the closed-form level-2 kernel) 20;
 * a path computed alone equals, bit for bit, the same path inside batches of 1..10 members (which
   move it between the lane kernel and the one-unit kernel), for the signature and its VJP.
 
@@ -42,7 +42,7 @@ def test_wide_logsignature_matches_iisignature(rng, d, m):
     np.testing.assert_allclose(logsignature(x, m), ref, rtol=0, atol=TOL if m < 8 else 1e-11)
 
 
-@pytest.mark.parametrize("d,m", [(6, 3), (8, 3), (6, 4)])
+@pytest.mark.parametrize("d,m", [(6, 3), (8, 3), (6, 4), (8, 2), (20, 2)])
 def test_wide_vjp_matches_iisignature(rng, d, m):
     x = rng.standard_normal((2, 5, d)) * 0.5
     g = rng.standard_normal((2, sigdim(d, m)))
@@ -54,7 +54,7 @@ def test_wide_vjp_matches_iisignature(rng, d, m):
                                atol=1e-5 * (1 + np.abs(refl).max()))
 
 
-@pytest.mark.parametrize("d,m", [(3, 4), (8, 3)])
+@pytest.mark.parametrize("d,m", [(3, 4), (8, 3), (8, 2)])
 def test_member_bits_do_not_depend_on_the_batch_size(rng, d, m):
     x = _paths(rng, 10, 12, d)
     g = rng.standard_normal((10, sigdim(d, m)))
