@@ -1,25 +1,28 @@
 """Benchmark: signatures, log-signatures and their gradients against pysiglib and iisignature.
 
-Everything is timed in one run on the same data; each cell is the median of ``--repeats`` calls
-after one untimed warm-up call (compilation, caches, pysiglib's prepared log-signature basis). In
-the tables the three libraries of a row are timed in turn (each timed call right after an untimed
-call of the same library), so that a burst of load from other processes hits them alike.
-The machine is shared and noisy: medians and same-run ratios are what this prints.
+Everything is timed in one run on the same data. The machine is shared and noisy: medians of
+interleaved calls and same-run ratios are what this prints.
 
-Cases (float64): (a) one path of 100,000 points in d = 3; (b) 1,000 paths of 1,000 points,
-d = 3; (c) 32 paths of 1,000 points, d = 5; levels 2..5. "time ratio" is our time divided by the
-peer's (below 1: ours is faster). All libraries get the machine's threads: ours
-(``numba.get_num_threads()``), pysiglib with ``n_jobs=-1``; iisignature is single-threaded. Log-signatures are
-compared in the Lyndon basis (pysiglib ``method=2``, iisignature's default), all three agree.
+First table (issue 22): every cell against pysiglib 4.0 in both modes, one thread (our
+``numba.set_num_threads(1)`` against ``n_jobs=1``, CPU time ``time.process_time``) and all threads
+(our default threads against ``n_jobs=-1``, wall time); each time is the median of ``--repeats``
+interleaved pairs (ours, peer, ours, peer, ... each timed call right after an untimed call of the
+same function). Cases: (d) 64 paths x 256 points, d = 8, depths 2-4; (e) 4 x 64, d = 20, depths
+2-3; (f) one path of 1000 points, d = 3, depth 4 (and (f') four of them); (g) one 10 x 4 path at
+depth 8; (h) 16 x 256, d = 6, depth 4; for the signature, the log-signature (Lyndon basis,
+pysiglib ``method=2``) and their vector-Jacobian products (pysiglib: ``sig_backprop`` after
+``sig``, and ``sig_to_log_sig_backprop`` in between for the log). Each signature row also prints a
+floor: the FLOPs of the Horner update (:func:`horner_flops` per segment, times the segments) at
+the rate this machine sustains for a vectorised multiply-add sweep in L1, or one pass over the
+paths and the signatures at its copy bandwidth, whichever is larger; "vs floor" is our one-thread
+time over it. "err/iisig" is the largest difference from iisignature relative to the largest
+entry (the gradients of iisignature agree to about 1e-7 only).
 
-Also measured: ``logsignature`` of a 10 x 3 path at depth 10 (fresh process: first call, which
-builds the sparse Lyndon map, and a repeat call; time and peak traced memory), ``logsigdim(2, 60)``,
-level 2 on (a) with a CPU-bound process beside it (our default threads vs our single-thread
-kernel, same loaded machine), bitwise equality of results with 1 and 2 threads, and the
-gradient (vector-Jacobian product) at depth 4 on (b).
-
-Our depth >= 3 kernel runs 8 work units side by side in packed SIMD registers
-(``roughpaths/signatures/_lanes.py``); its results are bitwise those of the one-unit-at-a-time loop.
+Then the cases of the earlier runs: (a) one path of 100,000 points in d = 3; (b) 1,000 paths of
+1,000 points, d = 3; (c) 32 paths of 1,000 points, d = 5; levels 2..5, all threads, with
+iisignature (single-threaded); the gradient at depth 4 on (b); ``logsignature`` of a 10 x 3 path
+at depth 10 in a fresh process; level 2 on (a) beside a CPU-bound process; bitwise equality of
+results with 1 and 2 threads.
 
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick]``
 """
@@ -101,10 +104,125 @@ def _run(code: str) -> list:
     return [float(v) for v in out.stdout.split()]
 
 
+def horner_flops(d: int, m: int) -> int:
+    """Floating-point operations of one Horner segment update ``S <- S ⊗ exp(D)`` at depth ``m``."""
+    f = d                                                      # level 1
+    for lev in range(2, m + 1):
+        f += d + sum(d ** j + d ** (j + 1) for j in range(1, lev - 1)) + d ** (lev - 1) + 2 * d ** lev
+    return f
+
+
+def machine_rates() -> tuple:
+    """(flop/s of a vectorised multiply-add sweep in L1, bytes/s of one pass over a large array)."""
+    import numba
+
+    @numba.njit(cache=True)
+    def sweep(y, x, reps):
+        for _ in range(reps):
+            for p in range(x.shape[0]):
+                y[p] += x[p] * 1e-9
+    y, x = np.zeros(2048), np.ones(2048)
+    sweep(y, x, 1)
+    t0 = time.process_time()
+    sweep(y, x, 20000)
+    flops = 2 * 2048 * 20000 / (time.process_time() - t0)
+    big = np.ones(2 ** 23)
+    out = np.empty_like(big)
+    t0 = time.process_time()
+    for _ in range(5):
+        np.copyto(out, big)
+    bandwidth = 5 * 2 * big.nbytes / (time.process_time() - t0)
+    return flops, bandwidth
+
+
+def paired(fns, repeats: int, clock) -> list:
+    """Medians of interleaved timings (ours, peer, ours, peer, ...), each after an untimed call."""
+    for fn in fns:
+        fn()
+    times = [[] for _ in fns]
+    for _ in range(max(1, repeats)):
+        for i, fn in enumerate(fns):
+            fn()
+            t0 = clock()
+            fn()
+            times[i].append(clock() - t0)
+    return [float(np.median(t)) for t in times]
+
+
+def peer_table(cases: dict, args, rng) -> None:
+    """Every cell, ours against pysiglib: one thread (CPU time) and all threads (wall time)."""
+    import iisignature
+    import numba
+    import pysiglib
+
+    from roughpaths import logsignature, logsignature_vjp, signature, signature_vjp
+
+    threads = numba.get_num_threads()
+    flops, bandwidth = machine_rates()
+    print(f"machine: multiply-add sweep in L1 {flops / 1e9:.2f} GFLOP/s (one thread), one pass over memory "
+          f"{bandwidth / 1e9:.1f} GB/s")
+    print("floor = max(Horner FLOPs / that rate, bytes of the paths and the signatures / that bandwidth), one "
+          "thread; 'vs floor' = our 1-thread time / floor\n")
+    head = (f"{'case':<24}{'what':<9}{'lvl':>4}{'ours 1t':>10}{'peer 1t':>10}{'ratio 1t':>9}"
+            f"{'ours ' + str(threads) + 't':>10}{'peer -1':>10}{'ratio':>7}{'floor':>9}{'vs floor':>9}{'err/iisig':>10}")
+    print("time ratio = ours / pysiglib (below 1: ours faster); ms; 1t: numba.set_num_threads(1) against "
+          f"n_jobs=1, CPU time; {threads}t: our default threads against n_jobs=-1, wall time")
+    print(head)
+    for name, (x, depths, kinds) in cases.items():
+        nb = int(np.prod(x.shape[:-2]))
+        n, d = x.shape[-2:]
+        for m in depths:
+            sig_ii = iisignature.sig(x, m)
+            g = rng.standard_normal(sig_ii.shape)
+            g1 = np.concatenate([np.zeros(g.shape[:-1] + (1,)), g], axis=-1)
+            gl = rng.standard_normal(x.shape[:-2] + (iisignature.logsiglength(d, m),))
+            pysiglib.prepare_log_sig(d, m, method=2)
+            prep = iisignature.prepare(d, m) if "logsig" in kinds else None
+
+            def peer_log_vjp(jobs):
+                s = pysiglib.sig(x, m, scalar_term=True, n_jobs=jobs)
+                gs = pysiglib.sig_to_log_sig_backprop(s, gl, d, m, method=2, n_jobs=jobs)
+                return pysiglib.sig_backprop(x, s, gs, m, n_jobs=jobs)
+
+            cells = {
+                "sig": (lambda: signature(x, m), lambda j: pysiglib.sig(x, m, n_jobs=j),
+                        lambda: sig_ii),
+                "logsig": (lambda: logsignature(x, m), lambda j: pysiglib.log_sig(x, m, method=2, n_jobs=j),
+                           lambda: iisignature.logsig(x, prep)),
+                "sig vjp": (lambda: signature_vjp(x, m, g),
+                            lambda j: pysiglib.sig_backprop(x, pysiglib.sig(x, m, scalar_term=True, n_jobs=j), g1,
+                                                            m, n_jobs=j),
+                            lambda: iisignature.sigbackprop(g, x, m)),
+                "log vjp": (lambda: logsignature_vjp(x, m, gl), peer_log_vjp,
+                            lambda: iisignature.logsigbackprop(gl, x, prep)),
+            }
+            for kind in kinds:
+                ours, peer, ref = cells[kind]
+                numba.set_num_threads(1)
+                try:
+                    t_o1, t_p1 = paired((ours, lambda: peer(1)), args.repeats, time.process_time)
+                    got = ours()
+                finally:
+                    numba.set_num_threads(threads)
+                t_on, t_pn = paired((ours, lambda: peer(-1)), args.repeats, time.perf_counter)
+                want = ref()
+                err = float(np.max(np.abs(got - want)) / max(1.0, float(np.max(np.abs(want)))))
+                floor = ""
+                if kind == "sig":
+                    fl = max(nb * (n - 1) * horner_flops(d, m) / flops, 8 * (x.size + sig_ii.size) / bandwidth)
+                    floor = f"{1e3 * fl:>9.3f}{t_o1 / fl:>9.1f}"
+                else:
+                    floor = f"{'':>9}{'':>9}"
+                print(f"{name:<24}{kind:<9}{m:>4}{1e3 * t_o1:>10.3f}{1e3 * t_p1:>10.3f}{t_o1 / t_p1:>9.2f}"
+                      f"{1e3 * t_on:>10.3f}{1e3 * t_pn:>10.3f}{t_on / t_pn:>7.2f}{floor}{err:>10.1e}", flush=True)
+    print()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--quick", action="store_true", help="smaller sizes (smoke test)")
+    parser.add_argument("--only-peer-table", action="store_true", help="print the pysiglib table only")
     args = parser.parse_args()
 
     import iisignature
@@ -120,9 +238,27 @@ def main() -> None:
         "(b) 1000 x 1000, d=3": np.cumsum(rng.standard_normal((1_000 // s, 1_000, 3)), axis=-2) / 30,
         "(c) 32 x 1000, d=5": np.cumsum(rng.standard_normal((32, 1_000 // s, 5)), axis=-2) / 30,
     }
+    wide = {
+        "(d) 64 x 256, d=8": (np.cumsum(rng.standard_normal((64, 256, 8)), axis=-2) / 16, (2, 3, 4),
+                              ("sig", "logsig", "sig vjp", "log vjp")),
+        "(e) 4 x 64, d=20": (np.cumsum(rng.standard_normal((4, 64, 20)), axis=-2) / 8, (2, 3),
+                             ("sig", "logsig", "sig vjp", "log vjp")),
+        "(f) 1 x 1000, d=3": (np.cumsum(rng.standard_normal((1, 1000, 3)), axis=-2) / 30, (4,),
+                              ("sig", "logsig", "sig vjp", "log vjp")),
+        "(f') 4 x 1000, d=3": (np.cumsum(rng.standard_normal((4, 1000, 3)), axis=-2) / 30, (4,),
+                               ("sig", "logsig")),
+        "(g) 1 x 10, d=4": (np.cumsum(rng.standard_normal((1, 10, 4)), axis=-2) / 3, (8,),
+                            ("sig", "logsig", "log vjp")),
+        "(h) 16 x 256, d=6": (np.cumsum(rng.standard_normal((16, 256, 6)), axis=-2) / 16, (4,),
+                              ("sig", "logsig", "sig vjp")),
+    }
     threads = numba.get_num_threads()
     print(f"numba threads {threads}, cpu count {os.cpu_count()}, load average {os.getloadavg()[0]:.1f}, "
-          f"median of {args.repeats} calls (3 for cells slower than 2 s); times in ms")
+          f"median of {args.repeats} interleaved pairs; times in ms\n")
+    peer_table(wide, args, rng)
+    if args.only_peer_table:
+        return
+    print("the cases of the earlier runs (all threads, wall time)")
     print("time ratio = ours / peer (below 1: ours faster)\n")
     head = (f"{'case':<22}{'lvl':>4}{'':>2}{'ours':>10}{'pysiglib':>10}{'iisig':>10}"
             f"{'ratio/pysiglib':>16}{'ratio/iisig':>13}{'max |ours-iisig|':>18}")

@@ -7,8 +7,8 @@
 # Nothing is installed when nothing changed: $VENV/.setup-stamp records a hash of pyproject.toml and
 # of the environment's Python version, and the extras installed; the install runs again only when
 # that hash differs or an extra is missing (so ./run.sh after ./test.sh does not reinstall).
-# After an install, the numba kernels are compiled once (a --tiny run of the main job and a few
-# library calls; numba caches them on disk), so the first real call starts at once.
+# After an install, the numba kernels are compiled once (a --tiny run of the main job and
+# tools/warm_kernels.py; numba caches them on disk), so the first real call starts at once.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV="${VENV:-.venv}"
@@ -70,21 +70,14 @@ else
 fi
 
 # Compile the numba kernels once (cached on disk by numba): the main job's, at tiny sizes, and the
-# signature and norm kernels; afterwards the first call of a user does not wait for the compiler.
-echo "Compiling the numba kernels once (about a minute) ..." >&2
+# signature kernels (tools/warm_kernels.py); afterwards the first call of a user does not wait for the compiler.
+echo "Compiling the numba kernels once (a few minutes) ..." >&2
 WARM="$(mktemp -d)"
 rc=0
 "$PY" -m mechanics --tiny --quiet --output "$WARM/run" >>"$LOG" 2>&1 || rc=$?
 [ "$rc" -le 1 ] || echo "warning: the warm-up run failed (exit $rc, see $LOG)" >&2   # 1: a tiny-size check failed
-"$PY" - >>"$LOG" 2>&1 <<'EOF' || echo "warning: compiling the signature kernels failed (see $LOG)" >&2
-import numpy as np
-import roughpaths as rp
-
-x = np.random.default_rng(0).standard_normal((2, 9, 3)).cumsum(axis=1)
-rp.signature(x, 3)
-rp.logsignature(x, 3)
-rp.p_variation(x[0], 2.5)
-EOF
+# every signature / log-signature / VJP kernel a public function can reach (gradients included)
+"$PY" tools/warm_kernels.py >>"$LOG" 2>&1 || echo "warning: compiling the signature kernels failed (see $LOG)" >&2
 rm -rf "$WARM"
 
 { inputs_hash; norm_extras "$EXTRAS"; } > "$STAMP"

@@ -34,12 +34,21 @@ def level_offsets(dim: int, depth: int) -> np.ndarray:
     return off
 
 
+def _run(fn, parts: list) -> None:
+    """:func:`roughpaths._threads.run`, but a single range runs here at once (a small batch's call
+    then costs no thread-pool query)."""
+    if len(parts) == 1:
+        fn(*parts[0])
+    else:
+        _threads.run(fn, parts)
+
+
 def log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
     off = level_offsets(dim, depth)
     out = np.empty_like(a)
-    _threads.run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
-                 _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
+    _run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
+         _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
     return out
 
 
@@ -50,8 +59,8 @@ def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     out = np.empty((z.shape[0], sum(p[0].shape[0] for p in projections)))
     start = 0
     for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
-        _threads.run(lambda lo, hi: _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, start, lo, hi),
-                     _threads.ranges(z.shape[0], float(lidx.shape[0] + indices.shape[0])))
+        _run(lambda lo, hi: _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, start, lo, hi),
+             _threads.ranges(z.shape[0], float(lidx.shape[0] + indices.shape[0])))
         start += lidx.shape[0]
     return out
 

@@ -29,6 +29,21 @@ _MIN_CHUNK_L2 = 8192
 _MAX_CHUNKS_L2 = 16
 
 
+#: Below 2 _MIN_CHUNK segments, a path with d <= 4 at depth <= 4 is cut into up to LANES chunks of at
+#: least this many segments, so that a lone path (or a few) fills a lane group instead of leaving
+#: lanes empty (a lone 1000 x 3 path at depth 4: 0.13 ms instead of 0.31). The price, the glue and
+#: the copy-out of 8x more units, is about 10% on large batches of such paths (measured on
+#: 200 x 1000 x 3); at d = 5 or depth 5 it grows, and those paths stay whole.
+_LANE_CHUNK = 100
+
+
+def _horner_chunks(n: int, d: int, depth: int) -> int:
+    """Work units per path for the depth >= 3 kernels: a function of ``n``, ``d`` and ``depth`` only."""
+    if n - 1 >= 2 * _MIN_CHUNK or d > 4 or depth > 4:
+        return _n_chunks(n, _MAX_CHUNKS, _MIN_CHUNK)
+    return max(1, min(_lanes.LANES, (n - 1) // _LANE_CHUNK))
+
+
 def _n_chunks(n: int, target: int, min_chunk: int) -> int:
     """Chunks per path: a function of the path length ``n`` only, so that a member's arithmetic does not
     depend on its neighbours."""
@@ -37,12 +52,35 @@ def _n_chunks(n: int, target: int, min_chunk: int) -> int:
     return max(1, min(target, (n - 1) // min_chunk))
 
 
+@lru_cache(maxsize=64)
 def _units(nb: int, n: int, nchunks: int) -> tuple:
     """``(path, first point, last point)`` of every work unit, path-major."""
     seg = -(-(n - 1) // nchunks)
     ub = np.repeat(np.arange(nb, dtype=np.int64), nchunks)
     lo = np.minimum(np.tile(np.arange(nchunks, dtype=np.int64), nb) * seg, n - 1)
     return ub, lo, np.minimum(lo + seg, n - 1)
+
+
+def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
+    """``a`` reshaped to ``shape``, float64, C-contiguous and writeable (copied only if needed).
+
+    numba compiles (and caches) a kernel once per argument type, and a read-only or strided array is
+    another type: every array a kernel receives goes through here, so the kernels compiled at install
+    time (``tools/warm_kernels.py``) are the ones every call finds.
+    """
+    return np.require(a.reshape(shape), dtype=np.float64, requirements=["C", "W"])
+
+
+@lru_cache(maxsize=512)
+def _sigdim(d: int, depth: int) -> int:
+    """:func:`roughpaths.sigdim`, cached (its argument checks cost more than a small signature)."""
+    return int(sigdim(d, depth))
+
+
+@lru_cache(maxsize=512)
+def _offsets(d: int, depth: int) -> np.ndarray:
+    """:func:`roughpaths.algebra.flat.level_offsets`, cached (shared: never written to)."""
+    return level_offsets(d, depth)
 
 
 def _check_depth(depth) -> int:
@@ -60,7 +98,7 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     layout permutation); the log-signature 2 more (log, scratch) plus the sparse Lyndon map, whose
     top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built).
     """
-    dim = sigdim(d, depth)
+    dim = _sigdim(d, depth)
     need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
     if log and depth > 1 and d > 1:
         need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
@@ -101,38 +139,71 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
     return out
 
 
+#: From this width on every unit runs alone (:func:`_lanes.scalar_units`, the same bits as the lanes):
+#: ``LANES`` signatures of d >= 6 at depth >= 4 no longer fit in the L2 cache, and the one-unit loops
+#: over the first letters are long enough to vectorise on their own.
+_WIDE = 6
+#: A lane group with at most this many units runs them one at a time instead (the empty lanes of a
+#: group cost as much as full ones; one unit alone costs about a quarter of a group, measured at d = 3).
+_FEW = 2
+
+
+def _split_units(nunits: int, d: int) -> tuple:
+    """``(lane groups, first unit run alone)``: units ``0 .. LANES * groups - 1`` run on lanes, the rest alone.
+
+    Either kernel gives the same bits, so the split may depend on the batch."""
+    if d >= _WIDE:
+        return 0, 0
+    groups, rest = divmod(nunits, _lanes.LANES)
+    if rest > _FEW:
+        groups += 1
+    return groups, min(nunits, groups * _lanes.LANES)
+
+
 def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     """Signature (reversed layout) of every work unit of a ``(B, n, d)`` batch, shape ``(units, sigdim)``."""
     nb, n, d = x.shape
     units = _units(nb, n, nchunks)
-    off = level_offsets(d, depth)
-    dim = sigdim(d, depth)
+    off = _offsets(d, depth)
+    dim = _sigdim(d, depth)
     nunits = nb * nchunks
     part = np.empty((nunits, dim))
     per_unit = (n / nchunks) * 1.5 * d ** depth
-    ngroups = -(-nunits // _lanes.LANES)
-    _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
-                 _threads.ranges(ngroups, per_unit * _lanes.LANES))
+    ngroups, first_alone = _split_units(nunits, d)
+    if ngroups:
+        _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
+                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
+    if first_alone < nunits:
+        _threads.run(lambda lo, hi: _lanes.scalar_units(x, *units, depth, off, first_alone + lo,
+                                                        first_alone + hi, part),
+                     _threads.ranges(nunits - first_alone, per_unit))
     return part
+
+
+def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
+    """Level-2 signatures ``(B, d + d*d)`` of a validated ``(B, n >= 2, d)`` batch, or with ``log`` the
+    level-2 log-signatures in the Lyndon basis ``(B, d + d(d-1)/2)`` (increment, Lévy areas)."""
+    nb, n, d = x.shape
+    nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
+    part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
+    _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, lo, hi, part),
+                 _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
+    return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
 def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     """Signatures of a validated ``(B, n, d)`` C-contiguous batch, shape ``(B, sigdim)``."""
     nb, n, d = x.shape
     if nb == 0 or n == 1:
-        return np.zeros((nb, sigdim(d, depth)))
+        return np.zeros((nb, _sigdim(d, depth)))
     if depth == 1:
         return x[:, -1, :] - x[:, 0, :]
     if depth == 2:
-        nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
-        part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
-        _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, lo, hi, part),
-                     _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
-        return _l2.sig2_glue(part, nb, nchunks, d)
-    nchunks = _n_chunks(n, _MAX_CHUNKS, _MIN_CHUNK)
+        return _level2_flat(x, log=False)
+    nchunks = _horner_chunks(n, d, depth)
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
-        out = _lanes.lane_glue(out, nb, nchunks, depth, level_offsets(d, depth))
+        out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
     return out[:, _reversed_to_rowmajor(d, depth)]
 
 

@@ -128,24 +128,31 @@ def _area_chunk_d5(x, b, lo, hi, out):
 
 @njit(cache=True)
 def _area_chunk_generic(x, b, lo, hi, out):
+    # the full d x d table (the same expression per pair i < j as the d = 2..5 kernels): the loop
+    # over j runs over contiguous rows with unsigned indices, so it vectorises for any d
     d = x.shape[2]
+    ud = np.uint64(d)
     prev = np.zeros(d)
     cur = np.empty(d)
-    acc = np.zeros(d * (d - 1) // 2)
+    acc = np.zeros(d * d)
     for k in range(lo + 1, hi + 1):
         for i in range(d):
             cur[i] = x[b, k, i] - x[b, lo, i]
-        q = 0
-        for i in range(d):
-            for j in range(i + 1, d):
-                acc[q] += prev[i] * cur[j] - prev[j] * cur[i]
-                q += 1
+        for i in range(ud):
+            pi = prev[i]
+            ci = cur[i]
+            row = i * ud
+            for j in range(ud):
+                acc[row + j] += pi * cur[j] - prev[j] * ci
         for i in range(d):
             prev[i] = cur[i]
     for i in range(d):
         out[i] = prev[i]
-    for q in range(acc.shape[0]):
-        out[d + q] = acc[q]
+    q = d
+    for i in range(d):
+        for j in range(i + 1, d):
+            out[q] = acc[i * d + j]
+            q += 1
 
 
 @njit(cache=True)
@@ -180,6 +187,22 @@ def sig2_tasks(x, nchunks, lo, hi, part):
             _area_chunk(x, b, a, e, part[t])
 
 
+@njit(cache=True)
+def _glue_total(part, b, nchunks, d, tot):
+    """``tot <- (increment, twice the Lévy area over i<j)`` of path ``b``, chunks glued by Chen in order."""
+    for r in range(tot.shape[0]):
+        tot[r] = 0.0
+    for c in range(nchunks):
+        p = part[b * nchunks + c]
+        q = 0
+        for i in range(d):
+            for j in range(i + 1, d):
+                tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
+                q += 1
+        for i in range(d):
+            tot[i] += p[i]
+
+
 @njit(**_NOGIL)
 def sig2_glue(part, nb, nchunks, d):
     """Level-2 signatures ``(B, d + d*d)`` from the chunk data, glued by Chen: ``2A = 2A_1 + 2A_2 + X_1 ∧ X_2``."""
@@ -187,17 +210,7 @@ def sig2_glue(part, nb, nchunks, d):
     out = np.empty((nb, d + d * d))
     tot = np.empty(width)
     for b in range(nb):
-        for r in range(width):
-            tot[r] = 0.0
-        for c in range(nchunks):
-            p = part[b * nchunks + c]
-            q = 0
-            for i in range(d):
-                for j in range(i + 1, d):
-                    tot[d + q] += p[d + q] + tot[i] * p[j] - tot[j] * p[i]
-                    q += 1
-            for i in range(d):
-                tot[i] += p[i]
+        _glue_total(part, b, nchunks, d, tot)
         for i in range(d):
             out[b, i] = tot[i]
         q = 0
@@ -209,3 +222,65 @@ def sig2_glue(part, nb, nchunks, d):
                 out[b, d + j * d + i] = sym - 0.5 * tot[d + q]
                 q += 1
     return out
+
+
+@njit(**_NOGIL)
+def logsig2_glue(part, nb, nchunks, d):
+    """Level-2 log-signatures in the Lyndon basis ``(B, d + d(d-1)/2)``: the increment, then the Lévy
+    areas ``[i, j]`` (``i < j``, lexicographic), from the chunk data (glued as :func:`sig2_glue`)."""
+    width = part.shape[1]
+    out = np.empty((nb, width))
+    tot = np.empty(width)
+    for b in range(nb):
+        _glue_total(part, b, nchunks, d, tot)
+        for i in range(d):
+            out[b, i] = tot[i]
+        for r in range(d, width):
+            out[b, r] = 0.5 * tot[r]
+    return out
+
+
+@njit(**_NOGIL)
+def sig2_vjp_rows(x, g, lo, hi, gx):
+    """Cotangent ``gx`` (B, n, d) of the points of paths ``lo..hi-1`` given ``g`` (B, d + d*d), the
+    row-major cotangent of their level-2 signatures (``n >= 2``).
+
+    With ``c_k`` the cotangent of the increment ``Δ_k``: ``c_k = G_1 + G_2 X + A (Y_{k-1} + Y_k) / 2``,
+    ``X`` the total increment, ``Y_k`` the point ``k`` minus the first, ``A = G_2^T - G_2``. So an
+    interior point gets ``c_k - c_{k+1} = -A (x_{k+1} - x_{k-1}) / 2``: ``d^2`` operations a point.
+    """
+    n = x.shape[1]
+    d = x.shape[2]
+    at = np.empty((d, d))                                   # at[j, a] = A[a, j]
+    c = np.empty(d)
+    w0 = np.empty(d)
+    w1 = np.empty(d)
+    for b in range(lo, hi):
+        for j in range(d):
+            for a in range(d):
+                at[j, a] = g[b, d + j * d + a] - g[b, d + a * d + j]
+        for a in range(d):
+            acc = g[b, a]
+            for j in range(d):
+                acc += g[b, d + a * d + j] * (x[b, n - 1, j] - x[b, 0, j])
+            c[a] = acc
+        row = gx[b]
+        for k in range(n):
+            for a in range(d):
+                row[k, a] = 0.0
+        for k in range(1, n - 1):
+            for j in range(d):
+                w = -0.5 * (x[b, k + 1, j] - x[b, k - 1, j])
+                for a in range(d):
+                    row[k, a] += at[j, a] * w
+        for j in range(d):
+            w0[j] = 0.5 * (x[b, 1, j] - x[b, 0, j])
+            w1[j] = (x[b, n - 1, j] - x[b, 0, j]) - 0.5 * (x[b, n - 1, j] - x[b, n - 2, j])
+        for a in range(d):
+            s0 = c[a]
+            s1 = c[a]
+            for j in range(d):
+                s0 += at[j, a] * w0[j]
+                s1 += at[j, a] * w1[j]
+            row[0, a] = -s0
+            row[n - 1, a] = s1

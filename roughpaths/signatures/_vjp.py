@@ -19,11 +19,32 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._lanes import BLOCK, _horner_step, _lane_step_d, mul_inplace
+from ._lanes import BLOCK, _addto, _axpy, _horner_step, _lane_step_d, mul_inplace
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 from ._kernels import _exp_lie2
 
 _NOGIL = dict(cache=True, nogil=True)
+
+
+@njit(cache=True, inline="always")
+def _tb_row(tb, to, x, xo, n, e, s, so):
+    """``tb[to:to+n] = x[xo:xo+n] * e + s[so:so+n]`` (unsigned indices: vectorised)."""
+    u = np.uint64(to)
+    v = np.uint64(xo)
+    w = np.uint64(so)
+    for p in range(np.uint64(n)):
+        tb[u + p] = x[v + p] * e + s[w + p]
+
+
+@njit(cache=True, inline="always")
+def _dot(a, ao, b, bo, n):
+    """``sum_p a[ao+p] b[bo+p]``, summed in order of ``p`` (as every lane of the lane kernel)."""
+    u = np.uint64(ao)
+    v = np.uint64(bo)
+    acc = 0.0
+    for p in range(np.uint64(n)):
+        acc += a[u + p] * b[v + p]
+    return acc
 
 
 @njit(cache=True)
@@ -39,11 +60,7 @@ def _lcon(x0, s, g, d, m, offsets, out):
             oi = offsets[i]
             ok = offsets[i + j]
             for w in range(nj):
-                base = ok + ni * w
-                acc = 0.0
-                for u in range(ni):
-                    acc += s[oi + u] * g[base + u]
-                out[oj + w] += acc
+                out[oj + w] += _dot(s, oi, g, ok + ni * w, ni)
 
 
 @njit(cache=True)
@@ -58,22 +75,11 @@ def _rcon(x0, g, e, d, m, offsets, out):
             oj = offsets[j]
             ok = offsets[i + j]
             for q in range(d ** j):
-                eq = e[oj + q]
-                base = ok + ni * q
-                for p in range(ni):
-                    out[oi + p] += g[base + p] * eq
+                _axpy(out, oi, g, ok + ni * q, ni, e[oj + q])
 
 
-@njit(cache=True)
-def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
-    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
-
-    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
-    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
-    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
-    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
-    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``.
-    """
+@njit(cache=True, inline="always")
+def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
     dim = offsets[m + 1]
     for r in range(dim):
         gprev[r] = g[r]
@@ -90,10 +96,8 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
             oj = offsets[j]
             on = offsets[j + 1]
             for q in range(d):
-                e = delta[q] * f
                 base = on + size * q
-                for p in range(size):
-                    tb[base + p] = tb[oj + p] * e + s[base + p]
+                _tb_row(tb, base, tb, oj, size, delta[q] * f, s, base)
             size *= d
         # backward: gB_k = G_k
         ok = offsets[k]
@@ -107,25 +111,40 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
             for p in range(nj):
                 gb[p] = 0.0
             for q in range(d):
-                e = delta[q] * f
                 base = nj * q
-                acc = 0.0
-                for p in range(nj):
-                    gb[p] += ga[base + p] * e
-                    acc += ga[base + p] * tb[oj + p]
-                gdelta[q] += acc * f
+                _axpy(gb, 0, ga, base, nj, delta[q] * f)
+                gdelta[q] += _dot(ga, base, tb, oj, nj) * f
+            _addto(gprev, oj, gb, 0, nj)
             for p in range(nj):
-                gprev[oj + p] += gb[p]
                 ga[p] = gb[p]
         for q in range(d):
             gdelta[q] += ga[q] * inv
 
 
 @njit(cache=True)
+def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
+
+    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
+    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
+    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
+    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
+    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``. The same
+    operations, in the same order, as every lane of :func:`_lane_step_vjp_d`.
+    """
+    if d == 2:
+        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta)
+    elif d == 3:
+        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta)
+    else:
+        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta)
+
+
+@njit(cache=True)
 def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
     """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
     dim = offsets[m + 1]
-    buf = np.empty(2 * d ** m)
+    buf = np.empty(2 * d ** max(m - 1, 1) + d)
     tb = np.empty(dim)
     ga = np.empty(d ** m)
     gb = np.empty(d ** m)
@@ -174,10 +193,7 @@ def _mul_rev(x0, xs, a, d, m, offsets, out):
             oj = offsets[k - i]
             ni = d ** i
             for q in range(d ** (k - i)):
-                aq = a[oj + q]
-                base = ok + ni * q
-                for p in range(ni):
-                    out[base + p] += xs[oi + p] * aq
+                _axpy(out, ok + ni * q, xs, oi, ni, a[oj + q])
 
 
 @njit(cache=True)

@@ -12,13 +12,14 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _threads
-from ..algebra.flat import level_offsets, lyndon_flat_vjp
+from ..algebra.flat import lyndon_flat_vjp
 from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
+from . import _level2 as _l2
 from . import _vjp
-from ._engine import (_MAX_CHUNKS, _MIN_CHUNK, _check_depth, _check_fits, _check_paths, _n_chunks,
-                      _reversed_parts, _reversed_to_rowmajor, _signature_flat, _units)
+from ._engine import (_check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array, _offsets,
+                      _reversed_parts, _reversed_to_rowmajor, _sigdim, _signature_flat, _split_units, _units)
 from .signature import rough_path_signature
 
 __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]
@@ -29,7 +30,7 @@ def _check_grad(grad_output, batch: tuple, width: int, what: str) -> np.ndarray:
     if g.shape != batch + (width,):
         raise ValueError(f"grad_output has shape {g.shape}, expected {batch + (width,)}: the shape of "
                          f"{what}(paths, depth) (batch axes of paths, then {width}).")
-    return np.ascontiguousarray(g.reshape((-1, width)))
+    return _kernel_array(g, (-1, width))
 
 
 def _increments_to_points(gd: np.ndarray, n: int) -> np.ndarray:
@@ -50,17 +51,29 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
         gx[:, -1] += g_row
         gx[:, 0] -= g_row
         return gx
-    off = level_offsets(d, depth)
+    if depth == 2:                                # closed form, d^2 operations a point
+        gx = np.empty(x.shape)
+        g2 = _kernel_array(g_row, g_row.shape)
+        _threads.run(lambda lo, hi: _l2.sig2_vjp_rows(x, g2, lo, hi, gx), _threads.ranges(nb, n * d * d))
+        return gx
+    off = _offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
     g_rev = np.empty_like(g_row)
     g_rev[:, perm] = g_row
-    nchunks = _n_chunks(n, _MAX_CHUNKS, _MIN_CHUNK)
+    nchunks = _horner_chunks(n, d, depth)
     units = _units(nb, n, nchunks)
     part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
-    ngroups = -(-(nb * nchunks) // _lanes.LANES)
-    _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
-                 _threads.ranges(ngroups, (n / nchunks) * 5 * d ** depth * _lanes.LANES))
+    nunits = nb * nchunks
+    per_unit = (n / nchunks) * 5 * d ** depth
+    ngroups, first_alone = _split_units(nunits, d)         # the same bits either way
+    if ngroups:
+        _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
+    if first_alone < nunits:
+        _threads.run(lambda lo, hi: _vjp.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev,
+                                                       first_alone + lo, first_alone + hi, gd),
+                     _threads.ranges(nunits - first_alone, per_unit))
     return _increments_to_points(gd, n)
 
 
@@ -89,7 +102,8 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     segment is recovered as :math:`S \otimes \exp(-\Delta)` (nothing of the forward pass is
     stored), the increment's cotangent is the derivative of :math:`\langle S_{prev} \rhd G,
     \exp(\Delta)\rangle`, and :math:`G \leftarrow G \lhd \exp(\Delta)`. Memory is a few
-    signatures per path. Long paths are cut into the same chunks as :func:`signature`.
+    signatures per path. Long paths are cut into the same chunks as :func:`signature`. At depth 2
+    the cotangent has a closed form, ``d^2`` operations a point (``roughpaths.signatures._level2``).
 
     Examples
     --------
@@ -104,8 +118,8 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     depth = _check_depth(depth)
     x = _check_paths(paths)
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
-    g = _check_grad(grad_output, batch, sigdim(d, depth), "signature")
-    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    g = _check_grad(grad_output, batch, _sigdim(d, depth), "signature")
+    flat = _kernel_array(x, (-1, n, d))
     _check_fits(flat.shape[0], d, depth, log=True)
     return _signature_vjp_flat(flat, depth, g).reshape(x.shape)
 
@@ -145,13 +159,13 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     x = _check_paths(paths)
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     g = _check_grad(grad_output, batch, logsigdim(d, depth), "logsignature")
-    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    flat = _kernel_array(x, (-1, n, d))
     if depth == 1 or d == 1:
-        g_sig = np.zeros((flat.shape[0], sigdim(d, depth)))
+        g_sig = np.zeros((flat.shape[0], _sigdim(d, depth)))
         g_sig[:, :d] = g
         return _signature_vjp_flat(flat, depth, g_sig).reshape(x.shape)
     _check_fits(flat.shape[0], d, depth, log=True)
-    off = level_offsets(d, depth)
+    off = _offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
     sig = _signature_flat(flat, depth)
     g_log_row = lyndon_flat_vjp(g, d, depth)
@@ -207,18 +221,18 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     depth = _check_depth(depth)
     sig = rough_path_signature(X, depth)                  # validates level and kind
     d, n, batch = X.dim, X.n_steps, X.batch_shape
-    g = _check_grad(grad_output, batch, sigdim(d, depth), "rough_path_signature")
+    g = _check_grad(grad_output, batch, _sigdim(d, depth), "rough_path_signature")
     perm = _reversed_to_rowmajor(d, depth)
     s_rev = np.empty((g.shape[0], sig.shape[-1]))
     s_rev[:, perm] = sig.reshape((-1, sig.shape[-1]))
     g_rev = np.empty_like(g)
     g_rev[:, perm] = g
-    inc = np.ascontiguousarray(X.increments.reshape((-1, n, d)))
-    lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
+    inc = _kernel_array(X.increments, (-1, n, d))
+    lev = _kernel_array(X.step_levy_areas, (-1, n, d, d))
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
-    off = level_offsets(d, depth)
+    off = _offsets(d, depth)
     _threads.run(lambda lo, hi: _vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
-                 _threads.ranges(inc.shape[0], 4 * n * depth * depth * sigdim(d, depth)))
+                 _threads.ranges(inc.shape[0], 4 * n * depth * depth * _sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
     return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))

@@ -29,11 +29,11 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _threads
-from ..algebra.flat import level_offsets, log_flat, lyndon_flat
+from ..algebra.flat import log_flat, lyndon_flat
 from ..algebra.tensor import logsigdim, sigdim
 from . import _kernels as _k
-from ._engine import (_check_depth, _check_fits, _check_paths, _finite_or_raise, _reversed_to_rowmajor,
-                      _signature_flat)
+from ._engine import (_check_depth, _check_fits, _check_paths, _finite_or_raise, _kernel_array, _level2_flat,
+                      _offsets, _reversed_to_rowmajor, _sigdim, _signature_flat)
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
@@ -63,9 +63,9 @@ def signature(paths, depth: int) -> np.ndarray:
     depth = _check_depth(depth)
     x = _check_paths(paths, finite=depth == 1)     # depth >= 2: checked through the output
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
-    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    flat = _kernel_array(x, (-1, n, d))
     _check_fits(flat.shape[0], d, depth)
-    return _finite_or_raise(_signature_flat(flat, depth), x).reshape(batch + (sigdim(d, depth),))
+    return _finite_or_raise(_signature_flat(flat, depth), x).reshape(batch + (_sigdim(d, depth),))
 
 
 def logsignature(paths, depth: int) -> np.ndarray:
@@ -99,15 +99,15 @@ def logsignature(paths, depth: int) -> np.ndarray:
         # d = 1: the free Lie algebra is R (a path's log-signature is its increment).
         return signature(x, 1)[..., :logsigdim(d, depth)]
     batch, n = x.shape[:-2], x.shape[-2]
-    flat = np.ascontiguousarray(x.reshape((-1, n, d)))
+    flat = _kernel_array(x, (-1, n, d))
     _check_fits(flat.shape[0], d, depth, log=True)
-    sig = np.ascontiguousarray(_finite_or_raise(_signature_flat(flat, depth), x))
     if depth == 2:
-        # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas
-        iu, ju = np.triu_indices(d, k=1)
-        a = sig[:, d:].reshape(-1, d, d)
-        levy = 0.5 * (a[:, iu, ju] - a[:, ju, iu])
-        return np.concatenate([sig[:, :d], levy], axis=-1).reshape(batch + (-1,))
+        # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas,
+        # which the level-2 kernel accumulates directly
+        if flat.shape[0] == 0 or n == 1:
+            return np.zeros(batch + (logsigdim(d, 2),))
+        return _finite_or_raise(_level2_flat(flat, log=True), x).reshape(batch + (-1,))
+    sig = np.ascontiguousarray(_finite_or_raise(_signature_flat(flat, depth), x))
     return lyndon_flat(log_flat(sig, d, depth), d, depth).reshape(batch + (-1,))
 
 
@@ -163,13 +163,13 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
                          f"(Sym(XX) = ½ X⊗X). Convert an Itô lift to Stratonovich first "
                          f"(XX + ½(t - s) I), or build X with kind='geometric'.")
     d, n, batch = X.dim, X.n_steps, X.batch_shape
-    inc = np.ascontiguousarray(X.increments.reshape((-1, n, d)))
-    lev = np.ascontiguousarray(X.step_levy_areas.reshape((-1, n, d, d)))
-    out = np.empty((inc.shape[0], sigdim(d, depth)))
-    off = level_offsets(d, depth)
+    inc = _kernel_array(X.increments, (-1, n, d))
+    lev = _kernel_array(X.step_levy_areas, (-1, n, d, d))
+    out = np.empty((inc.shape[0], _sigdim(d, depth)))
+    off = _offsets(d, depth)
     _threads.run(lambda lo, hi: _k.rough_sig_rows(inc, lev, depth, off, lo, hi, out),
-                 _threads.ranges(inc.shape[0], n * depth * sigdim(d, depth)))
-    return out[:, _reversed_to_rowmajor(d, depth)].reshape(batch + (sigdim(d, depth),))
+                 _threads.ranges(inc.shape[0], n * depth * _sigdim(d, depth)))
+    return out[:, _reversed_to_rowmajor(d, depth)].reshape(batch + (_sigdim(d, depth),))
 
 
 # the gradients live in their own module; imported last (it builds on the helpers above)

@@ -1,0 +1,63 @@
+"""Compile (and cache on disk) every numba kernel the public signature functions can reach.
+
+Run once after an install (``tools/setup_env.sh`` does): numba compiles a kernel the first time it
+meets a type signature and caches it, so a user's first call would otherwise wait 10-30 s for the
+compiler. The calls below go through the public functions only, at the argument types user calls
+produce: every path array reaches the kernels as a C-contiguous, writeable float64 array of rank 3
+(leading batch axes are flattened; read-only or strided inputs are copied first, see
+``roughpaths.signatures._engine._kernel_array``), depths as Python ints. They cover each kernel
+family: the level-2 kernel (short and chunked paths, d <= 5 and wider), the lane kernel (full lane
+groups), the one-unit kernel (a lone path, and every d >= 6), long paths cut into chunks and glued,
+the log-signature (truncated log, Lyndon projection), the three vector-Jacobian products, and the
+tensor-algebra functions they build on.
+
+Usage: ``python tools/warm_kernels.py`` (prints the time it took).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+
+def warm() -> None:
+    import roughpaths as rp
+
+    rng = np.random.default_rng(0)
+
+    def path(*shape):
+        return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
+
+    lone, wide, batch = path(9, 3), path(2, 7, 6), path(10, 9, 3)
+    long_path = path(2 * 1024 + 8, 2)                     # cut into chunks (Chen glue)
+    long_l2 = path(2 * 8192 + 8, 3)                       # level 2, chunked
+    for x in (lone, wide, batch, long_path, lone.tolist(), lone[None, None]):
+        for m in (1, 2, 3):
+            rp.signature(x, m)
+            rp.logsignature(x, m)
+    rp.signature(long_l2, 2)
+    rp.signature(batch, np.int64(4))
+    for x in (lone, wide, batch, long_path):
+        for m in (2, 3):
+            rp.signature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.sigdim(np.shape(x)[-1], m),)))
+            rp.logsignature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.logsigdim(np.shape(x)[-1], m),)))
+    X = rp.RoughPath.from_path(batch)
+    for m in (2, 3):
+        s = rp.rough_path_signature(X, m)
+        rp.rough_path_signature_vjp(X, m, np.ones_like(s))
+    s = rp.signature(lone, 3)                             # lone has d = 3
+    z = rp.tensor_log(s, dim=3)
+    rp.tensor_exp(z, dim=3)
+    rp.lyndon_coordinates(z, dim=3)
+    rp.p_variation(lone, 2.5)
+
+
+def main() -> None:
+    t0 = time.perf_counter()
+    warm()
+    print(f"signature kernels compiled and cached in {time.perf_counter() - t0:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
