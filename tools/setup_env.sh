@@ -70,14 +70,15 @@ else
 fi
 
 # Compile the numba kernels once (cached on disk by numba): the main job's, at tiny sizes, and the
-# signature kernels (tools/warm_kernels.py); afterwards the first call of a user does not wait for the compiler.
+# library's other kernels (tools/warm_kernels.py: signatures and their gradients, signature kernels, the
+# Brownian tree, the coadjoint kernels); afterwards the first call of a user does not wait for the compiler.
 echo "Compiling the numba kernels once (a few minutes) ..." >&2
 WARM="$(mktemp -d)"
 rc=0
 "$PY" -m mechanics --tiny --quiet --output "$WARM/run" >>"$LOG" 2>&1 || rc=$?
 [ "$rc" -le 1 ] || echo "warning: the warm-up run failed (exit $rc, see $LOG)" >&2   # 1: a tiny-size check failed
-# every signature / log-signature / VJP kernel a public function can reach (gradients included)
-"$PY" tools/warm_kernels.py >>"$LOG" 2>&1 || echo "warning: compiling the signature kernels failed (see $LOG)" >&2
+# every other kernel a public function can reach (signatures with gradients, signature kernels, tree, coadjoint)
+"$PY" tools/warm_kernels.py >>"$LOG" 2>&1 || echo "warning: compiling the kernels failed (see $LOG)" >&2
 rm -rf "$WARM"
 
 { inputs_hash; norm_extras "$EXTRAS"; } > "$STAMP"

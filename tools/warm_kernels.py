@@ -1,4 +1,4 @@
-"""Compile (and cache on disk) every numba kernel the public signature functions can reach.
+"""Compile (and cache on disk) every numba kernel the public functions can reach beyond the main job's.
 
 Run once after an install (``tools/setup_env.sh`` does): numba compiles a kernel the first time it
 meets a type signature and caches it, so a user's first call would otherwise wait 10-30 s for the
@@ -9,7 +9,10 @@ produce: every path array reaches the kernels as a C-contiguous, writeable float
 family: the level-2 kernel (short and chunked paths, d <= 5 and wider), the lane kernel (full lane
 groups), the one-unit kernel (a lone path, and every d >= 6), long paths cut into chunks and glued,
 the log-signature (truncated log, Lyndon projection), the three vector-Jacobian products, and the
-tensor-algebra functions they build on.
+tensor-algebra functions they build on; then the signature kernels (Goursat PDE, its adjoint, the
+MMD statistics), the Brownian tree's split kernels (d = 2 and 3), and the generic coadjoint kernel of
+:mod:`mechanics` (one compiled signature serves every algebra and all three coadjoint schemes; the
+so(3)/se(3) kernels are warmed too, with and without areas).
 
 Usage: ``python tools/warm_kernels.py`` (prints the time it took).
 """
@@ -53,10 +56,45 @@ def warm() -> None:
     rp.p_variation(lone, 2.5)
 
 
+def warm_signature_kernels() -> None:
+    import roughpaths as rp
+
+    x = np.zeros((2, 3, 2))
+    rp.signature_kernel(x, x)
+    rp.signature_kernel_vjp(x, x, np.ones(2))
+    rp.signature_kernel_gram(x, x, static_kernel=rp.RBFKernel(1.0))
+    rp.signature_kernel_gram_vjp(x, x, np.ones((2, 2)))
+    rp.sig_mmd_test(x, x, seed=0, n_permutations=1)
+
+
+def warm_tree() -> None:
+    import roughpaths as rp
+
+    for d in (2, 3):
+        rp.BrownianTree(d, seed=0).area(0.1, 0.3)
+
+
+def warm_coadjoint() -> None:
+    from mechanics import ImplicitMidpoint, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body
+    from mechanics.systems.lie_algebra import su2
+    from roughpaths import BrownianDriver, solve
+
+    generic = LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1)
+    systems = (generic, rigid_body([1.0, 2.0, 3.0], sigma=0.1),
+               heavy_top([1.0, 2.0, 3.0], chi=[0.0, 0.0, 1.0], sigma=0.1))
+    for system in systems:
+        for levy_area in ("davie", None):
+            X = BrownianDriver(system.n_noise, seed=0, dt=0.01, n_steps=2, batch_shape=(2,), levy_area=levy_area)
+            for method in (LieEuler(), LieHeun(), ImplicitMidpoint()):
+                solve(system, X, np.ones((2, system.dim)), method)
+
+
 def main() -> None:
-    t0 = time.perf_counter()
-    warm()
-    print(f"signature kernels compiled and cached in {time.perf_counter() - t0:.1f} s")
+    for what, fn in (("signatures", warm), ("signature kernels", warm_signature_kernels),
+                     ("Brownian tree", warm_tree), ("coadjoint kernels", warm_coadjoint)):
+        t0 = time.perf_counter()
+        fn()
+        print(f"{what}: compiled and cached in {time.perf_counter() - t0:.1f} s")
 
 
 if __name__ == "__main__":
