@@ -43,6 +43,7 @@ import jax
 import jax.numpy as jnp
 
 import roughpaths as _rp
+from roughpaths._frontends import batch_broadcast, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable"]
 
@@ -56,23 +57,6 @@ def _as_jax(x, name: str):
         raise TypeError(f"{name} has dtype {x.dtype}; roughpaths.jax takes float32 or float64 arrays: pass "
                         f"{name}.astype(jnp.float32) (or float64 with jax_enable_x64).")
     return x
-
-
-def _batch_broadcast(arrays: list, core: tuple) -> list:
-    """Broadcast the leading (batch) axes of several inputs; ``core[i]`` trailing axes of input ``i`` are kept."""
-    if len(arrays) == 1:
-        return arrays
-    batch = np.broadcast_shapes(*(a.shape[:a.ndim - c] for a, c in zip(arrays, core)))
-    return [np.broadcast_to(a, batch + a.shape[a.ndim - c:]) for a, c in zip(arrays, core)]
-
-
-def _sum_to(g: np.ndarray, shape: tuple) -> np.ndarray:
-    """Sum a cotangent over the axes that broadcasting added or stretched, back to ``shape``."""
-    if g.shape == shape:
-        return g
-    g = g.sum(axis=tuple(range(g.ndim - len(shape))))
-    axes = tuple(k for k, (a, b) in enumerate(zip(shape, g.shape)) if a == 1 and b != 1)
-    return g.sum(axis=axes, keepdims=True) if axes else g
 
 
 def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
@@ -108,16 +92,16 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
 
     def build(params: dict, dtype):
         def forward_cb(*arrs):
-            arrays = _batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
+            arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             return np.asarray(forward(*arrays, **params), dtype=dtype)
 
         def backward_cb(*arrs):
             *arrs, g = arrs
             shapes = [a.shape for a in arrs]        # as received: with vmap's axes in front
-            arrays = _batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
+            arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             grads = vjp(*arrays, np.asarray(g, dtype=np.float64), **params)
             grads = (grads,) if len(arrs) == 1 else tuple(grads)
-            return tuple(np.asarray(_sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
+            return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
 
         @jax.custom_vjp
         def f(*args):

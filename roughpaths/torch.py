@@ -53,6 +53,7 @@ import torch
 from torch.autograd.function import once_differentiable
 
 import roughpaths as _rp
+from roughpaths._frontends import batch_broadcast, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable"]
 
@@ -74,23 +75,6 @@ def _as_numpy(t, name: str) -> np.ndarray:
         raise TypeError(f"{name} has dtype {t.dtype}; roughpaths.torch takes float32 or float64 tensors: pass "
                         f"{name}.double() (or {name}.float()).")
     return t.detach().numpy().astype(np.float64, copy=False)
-
-
-def _batch_broadcast(arrays: list, core: tuple) -> list:
-    """Broadcast the leading (batch) axes of several inputs; ``core[i]`` trailing axes of input ``i`` are kept."""
-    if len(arrays) == 1:
-        return arrays
-    batch = np.broadcast_shapes(*(a.shape[:a.ndim - c] for a, c in zip(arrays, core)))
-    return [np.broadcast_to(a, batch + a.shape[a.ndim - c:]) for a, c in zip(arrays, core)]
-
-
-def _sum_to(g: np.ndarray, shape: tuple) -> np.ndarray:
-    """Sum a cotangent over the axes that broadcasting added or stretched, back to ``shape``."""
-    if g.shape == shape:
-        return g
-    g = g.sum(axis=tuple(range(g.ndim - len(shape))))
-    axes = tuple(k for k, (a, b) in enumerate(zip(shape, g.shape)) if a == 1 and b != 1)
-    return g.sum(axis=axes, keepdims=True) if axes else g
 
 
 def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
@@ -129,7 +113,7 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
 
     def _forward(ctx, params, *tensors):
         # checked by apply() below: CPU tensors of one float dtype
-        arrays = _batch_broadcast([t.detach().numpy().astype(np.float64, copy=False) for t in tensors], core)
+        arrays = batch_broadcast([t.detach().numpy().astype(np.float64, copy=False) for t in tensors], core)
         out = np.asarray(forward(*arrays, **params), dtype=np.float64)
         ctx.params = params
         ctx.save_for_backward(*tensors)
@@ -138,12 +122,12 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     @once_differentiable
     def _backward(ctx, grad):
         tensors = ctx.saved_tensors
-        arrays = _batch_broadcast([t.detach().numpy().astype(np.float64, copy=False) for t in tensors], core)
+        arrays = batch_broadcast([t.detach().numpy().astype(np.float64, copy=False) for t in tensors], core)
         g = grad.detach().cpu().numpy().astype(np.float64, copy=False)
         grads = vjp(*arrays, np.broadcast_to(g, g.shape), **ctx.params)
         grads = (grads,) if len(tensors) == 1 else tuple(grads)
         return (None,) + tuple(
-            torch.from_numpy(np.ascontiguousarray(_sum_to(np.asarray(gr), tuple(t.shape)))).to(t.dtype)
+            torch.from_numpy(np.ascontiguousarray(sum_to(np.asarray(gr), tuple(t.shape)))).to(t.dtype)
             if need else None for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
 
     fn = type(label, (torch.autograd.Function,),
