@@ -335,7 +335,7 @@ def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure)
     return y, out, first_bad, reason
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
     """Stochastic velocities out (B, K, 3) = Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], A = ½(XX - XXᵀ).
 
@@ -389,5 +389,8 @@ def stochastic_velocities(system, dX, dXX, batch):
     pi, pj = _pairs(nm)
     brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
     out = np.empty((nb, nk, 3))
-    _eta_from_increments(dX, dXX, np.ascontiguousarray(system.xi), brk, pi, pj, out)
+    xi = np.ascontiguousarray(system.xi)
+    area = dXX.shape[0] > 0
+    run_blocks(lambda lo, hi: _eta_from_increments(dX[lo:hi], dXX[lo:hi] if area else dXX, xi, brk, pi, pj,
+                                                   out[lo:hi]), nb, BLOCK)    # per member: any split, same numbers
     return out
