@@ -228,8 +228,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         numbers.
     block_steps : int, optional
         Steps per time block (default: the driver's cache-sized blocks, at least
-        256 steps (``MIN_BLOCK_STEPS``): each block is one ``solve`` call, whose fixed cost a longer block
-        spreads over more steps). Changes memory use and speed, never the numbers.
+        256 steps (``MIN_BLOCK_STEPS``): each block is one call of the method's compiled kernel, whose fixed
+        cost a longer block spreads over more steps). Changes memory use and speed, never the numbers.
     executor : concurrent.futures.Executor, optional
         Runs the chunks (default: serially in this process); e.g. ``dask.distributed``'s
         ``client.get_executor()``. Never changes the numbers.
