@@ -18,8 +18,12 @@ sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scale
 Reported: median wall (or, with ``--clock cpu``, process CPU) time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
 max ||Π(T)| - 1| over the paths, and ratios peer / ours.
 
+Last, one thread against all of numba's threads on the full solve (driver included, ``n_paths`` x 1,000
+steps), with and without the area: wall, CPU, and the calling thread's CPU time (the idle-machine wall
+estimate on a shared machine), with a bitwise check.
+
 Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R] [--clock wall|cpu]
-[--skip diffrax,torchsde,sdeint]``.
+[--skip diffrax,torchsde,sdeint] [--threads-only]``.
 """
 
 from __future__ import annotations
@@ -212,6 +216,50 @@ def bench_sdeint(n_paths, n_steps, repeats):
     return _median_time(run, repeats)
 
 
+def bench_threads(n_paths, n_steps, repeats):
+    """One thread against all of numba's threads on the full solve (driver sampling included), interleaved.
+
+    Prints wall and process CPU time per path-step and, for the threaded run, the CPU time of the calling
+    thread alone: the work is shared between the caller and the pool, so on an idle machine the wall time
+    of the threaded run is about the caller's CPU time; on a machine whose other cores are busy the wall
+    ratio measures the other load, and the caller's CPU time estimates what the threads give.
+    """
+    import numba
+
+    from mechanics import LieHeun, rigid_body
+    from roughpaths import BrownianDriver, solve
+
+    rb = rigid_body(INERTIA, sigma=SIGMA, theta=THETA)
+    mu0 = np.array([0.0, 0.0, 1.0])
+    n_all = numba.get_num_threads()
+    print(f"threads: 1 against {n_all} (numba.set_num_threads), full solve {n_paths} x {n_steps}, medians of "
+          f"{repeats} interleaved runs, ns per path-step")
+    print(f"  {'problem':26s} {'wall 1':>8s} {'wall N':>8s} {'N/1':>5s} {'cpu 1':>8s} {'cpu N':>8s} {'N/1':>5s} "
+          f"{'caller cpu N':>12s} {'/ cpu 1':>7s} {'bitwise':>7s}")
+    for label, area in (("LieHeun + Davie area", "davie"), ("LieHeun, no area", None)):
+        def run():
+            drv = BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,), levy_area=area)
+            return solve(rb, drv, mu0, LieHeun(), save_at="end").final
+
+        run()
+        wall, cpu, caller, out = {1: [], n_all: []}, {1: [], n_all: []}, {1: [], n_all: []}, {}
+        try:
+            for _ in range(repeats):
+                for t in (1, n_all):
+                    numba.set_num_threads(t)
+                    w0, c0, m0 = time.perf_counter(), time.process_time(), time.thread_time()
+                    out[t] = run()
+                    wall[t].append(time.perf_counter() - w0)
+                    cpu[t].append(time.process_time() - c0)
+                    caller[t].append(time.thread_time() - m0)
+        finally:
+            numba.set_num_threads(n_all)
+        w1, wn, c1, cn, mn = (1e9 * statistics.median(x) / (n_paths * n_steps)
+                              for x in (wall[1], wall[n_all], cpu[1], cpu[n_all], caller[n_all]))
+        print(f"  {label:26s} {w1:8.1f} {wn:8.1f} {wn / w1:5.2f} {c1:8.1f} {cn:8.1f} {cn / c1:5.2f} {mn:12.1f} "
+              f"{mn / c1:7.2f} {str(np.array_equal(out[1], out[n_all])):>7s}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="100 paths x 1,000 steps (smoke run)")
@@ -220,12 +268,16 @@ def main(argv=None):
                     help="wall time, or the process's CPU time summed over its threads (steadier on a "
                          "shared machine; counts a peer's extra threads as cost)")
     ap.add_argument("--skip", default="", help="comma-separated peers to skip: diffrax,torchsde,sdeint")
+    ap.add_argument("--threads-only", action="store_true", help="only the table of 1 thread against all")
     args = ap.parse_args(argv)
     if args.clock == "cpu":
         _CLOCK[0] = time.process_time
     n_paths, n_steps = (100, 1_000) if args.quick else (1_000, 10_000)
     sde_paths = 1 if args.quick else 4
     skip = set(filter(None, args.skip.split(",")))
+    if args.threads_only:
+        bench_threads(n_paths, min(n_steps, 1_000), max(args.repeats, 5))
+        return 0
     print(f"rigid body: I = diag(1,2,3), theta = {THETA}, sigma = {SIGMA}, dt = {DT}, "
           f"{n_paths} paths x {n_steps} steps, float64, repeats = {args.repeats}, "
           f"cpus = {os.cpu_count()}, clock = {args.clock}")
@@ -259,6 +311,7 @@ def main(argv=None):
     print("ratios (ns per path-step, peer / ours with Levy area):")
     for name, _, ns, _ in rows[1:]:
         print(f"  {name:32s} {ns / ours:8.2f}x")
+    bench_threads(n_paths, min(n_steps, 1_000), max(args.repeats, 5))
     return 0
 
 

@@ -1,4 +1,5 @@
-"""Work sharing for the signature kernels (private).
+"""Work sharing for the compiled kernels (private; :func:`parallel_ranges` is public as
+:func:`roughpaths.validation.parallel_ranges`).
 
 :func:`run` executes ``fn(lo, hi)`` over a list of item ranges on a persistent thread pool. The
 kernels release the GIL. Ranges are taken from a shared counter by whoever is free, *including the
@@ -14,12 +15,13 @@ thread runs it. The number of threads is numba's (``NUMBA_NUM_THREADS``, ``numba
 from __future__ import annotations
 
 import itertools
+import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
 import numba
 
-__all__ = ["run", "ranges"]
+__all__ = ["run", "ranges", "parallel_ranges"]
 
 #: Below this much work (roughly, floating-point operations) a job stays on the calling thread.
 SERIAL_WORK = 1 << 20
@@ -28,6 +30,15 @@ RANGE_WORK = 1 << 17
 
 _POOL: ThreadPoolExecutor | None = None
 _POOL_LOCK = threading.Lock()
+
+
+def _forget_pool() -> None:                # in a forked child the parent's pool threads do not exist
+    global _POOL, _POOL_LOCK
+    _POOL = None
+    _POOL_LOCK = threading.Lock()
+
+
+os.register_at_fork(after_in_child=_forget_pool)
 
 
 def _pool(workers: int) -> ThreadPoolExecutor:
@@ -84,3 +95,36 @@ def run(fn, parts: list) -> None:
     done.wait()
     if errors:
         raise errors[0]
+
+
+def parallel_ranges(fn, n_items: int, block: int) -> None:
+    """Call ``fn(lo, hi)`` for the ranges ``[0, block), [block, 2 block), ...`` of ``range(n_items)`` on
+    numba's threads, the calling thread included (public as :func:`roughpaths.validation.parallel_ranges`).
+
+    For compiled kernels that release the GIL (``numba.njit(nogil=True)``) and compute each item by the
+    same code whatever range it is in, so that the result never depends on the number of threads
+    (``numba.set_num_threads``, ``NUMBA_NUM_THREADS``). Plain Python threads from a persistent pool,
+    dropped in a forked child: safe under ``fork`` and when called from several threads at once (unlike
+    numba's OpenMP ``prange``). Exceptions raised by ``fn`` are re-raised in the caller.
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(lo, hi)``, writing its results for items ``lo .. hi-1``.
+    n_items : int
+    block : int
+        Items per range (positive).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> out = np.zeros(10)
+    >>> def fill(lo, hi):
+    ...     out[lo:hi] = np.arange(lo, hi) ** 2
+    >>> parallel_ranges(fill, 10, 3)
+    >>> out.tolist() == [float(i * i) for i in range(10)]
+    True
+    """
+    if isinstance(block, bool) or not isinstance(block, int) or block < 1:
+        raise ValueError(f"block must be a positive int (items per range), got {block!r}.")
+    run(fn, [(lo, min(lo + block, n_items)) for lo in range(0, max(int(n_items), 0), block)])

@@ -13,7 +13,10 @@ import numbers
 
 import numpy as np
 
+from ._threads import parallel_ranges
+
 __all__ = [
+    "parallel_ranges",
     "as_float_array",
     "check_times",
     "check_antisymmetric",

@@ -150,24 +150,34 @@ def _run_chunk(spec: _Spec, first: int, last: int):
     block_steps = spec.block_steps
     if block_steps is None:
         block_steps = max(driver.default_block_steps(), MIN_BLOCK_STEPS)
+    # The blocks go straight to the method's ``integrate`` (what ``solve`` calls per block), checked once per
+    # chunk: no per-block output array, copy or memory check, and only the steps used are saved. A failed
+    # block is solved again through ``solve``, which raises its error (the same numbers: a pure function).
+    method = spec.method
+    method.check_driver(driver)
+    with_area = min(method.increment_level, driver.level) >= 2
     for block in driver.blocks(block_steps):
         k = block.n_steps
-        states = solve(system, block, mu, spec.method).states                 # (c, k + 1, n)
-        # averaged steps: idx > burn_in and idx % average_every == 0, a strided slice of states[:, 1:]
-        first_ok = max(spec.burn_in + 1, step + 1)
-        first_ok += (-first_ok) % spec.average_every
-        if first_ok <= step + k:
-            window = states[:, first_ok - step::spec.average_every]
+        steps = np.arange(step + 1, step + k + 1)
+        averaged = (steps > spec.burn_in) & (steps % spec.average_every == 0)
+        recorded = (np.zeros(k, dtype=bool) if spec.record_every is None else steps % spec.record_every == 0)
+        save = averaged | recorded
+        new_mu, saved, first_bad = method.integrate(system, mu, block.times, block.increments,
+                                                    block.areas if with_area else None, save,
+                                                    stop_on_failure=True)      # saved: (c, save.sum(), n)
+        if np.any(first_bad >= 0):
+            solve(system, block, mu, method)                                   # raises NonFiniteStateError
+            raise RuntimeError("a block failed in the compiled kernel but not in solve; please report this.")
+        if averaged.any():
+            window = saved if not recorded.any() else saved[:, averaged[save]]
             if fast_moments:
-                accumulate_moments(acc, window)                 # a strided view: no copy of the block's states
+                accumulate_moments(acc, window)
             else:
                 accumulate(acc, np.ascontiguousarray(_observe(spec.observable, window)))
             n_avg += window.shape[1]
-        if spec.record_every is not None:
-            for j in range(1, k + 1):
-                if (step + j) % spec.record_every == 0:
-                    snaps.append(_observe(spec.observable, states[:, j]))
-        mu = np.ascontiguousarray(states[:, -1])
+        for j in np.flatnonzero(recorded[save]):
+            snaps.append(_observe(spec.observable, saved[:, j]))
+        mu = np.ascontiguousarray(new_mu, dtype=np.float64)
         step += k
     final = _observe(spec.observable, mu)
     return final, (acc / n_avg if n_avg else None), snaps, (mu if spec.keep_final else None)
@@ -218,8 +228,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         numbers.
     block_steps : int, optional
         Steps per time block (default: the driver's cache-sized blocks, at least
-        256 steps (``MIN_BLOCK_STEPS``): each block is one ``solve`` call, whose fixed cost a longer block
-        spreads over more steps). Changes memory use and speed, never the numbers.
+        256 steps (``MIN_BLOCK_STEPS``): each block is one call of the method's compiled kernel, whose fixed
+        cost a longer block spreads over more steps). Changes memory use and speed, never the numbers.
     executor : concurrent.futures.Executor, optional
         Runs the chunks (default: serially in this process); e.g. ``dask.distributed``'s
         ``client.get_executor()``. Never changes the numbers.

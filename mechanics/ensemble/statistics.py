@@ -18,6 +18,8 @@ __all__ = ["RunningMoments", "moment_observable", "split_moment_features", "Leaf
 
 #: Paths per leaf of :class:`LeafReducer` (part of the definition of the ensemble's statistics).
 LEAF = 64
+#: Arrays smaller than this are allocated without asking :func:`roughpaths.validation.check_memory`.
+_SMALL_BYTES = 1 << 20
 
 
 # ------------------------------------------------------------------------------ running moments
@@ -41,8 +43,9 @@ class RunningMoments:
 
     def __init__(self, dim: int):
         self.dim = check_positive_int(dim, "dim")
-        check_memory(8.0 * self.dim * (self.dim + 1), f"the mean and scatter matrix (dim={self.dim})",
-                     "use fewer observables")
+        nbytes = 8.0 * self.dim * (self.dim + 1)
+        if nbytes > _SMALL_BYTES:            # the budget reads /proc: not for every leaf's few hundred bytes
+            check_memory(nbytes, f"the mean and scatter matrix (dim={self.dim})", "use fewer observables")
         self.count = 0
         self.mean = np.zeros(self.dim)
         self.scatter = np.zeros((self.dim, self.dim))

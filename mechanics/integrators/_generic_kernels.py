@@ -29,7 +29,7 @@ The coadjoint action :math:`e^{\mathrm{ad}^*_\sigma}\mu`, per member
 
 Layout: a block of up to :data:`BLOCK` members lives as ``(n, BLOCK)`` rows (structure of arrays);
 each operation is a loop over the members of the block, pure arithmetic, so LLVM vectorises it
-(no fast-math: vector and scalar loops round alike). Blocks run in parallel (:mod:`._blocks`, numba's
+(no fast-math: vector and scalar loops round alike). Blocks run in parallel (:func:`roughpaths.validation.parallel_ranges`, numba's
 number of threads: ``numba.set_num_threads`` / ``NUMBA_NUM_THREADS``); a member's result does not depend
 on its block, its neighbours or the thread. The implicit midpoint rule runs the chord iteration member by member
 (scalar code, as the hand-written kernels do).
@@ -42,7 +42,7 @@ import math
 import numba
 import numpy as np
 
-from ._blocks import run_blocks
+from roughpaths.validation import parallel_ranges
 from ._generic_member import DEGREE_THETA, chord1, exp1, velocity1
 
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
@@ -342,5 +342,5 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
             bool(stop_on_failure))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
-    run_blocks(lambda lo, hi: _run_block(*args, lo, hi, *tail), nb, BLOCK)
+    parallel_ranges(lambda lo, hi: _run_block(*args, lo, hi, *tail), nb, BLOCK)
     return y, out, first_bad, reason

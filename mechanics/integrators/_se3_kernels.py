@@ -21,7 +21,7 @@ import numba
 import numpy as np
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
-from ._blocks import run_blocks
+from roughpaths.validation import parallel_ranges
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
@@ -356,7 +356,7 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
 
     Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``. Blocks of :data:`BLOCK` members run in
-    parallel (:mod:`._blocks`; ``numba.set_num_threads``).
+    parallel (:func:`roughpaths.validation.parallel_ranges`; ``numba.set_num_threads``).
     """
     data = system.quadratic_velocity_data()
     nb = y.shape[0]
@@ -373,8 +373,8 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
               data["metric_inv"], float(data["theta"]))
     tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
     if code == 2:
-        run_blocks(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
+        parallel_ranges(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
                    nb, BLOCK)
     else:
-        run_blocks(lambda lo, hi: _se3_block(*args, int(code), *consts, *tail, lo, hi), nb, BLOCK)
+        parallel_ranges(lambda lo, hi: _se3_block(*args, int(code), *consts, *tail, lo, hi), nb, BLOCK)
     return y, out, first_bad, reason

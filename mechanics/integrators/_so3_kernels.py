@@ -23,7 +23,7 @@ import numba
 import numpy as np
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
-from ._blocks import run_blocks
+from roughpaths.validation import parallel_ranges
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 
@@ -320,7 +320,7 @@ def _so3_range(y, eta, dts, coef, code, tol, max_iter, q, lin, minv, theta, save
 def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure):
     """Run the so(3) kernel on ``y`` (B, 3) with ``eta`` (B, K, 3); returns (y, saved, first_bad, reason).
 
-    Blocks of :data:`BLOCK` members run in parallel (:mod:`._blocks`; ``numba.set_num_threads``)."""
+    Blocks of :data:`BLOCK` members run in parallel (:func:`roughpaths.validation.parallel_ranges`; ``numba.set_num_threads``)."""
     nb = y.shape[0]
     coef = coefficients(data)
     lin = np.concatenate([data["linear"], data["dissipation_change"]])
@@ -331,11 +331,11 @@ def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure)
     args = (y, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol),
             int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
             np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
-    run_blocks(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
+    parallel_ranges(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
     return y, out, first_bad, reason
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
     """Stochastic velocities out (B, K, 3) = Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], A = ½(XX - XXᵀ).
 
@@ -389,5 +389,8 @@ def stochastic_velocities(system, dX, dXX, batch):
     pi, pj = _pairs(nm)
     brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
     out = np.empty((nb, nk, 3))
-    _eta_from_increments(dX, dXX, np.ascontiguousarray(system.xi), brk, pi, pj, out)
+    xi = np.ascontiguousarray(system.xi)
+    area = dXX.shape[0] > 0
+    parallel_ranges(lambda lo, hi: _eta_from_increments(dX[lo:hi], dXX[lo:hi] if area else dXX, xi, brk, pi, pj,
+                                                   out[lo:hi]), nb, BLOCK)    # per member: any split, same numbers
     return out

@@ -108,6 +108,22 @@ class _Sampler:
             return max(w for _, _, w in self.plan.values())
         return 0
 
+    def fill_rows(self, dW, h, states, ito, zbuf, out) -> bool:
+        """Write the areas of the paths ``dW (p, k, d)`` with PCG64 ``states (p, 4)`` (advanced) into ``out``
+        ``(p, k, d, d)``; False (nothing done) for the kinds that need the whole block (``"fourier"``,
+        none). A path's areas depend on its own increments and stream only, so any split of the paths into
+        row ranges gives the same numbers (:class:`~roughpaths.BrownianDriver` samples ranges on threads)."""
+        d = dW.shape[2]
+        if self.kind == "bridge":
+            na = self.width
+            _block_areas(dW, h, zbuf[:na].reshape(1, 1, na), states, self.substeps, self.name == "davie" and d > 1,
+                         ito, out)
+            return True
+        if self.kind == "exact" and d == 2:
+            _exact_areas_d2(dW, h, states, load_table(), TABLE_STEP, _EXACT_TERMS, _EXACT_T1, _EXACT_T2, ito, out)
+            return True
+        return False
+
     def fill(self, dW, h, streams, ito, zbuf):
         """Areas ``(P, k, d, d)`` of a block ``dW (P, k, d)``, steps ``h (k,)``, from ``streams`` (advanced)."""
         P, k, d = dW.shape

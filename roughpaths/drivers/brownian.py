@@ -92,8 +92,9 @@ import numbers
 import numpy as np
 
 from ..validation import as_float_array, check_memory, check_positive_int
+from .. import _threads
 from ._area_kernels import _scale_accumulate
-from ._random import PathStreams, _fast_streams_ok
+from ._random import PathStreams, _fast_streams_ok, _pcg64_normals
 from .areas import _Sampler
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
 from ..paths.rough_path import RoughPath
@@ -395,6 +396,30 @@ class BrownianDriver(SeededDriver):
         return RefinedBrownianDriver(self, factor)
 
     # ------------------------------------------------------------------ generation
+    def _sample_rows(self, dW, h, x, inc_streams, area_streams, zbuf):
+        """Fill the block ``dW (P, k, d)`` (scaled; ``x`` advanced to its end) and, where the sampler can,
+        its areas, on numba's threads over ranges of paths (:mod:`roughpaths._threads`). Every path's
+        numbers come from its own streams, so the split never changes them. Returns the areas, ``False``
+        (increments done, areas left to :meth:`_Sampler.fill`) or ``None`` (nothing done: numpy streams)."""
+        if inc_streams.states is None or (area_streams is not None and area_streams.states is None):
+            return None
+        P, k, d = dW.shape
+        sqh = np.sqrt(h)
+        ito = self.kind == "ito"
+        rows = self.level == 2 and (self._sampler.kind == "bridge" or (self._sampler.kind == "exact" and d == 2))
+        areas = np.empty((P, k, d, d)) if rows else None
+        flat = dW.reshape(P, k * d)
+
+        def sample(lo, hi):
+            _pcg64_normals(inc_streams.states[lo:hi], flat[lo:hi])
+            _scale_accumulate(dW[lo:hi], sqh, x[lo:hi])
+            if rows:
+                self._sampler.fill_rows(dW[lo:hi], h, area_streams.states[lo:hi], ito, zbuf, areas[lo:hi])
+
+        per_path = k * (d + (self._sampler.width + d * d if rows else 0)) * 16.0
+        _threads.run(sample, _threads.ranges(P, per_path))
+        return areas if rows else False
+
     def blocks(self, max_steps=None):
         """Yield consecutive ``RoughPath`` blocks of at most ``max_steps`` steps covering the grid.
 
@@ -421,10 +446,17 @@ class BrownianDriver(SeededDriver):
             k = k1 - k0
             h = np.ascontiguousarray(h_all[k0:k1])
             dW = np.empty((P, k, d))
-            inc_streams.fill(dW.reshape(P, k * d))
             x_start = x.copy()
-            _scale_accumulate(dW, np.sqrt(h), x)    # x: the position at the end of the block
-            areas = None if self.level == 1 else self._sampler.fill(dW, h, area_streams, self.kind == "ito", zbuf)
+            sampled = self._sample_rows(dW, h, x, inc_streams, area_streams, zbuf)
+            if sampled is None:                     # the numpy streams: the whole block at once
+                inc_streams.fill(dW.reshape(P, k * d))
+                _scale_accumulate(dW, np.sqrt(h), x)    # x: the position at the end of the block
+            if self.level == 1:
+                areas = None
+            elif sampled is None or sampled is False:
+                areas = self._sampler.fill(dW, h, area_streams, self.kind == "ito", zbuf)
+            else:
+                areas = sampled
             block = RoughPath(dW.reshape(self.batch_shape + (k, d)),
                               None if areas is None else areas.reshape(self.batch_shape + (k, d, d)),
                               times=self.times[k0:k1 + 1], x0=x_start.reshape(self.batch_shape + (d,)),
