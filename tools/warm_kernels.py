@@ -75,7 +75,8 @@ def warm_tree() -> None:
 
 
 def warm_coadjoint() -> None:
-    from mechanics import ImplicitMidpoint, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body
+    from mechanics import (ImplicitMidpoint, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body,
+                           run_ensemble)
     from mechanics.systems.lie_algebra import su2
     from roughpaths import BrownianDriver, solve
 
@@ -87,6 +88,8 @@ def warm_coadjoint() -> None:
             X = BrownianDriver(system.n_noise, seed=0, dt=0.01, n_steps=2, batch_shape=(2,), levy_area=levy_area)
             for method in (LieEuler(), LieHeun(), ImplicitMidpoint()):
                 solve(system, X, np.ones((2, system.dim)), method)
+    for system in systems[1:]:      # the streamed statistics (so(3) moments in registers, se(3) generic)
+        run_ensemble(system, np.ones(system.dim), dt=0.01, n_steps=4, n_paths=2, seed=0)
 
 
 def main() -> None:
