@@ -216,30 +216,21 @@ class CoadjointSolver(Solver):
                 getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
             y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
             first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
-        elif isinstance(system.algebra, SE3Algebra) and plain:
-            nb = int(np.prod(batch, dtype=np.int64))
-            d = dX.shape[-1]
-            dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
-            if dXX is not None:
-                dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
-                                           dtype=np.float64)
-            y2, saved, first_bad, reason = _se3_kernels.integrate_se3(
-                system, self._code, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1), y.reshape(nb, n), dX,
-                dXX, dts, save, stop_on_failure)
-            y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
-            chord = (reason == _se3_kernels.CHORD_FAILED).reshape(batch)
         elif plain:
+            # se(3) (the heavy top): the hand-written kernel; every other algebra: the generic one
+            kernels = _se3_kernels if isinstance(system.algebra, SE3Algebra) else _generic_kernels
+            run = _se3_kernels.integrate_se3 if kernels is _se3_kernels else _generic_kernels.integrate_generic
             nb = int(np.prod(batch, dtype=np.int64))
             d = dX.shape[-1]
             dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
             if dXX is not None:
                 dXX = np.ascontiguousarray(np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d),
                                            dtype=np.float64)
-            y2, saved, first_bad, reason = _generic_kernels.integrate_generic(
+            y2, saved, first_bad, reason = run(
                 system, self._code, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1), y.reshape(nb, n), dX,
                 dXX, dts, save, stop_on_failure)
             y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
-            chord = (reason == _generic_kernels.CHORD_FAILED).reshape(batch)
+            chord = (reason == kernels.CHORD_FAILED).reshape(batch)
         else:
             saved = np.full(batch + (nsave, n), np.nan)
             first_bad = np.full(batch, -1, dtype=np.int64)
