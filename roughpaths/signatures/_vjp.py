@@ -67,7 +67,9 @@ def _dot_wide(a, ao, b, bo, n):
 
 @njit(cache=True)
 def _lcon(x0, s, g, d, m, offsets, out):
-    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``."""
+    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``.
+
+    Per path, never per lane: the sums over ``u`` run in :func:`_dot_wide` for every ``d``."""
     for j in range(1, m + 1):
         oj = offsets[j]
         nj = d ** j
@@ -78,7 +80,7 @@ def _lcon(x0, s, g, d, m, offsets, out):
             oi = offsets[i]
             ok = offsets[i + j]
             for w in range(nj):
-                out[oj + w] += _dot(s, oi, g, ok + ni * w, ni)
+                out[oj + w] += _dot_wide(s, oi, g, ok + ni * w, ni)
 
 
 @njit(cache=True)
