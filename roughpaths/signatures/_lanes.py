@@ -24,7 +24,8 @@ d = 3, 5.
 
 *One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step`, whose loops
 run over the first letters of a level (contiguous, packed ``LANES`` first letters at a time or
-vectorised by LLVM): the same bits as the lanes. The engine uses it for every d >= 6 (``LANES``
+vectorised by LLVM; for d = 6..15 :func:`_wide_step`, the same operations with less loop
+control): the same bits as the lanes. The engine uses it for every d >= 6 (``LANES``
 signatures of a wide path no longer fit in the L1/L2 caches, and one unit's rows are long enough
 to fill the vector registers) and for a lane group that would hold at most two units.
 
