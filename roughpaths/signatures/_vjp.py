@@ -47,9 +47,29 @@ def _dot(a, ao, b, bo, n):
     return acc
 
 
+@njit(cache=True, inline="always")
+def _dot_wide(a, ao, b, bo, n):
+    """:func:`_dot` in four running sums (``p mod 4``) added as ``(s0 + s1) + (s2 + s3)``: a fixed
+    order (a function of ``n`` only) without one long chain of dependent additions (d >= 6 only)."""
+    u = np.uint64(ao)
+    v = np.uint64(bo)
+    n4 = np.uint64(n - n % 4)
+    s0 = s1 = s2 = s3 = 0.0
+    for p in range(np.uint64(0), n4, np.uint64(4)):
+        s0 += a[u + p] * b[v + p]
+        s1 += a[u + p + 1] * b[v + p + 1]
+        s2 += a[u + p + 2] * b[v + p + 2]
+        s3 += a[u + p + 3] * b[v + p + 3]
+    for p in range(n4, np.uint64(n)):
+        s0 += a[u + p] * b[v + p]
+    return (s0 + s1) + (s2 + s3)
+
+
 @njit(cache=True)
 def _lcon(x0, s, g, d, m, offsets, out):
-    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``."""
+    """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``.
+
+    Per path, never per lane: the sums over ``u`` run in :func:`_dot_wide` for every ``d``."""
     for j in range(1, m + 1):
         oj = offsets[j]
         nj = d ** j
@@ -60,7 +80,7 @@ def _lcon(x0, s, g, d, m, offsets, out):
             oi = offsets[i]
             ok = offsets[i + j]
             for w in range(nj):
-                out[oj + w] += _dot(s, oi, g, ok + ni * w, ni)
+                out[oj + w] += _dot_wide(s, oi, g, ok + ni * w, ni)
 
 
 @njit(cache=True)
@@ -79,7 +99,7 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 
 @njit(cache=True, inline="always")
-def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, wide):
     dim = offsets[m + 1]
     for r in range(dim):
         gprev[r] = g[r]
@@ -99,11 +119,8 @@ def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
                 base = on + size * q
                 _tb_row(tb, base, tb, oj, size, delta[q] * f, s, base)
             size *= d
-        # backward: gB_k = G_k
+        # backward: gB_k = G_k (read in place from g), then gB_j in ga
         ok = offsets[k]
-        nk = d ** k
-        for r in range(nk):
-            ga[r] = g[ok + r]
         for j in range(k - 1, 0, -1):
             f = 1.0 / (k - j)
             nj = d ** j
@@ -111,9 +128,14 @@ def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
             for p in range(nj):
                 gb[p] = 0.0
             for q in range(d):
-                base = nj * q
-                _axpy(gb, 0, ga, base, nj, delta[q] * f)
-                gdelta[q] += _dot(ga, base, tb, oj, nj) * f
+                if j == k - 1:
+                    base = ok + nj * q
+                    _axpy(gb, 0, g, base, nj, delta[q] * f)
+                    gdelta[q] += (_dot_wide(g, base, tb, oj, nj) if wide else _dot(g, base, tb, oj, nj)) * f
+                else:
+                    base = nj * q
+                    _axpy(gb, 0, ga, base, nj, delta[q] * f)
+                    gdelta[q] += (_dot_wide(ga, base, tb, oj, nj) if wide else _dot(ga, base, tb, oj, nj)) * f
             _addto(gprev, oj, gb, 0, nj)
             for p in range(nj):
                 ga[p] = gb[p]
@@ -129,15 +151,18 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
     ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
     the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
     ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
-    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``. The same
-    operations, in the same order, as every lane of :func:`_lane_step_vjp_d`.
+    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``. For d <= 5
+    the same operations, in the same order, as every lane of :func:`_lane_step_vjp_d`; from d = 6
+    (``_engine._WIDE``: no lanes) the dot products run in :func:`_dot_wide`.
     """
     if d == 2:
-        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta)
+        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta, False)
     elif d == 3:
-        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta)
-    else:
-        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta)
+        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta, False)
+    elif d < 6:
+        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, False)
+    else:                   # every unit runs alone (no lane to match): the dot products in 4 sums
+        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, True)
 
 
 @njit(cache=True)
