@@ -143,15 +143,6 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
     return apply
 
 
-def _kernel_api(name: str):
-    """``roughpaths.<name>``, looked up at call time (the signature kernels are a separate part of the library)."""
-    f = getattr(_rp, name, None)
-    if f is None:
-        raise NotImplementedError(f"roughpaths.{name} is not available in this version of roughpaths "
-                                  f"({_rp.__version__}); upgrade roughpaths to use the signature kernels.")
-    return f
-
-
 def _paths_core(cores, name="paths"):
     (n, d), = cores
     if n < 1 or d < 1:
@@ -167,12 +158,12 @@ _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
                                lambda batch, cores, depth: batch + (_rp.logsigdim(_paths_core(cores), depth),),
                                names=("paths",), core=(2,))
-_kernel = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel")(x, y, **kw),
-                         lambda x, y, g, **kw: _kernel_api("signature_kernel_vjp")(x, y, g, **kw),
+_kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
+                         lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
                          lambda batch, cores, **kw: batch,
                          names=("x", "y"), core=(2, 2))
-_gram = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel_gram")(x, y, **kw),
-                       lambda x, y, g, **kw: _kernel_api("signature_kernel_gram_vjp")(x, y, g, **kw),
+_gram = differentiable(lambda x, y, **kw: _rp.signature_kernel_gram(x, y, **kw),
+                       lambda x, y, g, **kw: _rp.signature_kernel_gram_vjp(x, y, g, **kw),
                        lambda batch, cores, **kw: batch + (cores[0][0], cores[1][0]),
                        names=("X", "Y"), core=(3, 3))
 

@@ -145,26 +145,17 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     return apply
 
 
-def _kernel_api(name: str):
-    """``roughpaths.<name>``, looked up at call time (the signature kernels are a separate part of the library)."""
-    f = getattr(_rp, name, None)
-    if f is None:
-        raise NotImplementedError(f"roughpaths.{name} is not available in this version of roughpaths "
-                                  f"({_rp.__version__}); upgrade roughpaths to use the signature kernels.")
-    return f
-
-
 _signature = differentiable(lambda x, depth: _rp.signature(x, depth),
                             lambda x, g, depth: _rp.signature_vjp(x, depth, g),
                             names=("paths",), core=(2,), label="_Signature")
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
                                names=("paths",), core=(2,), label="_LogSignature")
-_kernel = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel")(x, y, **kw),
-                         lambda x, y, g, **kw: _kernel_api("signature_kernel_vjp")(x, y, g, **kw),
+_kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
+                         lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
                          names=("x", "y"), core=(2, 2), label="_SignatureKernel")
-_gram = differentiable(lambda x, y, **kw: _kernel_api("signature_kernel_gram")(x, y, **kw),
-                       lambda x, y, g, **kw: _kernel_api("signature_kernel_gram_vjp")(x, y, g, **kw),
+_gram = differentiable(lambda x, y, **kw: _rp.signature_kernel_gram(x, y, **kw),
+                       lambda x, y, g, **kw: _rp.signature_kernel_gram_vjp(x, y, g, **kw),
                        names=("X", "Y"), core=(3, 3), label="_SignatureKernelGram")
 
 

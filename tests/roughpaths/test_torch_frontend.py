@@ -4,8 +4,7 @@ Claims: the forward values are the numpy API's (1e-12 in float64, float32 roundi
 the gradients pass ``torch.autograd.gradcheck`` (central differences, float64) and are the numpy
 VJPs; a few Adam steps through each function lower a loss; bad tensors (non-tensor, meta device,
 integer or half dtype, mixed dtypes) are refused with the fix named. The signature-kernel wrappers
-are checked the same way when ``roughpaths.signature_kernel`` exists (skipped otherwise), and their
-plumbing (keywords, broadcasting, the gradients' shapes) against a stand-in kernel either way.
+are checked the same way (values, keywords, batch broadcasting, gradcheck, Adam steps).
 """
 
 from __future__ import annotations
@@ -23,9 +22,6 @@ if os.environ.get("CI") and importlib.util.find_spec("torch") is None:
 torch = pytest.importorskip("torch", reason="the torch extra is not installed (pip install -e '.[torch]')")
 rpt = pytest.importorskip("roughpaths.torch")
 
-HAS_KERNEL = hasattr(rp, "signature_kernel")
-needs_kernel = pytest.mark.skipif(not HAS_KERNEL, reason="roughpaths.signature_kernel is not in this version "
-                                                        "(the wrappers follow its contract; run after it lands)")
 
 
 def _paths(shape, seed=0):
@@ -97,40 +93,13 @@ def test_bad_tensors_are_refused(make, exc, words):
 
 
 # ------------------------------------------------------------------ signature kernels
-def _fake_kernel(x, y, *, dyadic_order=0, static_kernel=None):
-    """Stand-in with the kernels' contract: 1 + <S(x), S(y)> at depth 2 (+ dyadic_order, to see it arrive)."""
-    return 1.0 + dyadic_order + np.einsum("...i,...i->...", rp.signature(x, 2), rp.signature(y, 2))
-
-
-def _fake_kernel_vjp(x, y, g, *, dyadic_order=0, static_kernel=None):
-    sx, sy = rp.signature(x, 2), rp.signature(y, 2)
-    return rp.signature_vjp(x, 2, g[..., None] * sy), rp.signature_vjp(y, 2, g[..., None] * sx)
-
-
-def _fake_gram(X, Y, *, dyadic_order=0, static_kernel=None):
-    return _fake_kernel(X[..., :, None, :, :], Y[..., None, :, :, :], dyadic_order=dyadic_order)
-
-
-def _fake_gram_vjp(X, Y, g, *, dyadic_order=0, static_kernel=None):
-    sx, sy = rp.signature(X, 2), rp.signature(Y, 2)
-    return (rp.signature_vjp(X, 2, np.einsum("...ab,...bk->...ak", g, sy)),
-            rp.signature_vjp(Y, 2, np.einsum("...ab,...ak->...bk", g, sx)))
-
-
-@pytest.fixture
-def stand_in_kernels(monkeypatch):
-    for name, f in [("signature_kernel", _fake_kernel), ("signature_kernel_vjp", _fake_kernel_vjp),
-                    ("signature_kernel_gram", _fake_gram), ("signature_kernel_gram_vjp", _fake_gram_vjp)]:
-        monkeypatch.setattr(rp, name, f, raising=False)
-
-
-def test_kernel_plumbing_with_a_stand_in(stand_in_kernels):
+def test_kernel_broadcasting_and_batched_gram():
     x = torch.from_numpy(_paths((3, 5, 2), seed=5)).requires_grad_()
     y = torch.from_numpy(_paths((6, 2), seed=6)).requires_grad_()        # broadcast against x's batch
     k = rpt.signature_kernel(x, y, dyadic_order=2)
     assert k.shape == (3,)
-    np.testing.assert_allclose(k.detach().numpy(), 3.0 + rp.signature(x.detach().numpy(), 2)
-                               @ rp.signature(y.detach().numpy(), 2), rtol=1e-13)
+    np.testing.assert_allclose(k.detach().numpy(), rp.signature_kernel(x.detach().numpy(), y.detach().numpy(),
+                                                                       dyadic_order=2), rtol=1e-13)
     assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel(a, b), (x, y))
     X = torch.from_numpy(_paths((2, 3, 4, 2), seed=7)).requires_grad_()
     Y = torch.from_numpy(_paths((2, 5, 6, 2), seed=8)).requires_grad_()
@@ -138,13 +107,8 @@ def test_kernel_plumbing_with_a_stand_in(stand_in_kernels):
     assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel_gram(a, b), (X, Y))
 
 
-def test_missing_kernels_say_so(monkeypatch):
-    monkeypatch.delattr(rp, "signature_kernel", raising=False)
-    with pytest.raises(NotImplementedError, match="signature_kernel is not available"):
-        rpt.signature_kernel(torch.zeros(3, 2), torch.zeros(3, 2))
 
 
-@needs_kernel
 def test_kernels_equal_numpy_and_gradcheck():
     x, y = _paths((2, 5, 2), seed=9), _paths((2, 4, 2), seed=10)
     X, Y = _paths((3, 5, 2), seed=11), _paths((2, 4, 2), seed=12)
@@ -160,7 +124,6 @@ def test_kernels_equal_numpy_and_gradcheck():
     assert torch.autograd.gradcheck(lambda a, b: rpt.signature_kernel_gram(a, b), (tX, tY))
 
 
-@needs_kernel
 def test_kernel_adam_steps_lower_a_loss():
     """Pull a batch of paths towards a reference in the kernel's distance k(x,x) - 2 k(x,y) + k(y,y)."""
     y = torch.from_numpy(_paths((4, 6, 2), seed=13)).float()
