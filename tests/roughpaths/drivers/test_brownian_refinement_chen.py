@@ -104,7 +104,7 @@ def test_refined_polygon_area_explains_coarse_area_iisignature_oracle(m, tol_cor
     assert np.corrcoef(-a_poly, L)[0, 1] < -0.6
 
 
-@pytest.mark.parametrize("factor", [3, 4, 8])
+@pytest.mark.parametrize("factor", [3, 4, pytest.param(8, marks=pytest.mark.slow)])
 def test_fine_area_variance_is_unbiased_for_factors_above_2(factor):
     # factors > 2 are refined in one go (the Fourier-path construction); the former bridge splits
     # inflated this variance by 7-18 %. Kurtosis 5 of the area: the relative SE of the mean of a²

@@ -77,8 +77,8 @@ def test_exact_coarse_area_gives_the_brownian_sum_variance():
     assert abs(ex) < 4 * se, (ex, se)
 
 
-@pytest.mark.parametrize("d", [2, 3])
-@pytest.mark.parametrize("n", [1, 2, 4])
+@pytest.mark.parametrize("n, d", [(1, 2), (2, 2), (4, 2), (2, 3),                     # d = 3, n = 1, 4: slow
+                                  pytest.param(1, 3, marks=pytest.mark.slow), pytest.param(4, 3, marks=pytest.mark.slow)])
 def test_few_terms_excess_within_the_documented_bound(n, d):
     F = 8
     S = _summed_fine_areas("mrongowius-rossler", d, F, paths=100, steps=150, seed=10 * n + d, n=n)
