@@ -29,7 +29,7 @@ from .norms import (area_holder_seminorm, area_p_variation, holder_distance, hol
                     rough_path_holder_norm, rough_path_p_variation)
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
 from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
-                  NonFiniteStateError, Solution, Solver, VectorFields, central_jacobian, solve)
+                  NonFiniteStateError, PIController, Solution, Solver, VectorFields, central_jacobian, solve)
 from .signatures import (LinearKernel, MMDTestResult, RBFKernel, brownian_expected_signature, logsignature,
                          logsignature_vjp, rough_path_signature, rough_path_signature_vjp, sig_mmd_test, signature,
                          signature_kernel, signature_kernel_gram, signature_kernel_gram_vjp, signature_kernel_vjp,
@@ -37,7 +37,7 @@ from .signatures import (LinearKernel, MMDTestResult, RBFKernel, brownian_expect
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
-    "solve", "Solution", "NonFiniteStateError", "Driver", "Solver", "Euler", "Heun", "Davie", "LogODE", "LogODE3",
+    "solve", "Solution", "NonFiniteStateError", "PIController", "Driver", "Solver", "Euler", "Heun", "Davie", "LogODE", "LogODE3",
     "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift", "central_jacobian", "rough_integral",
     # coloured noise
     "coloured_noise_limit", "ColouredNoiseDriver", "ColouredNoiseLimit", "ColouredNoiseSample",

@@ -50,7 +50,7 @@ import numpy as np
 
 from .paths.rough_path import RoughPath
 from .validation import check_memory
-from .rde.integrate import Solution
+from .rde.solution import Solution
 
 __all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "FORMAT", "FORMAT_VERSION"]
 

@@ -127,6 +127,9 @@ class BrownianTree:
     True
     """
 
+    #: The level of the rough path it answers (increments and areas).
+    level = 2
+
     def __init__(self, dim, *, seed, t0=0.0, t1=1.0, batch_shape=(), levy_area="auto", levy_area_error=None,
                  polygon_levels=3, resolution=40, cache_size=None):
         self.dim = check_positive_int(dim, "dim")

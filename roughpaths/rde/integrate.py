@@ -1,4 +1,4 @@
-r"""The entry point :func:`solve` for rough differential equations, and its result :class:`Solution`.
+r"""The entry point :func:`solve` for rough differential equations.
 
 Solves :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i` on the grid of a :class:`~roughpaths.RoughPath`
 (or of a :class:`~roughpaths.Driver`, consumed block by block) with a one-step solver that
@@ -12,15 +12,17 @@ affect each other: a member that becomes non-finite is reported by its index and
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..validation import arrays_equal, as_float_array, check_memory, check_positive_int, check_same_batch
+from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
 from ..drivers.base import Driver
+from ..drivers.tree import BrownianTree
 from ..paths.rough_path import RoughPath
 from ..paths.rough_path_n import RoughPathN
+from .adaptive import solve_adaptive
 from .base import Solver
+from .solution import NonFiniteStateError, Solution, _failure_message
 from .davie import Davie
 from .euler import Euler, Heun
 from .logode import LogODE
@@ -30,73 +32,6 @@ __all__ = ["solve", "Solution", "NonFiniteStateError"]
 
 #: Solver names accepted by :func:`~roughpaths.solve` as strings (default instances).
 SOLVERS = {"euler": Euler, "heun": Heun, "davie": Davie, "logode": LogODE}
-
-
-class NonFiniteStateError(ValueError):
-    """Batch members of a :func:`solve` became non-finite.
-
-    Attributes
-    ----------
-    members : tuple of tuple of int
-        The batch indices of the failed members (all of them, in C order).
-    steps : tuple of int
-        For each failed member, the index ``k`` of the step ``[t_k, t_{k+1}]`` after which it was
-        first non-finite.
-    """
-
-    def __init__(self, message, members=(), steps=()):
-        super().__init__(message)
-        self.members = tuple(members)
-        self.steps = tuple(steps)
-
-
-@dataclass(frozen=True, eq=False)
-class Solution:
-    """Result of :func:`solve`.
-
-    Attributes
-    ----------
-    times : ndarray, shape ``(K,)``
-        The saved times (all grid times by default).
-    states : ndarray, shape ``(..., K, e)``
-        The solution at ``times``; leading axes are the broadcast batch of driver and ``y0``.
-    failed_step : ndarray of int, shape ``(...)``
-        Per batch member, the index of the step after which it first became non-finite, ``-1`` for
-        a healthy member (all ``-1`` unless ``on_failure="mask"`` kept a batch with failures). The
-        states of a failed member are NaN from that step on.
-    stats : dict
-        ``solver``, ``n_steps``, ``n_blocks``, ``batch_shape``, ``wall_time`` (seconds).
-    """
-
-    times: np.ndarray
-    states: np.ndarray
-    failed_step: np.ndarray = None
-    stats: dict = field(default_factory=dict)
-
-    @property
-    def final(self) -> np.ndarray:
-        """The state at the last saved time, shape ``(..., e)``."""
-        return self.states[..., -1, :]
-
-    def __eq__(self, other) -> bool:
-        """Equal times, states and failed steps (entry by entry, NaN equal) and equal ``stats``."""
-        if not isinstance(other, Solution):
-            return NotImplemented
-        return (arrays_equal(self.times, other.times) and arrays_equal(self.states, other.states)
-                and arrays_equal(self.failed_step, other.failed_step) and self.stats == other.stats)
-
-    __hash__ = None
-
-    @property
-    def failed(self) -> np.ndarray:
-        """Boolean mask ``(...)`` of the batch members that became non-finite."""
-        if self.failed_step is None:
-            return np.zeros(self.states.shape[:-2], dtype=bool)
-        return self.failed_step >= 0
-
-    def __repr__(self) -> str:
-        return (f"Solution(times: {self.times.shape}, states: {self.states.shape}, "
-                f"solver={self.stats.get('solver')!r})")
 
 
 def _resolve_solver(solver) -> Solver:
@@ -120,26 +55,8 @@ def _resolve_solver(solver) -> Solver:
     return solver
 
 
-def _failure_message(failed_step, times, batch) -> tuple:
-    members = [tuple(int(i) for i in idx) for idx in np.argwhere(failed_step >= 0)]
-    steps = [int(failed_step[m]) for m in members]
-    first = int(np.argmin(steps))
-    k, m = steps[first], members[first]
-    msg = (f"the solution became non-finite at step {k} (t = {float(times[k + 1]):.6g}, step from "
-           f"t = {float(times[k]):.6g}) for batch member {m}")
-    if len(members) > 1:
-        shown = ", ".join(f"{mm} at step {kk}" for mm, kk in zip(members[:8], steps[:8]))
-        more = f" and {len(members) - 8} more" if len(members) > 8 else ""
-        msg += (f"; {len(members)} of {int(np.prod(batch, dtype=np.int64))} members failed: "
-                f"{shown}{more}")
-    msg += ("; the vector fields may blow up there, or the step is too large: refine the driver's "
-            "grid. Pass on_failure='mask' to keep the healthy members' results (Solution.failed marks "
-            "the others).")
-    return msg, members, steps
-
-
 def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_failure="raise",
-          block_steps=None, executor=None, chunks=None) -> Solution:
+          block_steps=None, executor=None, chunks=None, step_control=None) -> Solution:
     r"""Solve the RDE :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i`, :math:`Y_{t_0} = y_0`, on the driver's grid.
 
     Parameters
@@ -150,9 +67,10 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         accept a ``LiePoissonSystem``. Driving field ``i`` of the API (``0``-based) is
         :math:`V_{i+1}` of the maths; the maths' :math:`V_0` is the drift. The object must have
         ``dim_state`` (``e``) and ``dim_noise`` (``d``).
-    driver : RoughPath, RoughPathN or Driver
+    driver : RoughPath, RoughPathN, Driver or BrownianTree
         Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.Driver` is
-        consumed block by block (memory for one block). Level 2 for level-2 solvers, a
+        consumed block by block (memory for one block). A :class:`~roughpaths.BrownianTree` is
+        solved on ``[tree.t0, tree.t1]`` with adaptive steps (``step_control``). Level 2 for level-2 solvers, a
         :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``).
         Convention: area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
     y0 : array_like, shape ``(..., e)``
@@ -164,7 +82,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     drift : callable, matrix ``(e, e)`` or LinearDrift, optional
         Extra drift added to :math:`V_0`, e.g. ``fields.friz_oberhauser_drift(s)`` (vector fields only).
     save_at : "all", "end" or array_like of grid times
-        Which states to keep (default all ``N + 1``).
+        Which states to keep (default all ``N + 1``; with adaptive steps every accepted step, or the
+        given times in ``[t0, t1]``, which the steps then hit).
     on_failure : "raise" or "mask"
         What to do when batch members become non-finite: raise :class:`NonFiniteStateError` naming every
         failed member and its step (default), or finish the healthy members and return them, with
@@ -181,6 +100,12 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         module-level functions do). A lazy driver must offer ``select(paths)``.
     chunks : int, optional
         Number of groups for ``executor`` (default ``min(members, 4 × CPU count)``).
+    step_control : PIController, optional
+        Adaptive steps, for a :class:`~roughpaths.BrownianTree` driver and an order-1 solver (``Davie``,
+        ``LogODE``, a coadjoint ``LieHeun``): step doubling on the same tree, the steps shared by the
+        batch (:mod:`roughpaths.rde.adaptive`; ``docs/adaptive-steps.md``). ``Solution.stats`` then holds
+        ``accepted``, ``rejected`` and ``at_dt_min``. Fixed steps (``None``) need a grid: a
+        ``RoughPath``, a ``Driver``, or ``tree.rough_path(times)``.
 
     Returns
     -------
@@ -219,8 +144,20 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     if executor is not None:
         return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
                             on_failure=on_failure, block_steps=block_steps)
-    if not isinstance(driver, (RoughPath, RoughPathN, Driver)):
-        raise TypeError(f"driver must be a RoughPath, a RoughPathN or a Driver (e.g. roughpaths.BrownianDriver), "
+    if isinstance(driver, BrownianTree):
+        if step_control is None:
+            raise ValueError("a BrownianTree driver needs adaptive steps: pass step_control=PIController(rtol, "
+                             "atol), or solve on a grid with driver=tree.rough_path(times).")
+        if executor is not None:
+            raise ValueError("executor= splits a batch solved on a fixed grid; adaptive steps are shared by the "
+                             "batch, so solve the tree serially (or one tree per process).")
+    elif step_control is not None:
+        raise ValueError(f"step_control needs a driver that answers on any interval, a roughpaths.BrownianTree; "
+                         f"got a {type(driver).__name__}, whose grid is fixed. Build BrownianTree(dim, seed=...) "
+                         f"or drop step_control.")
+    if not isinstance(driver, (RoughPath, RoughPathN, Driver, BrownianTree)):
+        raise TypeError(f"driver must be a RoughPath, a RoughPathN, a Driver (e.g. roughpaths.BrownianDriver) or a "
+                        f"BrownianTree, "
                         f"got {type(driver).__name__}; build a path with RoughPath.from_path(values, times=...) "
                         f"or RoughPath(increments, areas, times=...).")
     if on_failure not in ("raise", "mask"):
@@ -244,6 +181,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
             raise TypeError(f"drift= is for vector fields; {type(fields).__name__} takes its drift from "
                             f"its own definition.")
         fields = fields.with_drift(drift)
+    if step_control is not None:
+        return solve_adaptive(fields, driver, y, solver, step_control, save_at, on_failure, batch)
 
     times = np.asarray(driver.times)
     n = driver.n_steps

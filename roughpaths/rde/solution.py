@@ -1,0 +1,100 @@
+r"""The result of :func:`~roughpaths.solve`: :class:`Solution`, and :class:`NonFiniteStateError`.
+
+Shared by the fixed-step loop (:mod:`roughpaths.rde.integrate`) and the adaptive one
+(:mod:`roughpaths.rde.adaptive`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..validation import arrays_equal
+
+__all__ = ["Solution", "NonFiniteStateError"]
+
+
+class NonFiniteStateError(ValueError):
+    """Batch members of a :func:`solve` became non-finite.
+
+    Attributes
+    ----------
+    members : tuple of tuple of int
+        The batch indices of the failed members (all of them, in C order).
+    steps : tuple of int
+        For each failed member, the index ``k`` of the step ``[t_k, t_{k+1}]`` after which it was
+        first non-finite.
+    """
+
+    def __init__(self, message, members=(), steps=()):
+        super().__init__(message)
+        self.members = tuple(members)
+        self.steps = tuple(steps)
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """Result of :func:`solve`.
+
+    Attributes
+    ----------
+    times : ndarray, shape ``(K,)``
+        The saved times (all grid times by default).
+    states : ndarray, shape ``(..., K, e)``
+        The solution at ``times``; leading axes are the broadcast batch of driver and ``y0``.
+    failed_step : ndarray of int, shape ``(...)``
+        Per batch member, the index of the step after which it first became non-finite, ``-1`` for
+        a healthy member (all ``-1`` unless ``on_failure="mask"`` kept a batch with failures). The
+        states of a failed member are NaN from that step on.
+    stats : dict
+        ``solver``, ``n_steps``, ``n_blocks``, ``batch_shape``, ``wall_time`` (seconds).
+    """
+
+    times: np.ndarray
+    states: np.ndarray
+    failed_step: np.ndarray = None
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def final(self) -> np.ndarray:
+        """The state at the last saved time, shape ``(..., e)``."""
+        return self.states[..., -1, :]
+
+    def __eq__(self, other) -> bool:
+        """Equal times, states and failed steps (entry by entry, NaN equal) and equal ``stats``."""
+        if not isinstance(other, Solution):
+            return NotImplemented
+        return (arrays_equal(self.times, other.times) and arrays_equal(self.states, other.states)
+                and arrays_equal(self.failed_step, other.failed_step) and self.stats == other.stats)
+
+    __hash__ = None
+
+    @property
+    def failed(self) -> np.ndarray:
+        """Boolean mask ``(...)`` of the batch members that became non-finite."""
+        if self.failed_step is None:
+            return np.zeros(self.states.shape[:-2], dtype=bool)
+        return self.failed_step >= 0
+
+    def __repr__(self) -> str:
+        return (f"Solution(times: {self.times.shape}, states: {self.states.shape}, "
+                f"solver={self.stats.get('solver')!r})")
+
+
+def _failure_message(failed_step, times, batch) -> tuple:
+    members = [tuple(int(i) for i in idx) for idx in np.argwhere(failed_step >= 0)]
+    steps = [int(failed_step[m]) for m in members]
+    first = int(np.argmin(steps))
+    k, m = steps[first], members[first]
+    msg = (f"the solution became non-finite at step {k} (t = {float(times[k + 1]):.6g}, step from "
+           f"t = {float(times[k]):.6g}) for batch member {m}")
+    if len(members) > 1:
+        shown = ", ".join(f"{mm} at step {kk}" for mm, kk in zip(members[:8], steps[:8]))
+        more = f" and {len(members) - 8} more" if len(members) > 8 else ""
+        msg += (f"; {len(members)} of {int(np.prod(batch, dtype=np.int64))} members failed: "
+                f"{shown}{more}")
+    msg += ("; the vector fields may blow up there, or the step is too large: refine the driver's "
+            "grid. Pass on_failure='mask' to keep the healthy members' results (Solution.failed marks "
+            "the others).")
+    return msg, members, steps
