@@ -141,9 +141,6 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     fields = solver.check_fields(fields)
     if block_steps is not None:
         block_steps = check_positive_int(block_steps, "block_steps")
-    if executor is not None:
-        return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
-                            on_failure=on_failure, block_steps=block_steps)
     if isinstance(driver, BrownianTree):
         if step_control is None:
             raise ValueError("a BrownianTree driver needs adaptive steps: pass step_control=PIController(rtol, "
@@ -155,6 +152,9 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         raise ValueError(f"step_control needs a driver that answers on any interval, a roughpaths.BrownianTree; "
                          f"got a {type(driver).__name__}, whose grid is fixed. Build BrownianTree(dim, seed=...) "
                          f"or drop step_control.")
+    if executor is not None:
+        return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
+                            on_failure=on_failure, block_steps=block_steps)
     if not isinstance(driver, (RoughPath, RoughPathN, Driver, BrownianTree)):
         raise TypeError(f"driver must be a RoughPath, a RoughPathN, a Driver (e.g. roughpaths.BrownianDriver) or a "
                         f"BrownianTree, "

@@ -1,0 +1,146 @@
+"""Adaptive steps on a Brownian tree: strong order 1 in the tolerance, no bias from rejections.
+
+Theorem checked (numerically): with ``PIController(rtol, atol)`` bounding the predicted global error
+``sqrt(T/h)·|y_2 - y_1|`` (step doubling), an order-1 scheme on non-commuting noise has strong error
+proportional to the tolerance. The reference is a fine *fixed-step* solve on the *same* tree (same Brownian
+path), so the error measured is the scheme's, not a difference of paths. An error-per-step rule would give a
+slope of 2/3; the fit must lie near 1.
+"""
+
+import numpy as np
+import pytest
+
+import roughpaths as rp
+
+M = 0.3 * np.random.default_rng(3).standard_normal((2, 3, 3))       # non-commuting
+Y0 = np.ones(3)
+
+
+def _rms(a, b):
+    return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
+
+
+def _order_ladder(paths, rtols, ref_steps, seed):
+    V = rp.LinearVectorFields(M)
+    assert np.abs(M[0] @ M[1] - M[1] @ M[0]).max() > 0.05
+    tree = rp.BrownianTree(2, seed=seed, batch_shape=(paths,))
+    ref = rp.solve(V, tree.rough_path(np.linspace(0.0, 1.0, ref_steps + 1)), Y0, rp.Davie(), save_at="end").final
+    errs, steps = [], []
+    for rtol in rtols:
+        sol = rp.solve(V, tree, Y0, rp.Davie(), step_control=rp.PIController(rtol, rtol), save_at="end")
+        errs.append(_rms(sol.final, ref))
+        steps.append(sol.stats["accepted"])
+    slope = np.polyfit(np.log(rtols), np.log(errs), 1)[0]
+    return slope, errs, steps
+
+
+def test_strong_error_is_proportional_to_rtol():
+    slope, errs, steps = _order_ladder(32, [1e-1, 3e-2, 1e-2], 2 ** 12, seed=11)
+    assert max(steps) * 8 <= 2 ** 12, steps                   # the reference is much finer than any solve
+    assert 0.8 <= slope <= 1.25, (slope, errs)
+    assert errs[-1] < 5e-2 * 1.0
+
+
+@pytest.mark.slow
+def test_strong_error_is_proportional_to_rtol_full():
+    slope, errs, steps = _order_ladder(128, [1e-1, 3e-2, 1e-2, 3e-3, 1e-3], 2 ** 15, seed=12)
+    assert max(steps) * 8 <= 2 ** 15, steps
+    assert 0.85 <= slope <= 1.15, (slope, errs)
+
+
+def test_accepted_path_is_the_trees_path():
+    """Rejected attempts leave no trace: the adaptive answer is a fixed-step solve on the accepted steps' halves."""
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=4, batch_shape=(5,))
+    sol = rp.solve(V, tree, Y0, rp.Davie(), step_control=rp.PIController(2e-2, 2e-2))
+    assert sol.stats["rejected"] > 0 and sol.stats["accepted"] == sol.times.size - 1
+    t = sol.times
+    grid = np.empty(2 * t.size - 1)
+    grid[0::2] = t
+    grid[1::2] = 0.5 * (t[:-1] + t[1:])
+    fixed = rp.solve(V, rp.BrownianTree(2, seed=4, batch_shape=(5,)).rough_path(grid), Y0, rp.Davie())
+    np.testing.assert_allclose(sol.states, fixed.states[:, 0::2], rtol=0, atol=1e-12)
+
+
+def test_answers_do_not_depend_on_earlier_queries():
+    V = rp.LinearVectorFields(M)
+    ctrl = rp.PIController(3e-2, 3e-2)
+    a = rp.solve(V, rp.BrownianTree(2, seed=9, batch_shape=(3,)), Y0, rp.Davie(), step_control=ctrl)
+    tree = rp.BrownianTree(2, seed=9, batch_shape=(3,))
+    tree.area(0.123, 0.777)
+    tree.rough_path(np.linspace(0.0, 1.0, 7))
+    b = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl)
+    c = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl)
+    assert np.array_equal(a.states, b.states) and np.array_equal(b.states, c.states)
+    assert np.array_equal(a.times, b.times)
+
+
+def test_save_at_times_are_hit_and_logode_runs():
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=2, batch_shape=(4,))
+    save = [0.0, 0.3, 0.71, 1.0]
+    sol = rp.solve(V, tree, Y0, rp.LogODE(), step_control=rp.PIController(1e-2, 1e-2), save_at=save)
+    np.testing.assert_allclose(sol.times, save, atol=1e-12)
+    assert sol.states.shape == (4, 4, 3)
+    np.testing.assert_array_equal(sol.states[:, 0], np.broadcast_to(Y0, (4, 3)))
+    end = rp.solve(V, tree, Y0, rp.LogODE(), step_control=rp.PIController(1e-2, 1e-2), save_at="end")
+    assert end.times.tolist() == [1.0] and end.states.shape == (4, 1, 3)
+
+
+def test_time_dependent_burst_gets_small_steps():
+    """Steps shrink where the noise bursts: the accepted steps inside the burst are much shorter than outside."""
+    def sig(t):
+        return 0.2 + 2.0 * np.exp(-((t - 0.5) / 0.03) ** 2)
+
+    V = rp.VectorFields(lambda t, y: sig(t) * np.einsum("iab,...b->...ai", M, y),
+                        lambda t, y: np.broadcast_to(sig(t) * M, y.shape[:-1] + M.shape),
+                        dim_state=3, dim_noise=2, time_dependent=True)
+    tree = rp.BrownianTree(2, seed=1, batch_shape=(8,))
+    sol = rp.solve(V, tree, Y0, rp.Davie(), step_control=rp.PIController(1e-2, 1e-2, dt_max=1 / 32))
+    h = np.diff(sol.times)
+    mid = 0.5 * (sol.times[:-1] + sol.times[1:])
+    inside, outside = h[np.abs(mid - 0.5) < 0.03], h[np.abs(mid - 0.5) > 0.2]
+    assert inside.size and outside.size
+    assert np.median(inside) * 4 < np.median(outside)
+
+
+def test_non_finite_members_are_reported_or_masked():
+    V = rp.VectorFields(lambda y: np.stack([y ** 3, 0.0 * y], axis=-1),            # V_1 = y³, V_2 = 0
+                        lambda y: np.stack([3 * y ** 2, 0.0 * y], axis=-2)[..., None],
+                        dim_state=1, dim_noise=2)
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
+    y0 = np.array([[0.1], [40.0], [0.2]])
+    ctrl = rp.PIController(1e-1, 1e-1, dt_min=2.0 ** -12)
+    with pytest.raises(rp.NonFiniteStateError) as info:
+        rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl)
+    assert info.value.members == ((1,),)
+    sol = rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl, on_failure="mask")
+    assert sol.failed.tolist() == [False, True, False]
+    assert np.all(np.isfinite(sol.final[[0, 2]])) and np.isnan(sol.final[1]).all()
+
+
+def test_bad_input_names_the_fix():
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=0)
+    ctrl = rp.PIController(1e-2, 1e-2)
+    with pytest.raises(ValueError, match="step_control=PIController"):
+        rp.solve(V, tree, Y0, rp.Davie())
+    X = tree.rough_path([0.0, 0.5, 1.0])
+    with pytest.raises(ValueError, match="BrownianTree"):
+        rp.solve(V, X, Y0, rp.Davie(), step_control=ctrl)
+    with pytest.raises(ValueError, match="order-1"):
+        rp.solve(V, tree, Y0, rp.Euler(), step_control=ctrl)
+    with pytest.raises(TypeError, match="PIController"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=1e-3)
+    with pytest.raises(ValueError, match="max_steps"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=rp.PIController(1e-6, 0.0, max_steps=20))
+    with pytest.raises(ValueError, match="lie in the tree"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, save_at=[0.5, 1.5])
+    with pytest.raises(ValueError, match="executor"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, executor=object())
+    with pytest.raises(ValueError, match="both 0"):
+        rp.PIController(0.0, 0.0)
+    with pytest.raises(ValueError, match="factor_min"):
+        rp.PIController(1e-3, 1e-3, factor_min=2.0)
+    with pytest.raises(ValueError, match="dt_min"):
+        rp.PIController(1e-3, 1e-3, dt_min=0.5, dt_max=0.1)
