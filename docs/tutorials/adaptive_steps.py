@@ -74,10 +74,10 @@ def sigma(t):
 burst = rp.VectorFields(lambda t, y: sigma(t) * np.einsum("iab,...b->...ai", M, y),
                         lambda t, y: np.broadcast_to(sigma(t) * M, y.shape[:-1] + M.shape),
                         dim_state=3, dim_noise=2, time_dependent=True)
-inner = 15 if SMALL else 17
+inner, tol = (14, 1e-2) if SMALL else (17, 3e-3)
 grid = np.unique(np.concatenate([np.linspace(0, 1, 2 ** 12 + 1), np.arange(0.375, 0.625, 2.0 ** -inner)]))
 ref = rp.solve(burst, tree.rough_path(grid), Y0, rp.Davie(), save_at="end").final
-sol = rp.solve(burst, tree, Y0, rp.Davie(), step_control=rp.PIController(3e-3, 3e-3, dt_max=1 / 64))
+sol = rp.solve(burst, tree, Y0, rp.Davie(), step_control=rp.PIController(tol, tol, dt_max=1 / 64))
 h = np.diff(sol.times)
 mid = 0.5 * (sol.times[1:] + sol.times[:-1])
 print(f"median step inside the burst {np.median(h[np.abs(mid - 0.5) < 0.02]):.1e}, "

@@ -289,13 +289,47 @@ class BrownianTree:
         t = as_float_array(times, "times", ndim=1)
         if t.size < 2 or not np.all(np.diff(t) > 0):
             raise ValueError(f"times must be a strictly increasing 1-D array of at least 2 points, got {t!r}.")
-        idx = [self._index(v, "times") for v in t]
-        P, d, n = self.n_paths, self.dim, t.size - 1
+        idx = np.array([self._index(v, "times") for v in t], dtype=np.int64)
+        if not np.all(np.diff(idx) > 0):
+            raise ValueError(f"times are closer than the tree's resolution (t1 - t0)·2^-{self.resolution}; "
+                             f"drop the duplicates or build the tree with a larger resolution.")
+        W, A = self._cells(idx)
+        return self._out(W), self._out(A)
+
+    def _cells(self, idx):
+        """``(W (P, n, d), A (P, n, d, d))`` of the cells ``[idx[k], idx[k+1])`` in one walk of the tree.
+
+        The walk splits exactly the nodes that hold a grid point strictly inside, so each cell is the Chen
+        product of the same canonical nodes as in :meth:`_chen`, in the same order: the answers are
+        bitwise those of :meth:`_chen` cell by cell, without walking down from the root once per cell.
+        """
+        P, d, L = self.n_paths, self.dim, self.resolution
+        n = idx.size - 1
+        if self._root_node is None:
+            self._root_node = self._root()
+        parts = [[] for _ in range(n)]
+        stack = [(0, 0, self._root_node)]
+        first, last = int(idx[0]), int(idx[-1])
+        while stack:
+            depth, index, node = stack.pop()
+            size = 1 << (L - depth)
+            lo, hi = index * size, (index + 1) * size
+            if hi <= first or lo >= last:
+                continue
+            k = int(np.searchsorted(idx, lo, side="right"))     # first grid point > lo
+            if k > n or idx[k] >= hi:                           # none strictly inside: within cell k - 1
+                parts[k - 1].append(_reduce(node))
+                continue
+            left, right = self._children(depth, index, node)
+            stack.append((depth + 1, 2 * index + 1, right))
+            stack.append((depth + 1, 2 * index, left))
         W = np.empty((P, n, d))
         A = np.empty((P, n, d, d))
-        for k in range(n):
-            W[:, k], A[:, k] = self._chen(idx[k], idx[k + 1])
-        return self._out(W), self._out(A)
+        for c, nodes in enumerate(parts):
+            Wk = np.stack([w for w, _ in nodes], axis=1)
+            W[:, c] = Wk.sum(axis=1)
+            A[:, c] = sum(a for _, a in nodes) + polygon_area(Wk)
+        return W, A
 
     def rough_path(self, times) -> RoughPath:
         """The tree on the grid ``times``: a geometric (Stratonovich) :class:`~roughpaths.RoughPath`.
