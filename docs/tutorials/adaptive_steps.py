@@ -2,7 +2,7 @@
 
 Run with ``python docs/tutorials/adaptive_steps.py`` (``TUTORIAL_SMALL=1`` for reduced sizes).
 
-A :class:`roughpaths.BrownianTree` holds one Brownian path per batch member and answers its increment and
+A `roughpaths.BrownianTree` holds one Brownian path per batch member and answers its increment and
 Lévy area on any interval. ``solve(..., step_control=PIController(rtol, atol))`` uses that: it tries a
 step, estimates its error by step doubling, and on rejection asks the same tree about a shorter interval.
 The path never changes, so the error is measured against a fine fixed-step solve on the same tree.
@@ -90,7 +90,7 @@ assert e_unif > 2 * e_adapt
 
 # %% [markdown]
 # ## 4. The stochastic rigid body
-# The coadjoint ``LieHeun`` of :mod:`mechanics` takes the same ``step_control``; the Casimir ``|Π|`` is
+# The coadjoint ``LieHeun`` of ``mechanics`` takes the same ``step_control``; the Casimir ``|Π|`` is
 # kept to round-off whatever the steps.
 
 # %%
