@@ -162,7 +162,12 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
             raise ValueError(f"save_at times must be finite and lie in the tree's [t0, t1] = [{t0}, {t1}], got "
                              f"{save_at!r}.")
         snapped = {min(int(round((v - t0) / T * n_cells)), end) for v in st}
-        targets = sorted(snapped | {end})
+        marks = np.array(sorted(snapped | {0, end}))
+        if np.any(np.diff(marks) < 2):
+            raise ValueError(f"save_at has times closer than two cells of the tree's grid ((t1 - t0)·2^-{L - 1}) to "
+                             f"each other or to t0, t1; a step between them cannot be halved. Drop the near "
+                             f"duplicates.")
+        targets = sorted(snapped - {0} | {end})
     save_all = isinstance(save_at, str) and save_at == "all"
     save_idx = ({end} if save_at == "end" else set()) if isinstance(save_at, str) else snapped
     dt_min = control.dt_min if control.dt_min is not None else T * 2.0 ** -30
