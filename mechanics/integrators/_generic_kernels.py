@@ -43,7 +43,7 @@ import numba
 import numpy as np
 
 from roughpaths.validation import parallel_ranges
-from ._generic_member import DEGREE_THETA, chord1, exp1, velocity1
+from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1
 
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
@@ -273,17 +273,19 @@ def _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, to
                         finite_in = False
                 ok = False
                 chord_failed = False
-                if finite_in:
-                    if code == 2:
-                        velocity1(vm, q, lin, f, mth, theta, work[8][0], work[8][1], work[8][2], vo, ti, tj, tk,
-                                   tv)
-                        for i in range(n):
-                            vs[i] = vo[i] * dt + ve[i]
-                        chord_failed = not chord1(vm, ve, vs, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk,
-                                                   tv, cnorm, degth, work)
-                    if not chord_failed:
-                        ok = exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
-                                   cnorm, degth)
+                if finite_in and code == 2:              # dimensions 3 and 6: compiled variants (DIMS3/6)
+                    if n == 6:
+                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                     ti, tj, tk, tv, cnorm, degth, work, DIMS6)
+                    elif n == 3:
+                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                     ti, tj, tk, tv, cnorm, degth, work, DIMS3)
+                    else:
+                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                     ti, tj, tk, tv, cnorm, degth, work)
+                elif finite_in:
+                    ok = exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
+                              cnorm, degth)
                 if ok:
                     for i in range(n):
                         mu[i, p] = vo[i]
