@@ -1,9 +1,10 @@
-"""Benchmark: the coadjoint kernels — hand-written (so(3), se(3)) against the generic one, and threads (same run).
+"""Benchmark: the coadjoint kernels — built-in (so(3), se(3)) against the generic one, and threads (same run).
 
 Problems (driven by one precomputed Brownian rough path with its Lévy area, dt = 0.01, θ > 0):
 
 * the rigid body on so(3)* (I = diag(1, 2, 3), σ = 0.3, θ = 0.5) and the heavy top on se(3)*
-  (χ = (0.1, −0.2, 1), σ = 0.2, θ = 0.3), each solved by its hand-written kernel and by the generic
+  (χ = (0.1, −0.2, 1), σ = 0.2, θ = 0.3), each solved by its built-in kernel (hand-written for so(3), and
+  for the se(3) implicit midpoint; the generic one for se(3) Lie–Euler / Lie–Heun) and by the generic
   kernel on the *same* problem (the algebra rebuilt as a plain ``LieAlgebra`` from its own structure
   constants, so only the kernel differs);
 * su(2), sl(2, R) and so(4) (6-dimensional) with a diagonal inertia and three noise vectors: the generic
@@ -83,7 +84,7 @@ def main():
     solvers = (LieEuler(), LieHeun(), ImplicitMidpoint())
     print(f"{P} paths x {K} steps, dt = 0.01, with the Lévy area; {a.clock} time, medians of {a.repeats} "
           f"interleaved runs, one thread; ns per path-step")
-    print(f"{'algebra':10s} {'solver':18s} {'hand-written':>13s} {'generic':>9s} {'generic/hand':>13s} "
+    print(f"{'algebra':10s} {'solver':18s} {'built-in':>13s} {'generic':>9s} {'generic/built-in':>16s} "
           f"{'max rel diff':>13s} {'Casimir drift':>14s}")
     problems = {}
     for name, system in (("so(3)", rb), ("se(3)", top)):
@@ -99,8 +100,10 @@ def main():
             c0 = system.casimirs(mu0)[:, None]
             drift = float(np.max(np.abs(system.casimirs(sb) - c0) / np.maximum(1.0, np.abs(c0))))
             print(f"{name:10s} {repr(solver)[:18]:18s} {1e9 * th / (P * K):13.1f} {1e9 * tg / (P * K):9.1f} "
-                  f"{tg / th:13.2f} {diff:13.2e} {drift:14.2e}")
+                  f"{tg / th:16.2f} {diff:13.2e} {drift:14.2e}")
 
+    print("(se(3) Lie-Euler / Lie-Heun: the built-in heavy top runs the generic kernel too; the hand-written loop it "
+          "replaced measured 1.1x / 1.4x slower than the generic one)")
     print(f"\n{'algebra':10s} {'solver':18s} {'numpy':>13s} {'generic':>9s} {'numpy/generic':>13s} "
           f"{'max rel diff':>13s} {'Casimir drift':>14s}")
     save = np.ones(K, dtype=bool)
@@ -127,7 +130,7 @@ def main():
     print(f"{'problem':22s} {'wall 1':>8s} {'wall N':>8s} {'wall N/1':>9s} {'cpu 1':>8s} {'cpu N':>8s} "
           f"{'cpu N/1':>8s} {'caller N/cpu 1':>14s} {'bitwise':>8s}")
     for name, (hand, gen, mu0, X) in problems.items():
-        for label, system in (("hand-written", hand), ("generic", gen)):
+        for label, system in (("built-in", hand), ("generic", gen)):
             if system is None:
                 continue
             walls, cpus, outs = {1: [], all_threads: []}, {1: [], all_threads: []}, {}

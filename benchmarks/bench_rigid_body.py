@@ -18,12 +18,15 @@ sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scale
 Reported: median wall (or, with ``--clock cpu``, process CPU) time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
 max ||Π(T)| - 1| over the paths, and ratios peer / ours.
 
+Then the cost of Davie's area (issue 24, item 4): a path-step of the full solve and of the driver alone with
+the area and without it, CPU time, interleaved runs, and the ratio (target <= 1.6).
+
 Last, one thread against all of numba's threads on the full solve (driver included, ``n_paths`` x 1,000
 steps), with and without the area: wall, CPU, and the calling thread's CPU time (the idle-machine wall
 estimate on a shared machine), with a bitwise check.
 
 Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R] [--clock wall|cpu]
-[--skip diffrax,torchsde,sdeint] [--threads-only]``.
+[--skip diffrax,torchsde,sdeint] [--threads-only] [--area-only]``.
 """
 
 from __future__ import annotations
@@ -216,6 +219,52 @@ def bench_sdeint(n_paths, n_steps, repeats):
     return _median_time(run, repeats)
 
 
+def bench_area_ratio(n_paths, n_steps, repeats):
+    """The cost of Davie's area: a path-step with the area against one without (issue 24, item 4; target <= 1.6x).
+
+    The full solve (driver sampling included, LieHeun, ``save_at="end"``) and the driver alone, with
+    ``levy_area="davie"`` and ``None``, in process CPU time, as interleaved runs (with, without, with, ...);
+    medians per configuration, and the median of the per-pair ratios.
+    """
+    from mechanics import LieHeun, rigid_body
+    from roughpaths import BrownianDriver, solve
+
+    rb = rigid_body(INERTIA, sigma=SIGMA, theta=THETA)
+    mu0 = np.array([0.0, 0.0, 1.0])
+
+    def driver(area):
+        return BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,), levy_area=area)
+
+    def run_solve(area):
+        return solve(rb, driver(area), mu0, LieHeun(), save_at="end").final
+
+    def run_driver(area):
+        for _ in driver(area).blocks():
+            pass
+
+    cfg = [("solve", run_solve, "davie"), ("solve", run_solve, None), ("driver", run_driver, "davie"),
+           ("driver", run_driver, None)]
+    for _, fn, area in cfg:
+        fn(area)
+    times = {i: [] for i in range(len(cfg))}
+    for _ in range(repeats):
+        for i, (_, fn, area) in enumerate(cfg):
+            t0 = time.process_time()
+            fn(area)
+            times[i].append(time.process_time() - t0)
+    ns = {i: 1e9 * statistics.median(t) / (n_paths * n_steps) for i, t in times.items()}
+    pair = statistics.median(a / b for a, b in zip(times[0], times[1]))
+    print(f"area cost: {n_paths} x {n_steps}, LieHeun, CPU time (all threads), medians of {repeats} interleaved runs, "
+          f"ns per path-step")
+    print(f"  {'':22s} {'Davie area':>10s} {'no area':>8s} {'ratio':>6s}")
+    print(f"  {'full solve':22s} {ns[0]:10.1f} {ns[1]:8.1f} {ns[0] / ns[1]:6.2f}   (median of pair ratios {pair:.2f}; "
+          f"target <= 1.6)")
+    print(f"  {'driver alone':22s} {ns[2]:10.1f} {ns[3]:8.1f} {ns[2] / ns[3]:6.2f}")
+    print(f"  {'solver (solve - driver)':22s} {ns[0] - ns[2]:10.1f} {ns[1] - ns[3]:8.1f} "
+          f"{(ns[0] - ns[2]) / (ns[1] - ns[3]):6.2f}")
+    return ns[0] / ns[1]
+
+
 def bench_threads(n_paths, n_steps, repeats):
     """One thread against all of numba's threads on the full solve (driver sampling included), interleaved.
 
@@ -269,6 +318,7 @@ def main(argv=None):
                          "shared machine; counts a peer's extra threads as cost)")
     ap.add_argument("--skip", default="", help="comma-separated peers to skip: diffrax,torchsde,sdeint")
     ap.add_argument("--threads-only", action="store_true", help="only the table of 1 thread against all")
+    ap.add_argument("--area-only", action="store_true", help="only the table of the area's cost (with / without)")
     args = ap.parse_args(argv)
     if args.clock == "cpu":
         _CLOCK[0] = time.process_time
@@ -277,6 +327,9 @@ def main(argv=None):
     skip = set(filter(None, args.skip.split(",")))
     if args.threads_only:
         bench_threads(n_paths, min(n_steps, 1_000), max(args.repeats, 5))
+        return 0
+    if args.area_only:
+        bench_area_ratio(n_paths, min(n_steps, 2_000), max(args.repeats, 5))
         return 0
     print(f"rigid body: I = diag(1,2,3), theta = {THETA}, sigma = {SIGMA}, dt = {DT}, "
           f"{n_paths} paths x {n_steps} steps, float64, repeats = {args.repeats}, "
@@ -311,6 +364,7 @@ def main(argv=None):
     print("ratios (ns per path-step, peer / ours with Levy area):")
     for name, _, ns, _ in rows[1:]:
         print(f"  {name:32s} {ns / ours:8.2f}x")
+    bench_area_ratio(n_paths, min(n_steps, 2_000), max(args.repeats, 5))
     bench_threads(n_paths, min(n_steps, 1_000), max(args.repeats, 5))
     return 0
 

@@ -43,7 +43,7 @@ import numba
 import numpy as np
 
 from roughpaths.validation import parallel_ranges
-from ._generic_member import DEGREE_THETA, chord1, exp1, velocity1
+from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1
 
 OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
@@ -145,11 +145,40 @@ def _velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv
 
 
 @numba.njit(cache=True)
+def _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
+    """:func:`_eta_rows` for three noise components: the same sums in the same order (the same bits), the
+    loops over the components and pairs written out."""
+    n = e.shape[1]
+    for p in range(bc):
+        for kk in range(kc):
+            k = k0 + kk
+            x0 = dX[lo + p, k, 0]
+            x1 = dX[lo + p, k, 1]
+            x2 = dX[lo + p, k, 2]
+            if area:
+                a0 = 0.5 * (dXX[lo + p, k, 0, 1] - dXX[lo + p, k, 1, 0])
+                a1 = 0.5 * (dXX[lo + p, k, 0, 2] - dXX[lo + p, k, 2, 0])
+                a2 = 0.5 * (dXX[lo + p, k, 1, 2] - dXX[lo + p, k, 2, 1])
+            for i in range(n):
+                acc = 0.0 + x0 * xi[0, i]
+                acc += x1 * xi[1, i]
+                acc += x2 * xi[2, i]
+                if area:
+                    acc += a0 * brk[0, i]
+                    acc += a1 * brk[1, i]
+                    acc += a2 * brk[2, i]
+                e[kk, i, p] = acc
+
+
+@numba.njit(cache=True)
 def _eta_rows(dX, dXX, area, lo, bc, k0, kc, xi, brk, pi, pj, e):
     """e[kk, :, p] = Σ_r dX_r ξ_r + Σ_{i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for members lo .. lo+bc-1 and
     steps k0 .. k0+kc-1 (member by member, so each member's increments are read in order)."""
     n = e.shape[1]
     nm = dX.shape[2]
+    if nm == 3 and (not area or pi.shape[0] == 3):
+        _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e)
+        return
     for p in range(bc):
         for kk in range(kc):
             k = k0 + kk
@@ -273,17 +302,19 @@ def _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, to
                         finite_in = False
                 ok = False
                 chord_failed = False
-                if finite_in:
-                    if code == 2:
-                        velocity1(vm, q, lin, f, mth, theta, work[8][0], work[8][1], work[8][2], vo, ti, tj, tk,
-                                   tv)
-                        for i in range(n):
-                            vs[i] = vo[i] * dt + ve[i]
-                        chord_failed = not chord1(vm, ve, vs, dt, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk,
-                                                   tv, cnorm, degth, work)
-                    if not chord_failed:
-                        ok = exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
-                                   cnorm, degth)
+                if finite_in and code == 2:              # dimensions 3 and 6: compiled variants (DIMS3/6)
+                    if n == 6:
+                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                     ti, tj, tk, tv, cnorm, degth, work, DIMS6)
+                    elif n == 3:
+                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                     ti, tj, tk, tv, cnorm, degth, work, DIMS3)
+                    else:
+                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                     ti, tj, tk, tv, cnorm, degth, work)
+                elif finite_in:
+                    ok = exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
+                              cnorm, degth)
                 if ok:
                     for i in range(n):
                         mu[i, p] = vo[i]

@@ -2,7 +2,7 @@ r"""Compiled se(3) kernels of the coadjoint solvers (quadratic Hamiltonian): an 
 
 Selected by :meth:`~mechanics.integrators.base.CoadjointSolver.integrate` when the algebra is a
 :class:`~mechanics.systems.lie_algebra.SE3Algebra` and the Hamiltonian is quadratic (the heavy top), for
-Lie–Euler, Lie–Heun and the implicit midpoint rule (its chord iteration, :mod:`._chord`, with the
+the implicit midpoint rule only (its chord iteration, :mod:`._chord`, with the
 6×6 chord Jacobian inverted per member by Gauss–Jordan elimination with partial pivoting: a singular
 Jacobian fails that member alone). Same scheme as the numpy path; state ``μ = (Π, Γ)``, algebra element
 ``σ = (ω, v)``, :math:`\mathrm{ad}^*_{(\omega,v)}(\Pi,\Gamma) = (\Pi\times\omega + \Gamma\times v,\ \Gamma\times\omega)`
@@ -266,50 +266,11 @@ def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slo
 
 
 @numba.njit(cache=True, nogil=True)
-def _se3_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, minv, theta, save, out, first_bad, reason, stop,
-               lo, hi):
-    """Advance every member of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty); Lie–Euler
-    (code 0) or Lie–Heun (code 1). A failed member gets ``first_bad`` and ``reason``. Returns the
-    number of members that failed."""
-    nb, nk, nm = dX.shape
-    area = dXX.shape[0] > 0
-    mu, e, w0, w1, s = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
-    a1, a2, pred, g, t1, t2, new = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
-    nfail = 0
-    for p in range(lo, hi):
-        for i in range(6):
-            mu[i] = y[p, i]
-        slot = 0
-        for k in range(nk):
-            dt = dts[k]
-            _step_velocity(dX, dXX, p, k, xi, brk, pi, pj, area, e)
-            _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
-            for i in range(6):
-                s[i] = w0[i] * dt + e[i]
-            if code == 1:
-                _ad_star(s, mu, a1)
-                _ad_star(s, a1, a2)
-                for i in range(6):
-                    pred[i] = mu[i] + a1[i] + 0.5 * a2[i]
-                _velocity(pred, q, lin, f, minv, theta, g, t1, t2, w1)
-                for i in range(6):
-                    s[i] = 0.5 * (w0[i] + w1[i]) * dt + e[i]
-            _exp(s, mu, new)
-            finite, slot, nf = _finish_step(mu, new, True, True, p, k, first_bad, reason, save, out, slot)
-            nfail += nf
-            if stop and not finite:
-                break
-        for i in range(6):
-            y[p, i] = mu[i]
-    return nfail
-
-
-@numba.njit(cache=True, nogil=True)
 def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
                         first_bad, reason, stop, lo, hi):
-    """As :func:`_se3_block` for the implicit midpoint rule: sigma from the chord iteration
-    (:func:`_se3_chord`); a member whose iteration fails gets ``reason = CHORD_FAILED``. A separate
-    kernel, so that the explicit schemes do not compile the chord."""
+    """Advance members lo .. hi-1 of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty) by the implicit
+    midpoint rule: sigma from the chord iteration (:func:`_se3_chord`); a member whose iteration fails gets
+    ``reason = CHORD_FAILED``, a non-finite one NON_FINITE. Returns the number of members that failed."""
     nb, nk, nm = dX.shape
     area = dXX.shape[0] > 0
     mu, e, w0, s, g, t1, t2, new = (np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6),
@@ -353,11 +314,16 @@ BLOCK = 64
 
 
 def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
-    """Run the se(3) kernel on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d) or None.
+    """Run the se(3) implicit-midpoint kernel (``code`` 2) on ``y`` (B, 6) over ``dX`` (B, K, d), ``dXX`` (B, K, d, d)
+    or None.
 
     Returns ``(y, saved (B, S, 6), first_bad (B,), reason (B,))``. Blocks of :data:`BLOCK` members run in
-    parallel (:func:`roughpaths.validation.parallel_ranges`; ``numba.set_num_threads``).
+    parallel (:func:`roughpaths.validation.parallel_ranges`; ``numba.set_num_threads``). Lie–Euler and
+    Lie–Heun on se(3) run the generic kernel (:mod:`._generic_kernels`), which measured faster there.
     """
+    if code != 2:
+        raise ValueError(f"the se(3) kernel runs the implicit midpoint rule (code 2) only, got code {code}; "
+                         f"Lie-Euler and Lie-Heun use mechanics.integrators._generic_kernels.")
     data = system.quadratic_velocity_data()
     nb = y.shape[0]
     nm = dX.shape[-1]
@@ -372,9 +338,6 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     consts = (data["q"], np.ascontiguousarray(data["linear"]), np.ascontiguousarray(data["dissipation_change"]),
               data["metric_inv"], float(data["theta"]))
     tail = (np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
-    if code == 2:
-        parallel_ranges(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
-                   nb, BLOCK)
-    else:
-        parallel_ranges(lambda lo, hi: _se3_block(*args, int(code), *consts, *tail, lo, hi), nb, BLOCK)
+    parallel_ranges(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
+                    nb, BLOCK)
     return y, out, first_bad, reason

@@ -38,7 +38,9 @@ discrete Proposition 2.1.
 Implementation: a system with a quadratic Hamiltonian and no forces runs compiled block kernels:
 for a :class:`~mechanics.systems.lie_algebra.SO3Algebra` the hand-written ones of
 :mod:`mechanics.integrators._so3_kernels`, for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy
-top) those of :mod:`mechanics.integrators._se3_kernels`, and for every other algebra the generic kernel of
+top) and the implicit midpoint rule that of :mod:`mechanics.integrators._se3_kernels` (Lie–Euler and
+Lie–Heun on se(3) measured faster in the generic kernel, ``benchmarks/bench_coadjoint_kernels.py``), and
+otherwise the generic kernel of
 :mod:`mechanics.integrators._generic_kernels`, compiled once for all algebras (the structure constants are
 data: su(2), sl(2, R), so(4), semidirect products, a user's basis). Otherwise (forces, a non-quadratic
 Hamiltonian) a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3), :func:`roughpaths.expm_batched`
@@ -217,9 +219,11 @@ class CoadjointSolver(Solver):
             y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
             first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
         elif plain:
-            # se(3) (the heavy top): the hand-written kernel; every other algebra: the generic one
-            kernels = _se3_kernels if isinstance(system.algebra, SE3Algebra) else _generic_kernels
-            run = _se3_kernels.integrate_se3 if kernels is _se3_kernels else _generic_kernels.integrate_generic
+            # se(3) (the heavy top): the hand-written kernel for the implicit midpoint rule; every other case
+            # (se(3) Lie-Euler / Lie-Heun included, where it measured faster): the generic one
+            hand = isinstance(system.algebra, SE3Algebra) and self._code == 2
+            kernels = _se3_kernels if hand else _generic_kernels
+            run = _se3_kernels.integrate_se3 if hand else _generic_kernels.integrate_generic
             nb = int(np.prod(batch, dtype=np.int64))
             d = dX.shape[-1]
             dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
