@@ -159,6 +159,7 @@ class BrownianTree:
         self.cache_size = check_positive_int(cache_size, "cache_size", minimum=0)
         self._cache: OrderedDict = OrderedDict()
         self._root_node = None
+        self._paths = np.arange(self.n_paths, dtype=np.int64)
 
     def __repr__(self) -> str:
         return (f"BrownianTree(dim={self.dim}, t0={self.t0}, t1={self.t1}, batch_shape={self.batch_shape}, "
@@ -170,12 +171,58 @@ class BrownianTree:
         """Nodes held in the cache now (never more than ``cache_size``)."""
         return 2 * len(self._cache)
 
+    def select(self, paths):
+        """A tree of some of this tree's paths, bitwise equal to those paths of this one.
+
+        Parameters
+        ----------
+        paths : slice, range or array_like of int
+            Flat indices into this tree's batch (C order).
+
+        Returns
+        -------
+        BrownianTree
+            ``batch_shape == (len(paths),)``, the same seed and settings, an empty cache. Member ``k`` answers
+            every query as member ``paths[k]`` of this tree does, so each member can be solved with steps of
+            its own (``solve(..., tree.select([i]), ..., step_control=...)``).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> tree = BrownianTree(2, seed=3, batch_shape=(4,))
+        >>> bool(np.array_equal(tree.select([2]).area(0.1, 0.3)[0], tree.area(0.1, 0.3)[2]))
+        True
+        """
+        n = self.n_paths
+        if isinstance(paths, slice):
+            idx = np.arange(n)[paths]
+        else:
+            if isinstance(paths, range):
+                paths = np.arange(paths.start, paths.stop, paths.step)
+            idx = np.asarray(paths)
+            if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
+                raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, "
+                                f"got {paths!r}.")
+            if idx.size and (idx.min() < -n or idx.max() >= n):
+                raise ValueError(f"paths holds indices outside [0, {n}) (this tree has {n} paths), "
+                                 f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
+            idx = np.where(idx < 0, idx + n, idx).astype(np.int64)
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new._paths = self._paths[idx]
+        new.batch_shape = (int(idx.size),)
+        new.n_paths = int(idx.size)
+        new.node_bytes = max(1, new.n_paths) * self.node_bytes // max(1, self.n_paths)
+        new._cache = OrderedDict()
+        new._root_node = None
+        return new
+
     # ------------------------------------------------------------------ nodes
     def _streams(self, tag, depth, index):
         P = self.n_paths
         keys = np.empty((P, 5), dtype=np.int64)
         keys[:, 0] = tag
-        keys[:, 1] = np.arange(P)
+        keys[:, 1] = self._paths
         keys[:, 2] = depth
         keys[:, 3] = index >> 32
         keys[:, 4] = index & 0xFFFFFFFF

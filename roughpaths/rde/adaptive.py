@@ -21,8 +21,8 @@ error :math:`\epsilon` give a global error :math:`\sqrt{T/h}\,\epsilon`; the con
 the predicted global error in units of the tolerance (``T = t1 - t0``). Since :math:`r \propto h`, the
 steps shrink in proportion to the tolerance and the strong error of an order-1 scheme is proportional to
 ``rtol`` (an error-per-step rule, :math:`\epsilon \le \mathrm{tol}`, would give ``rtol^(2/3)``).
-The steps are shared by the batch: the norm is the maximum over its members (solve one member per call
-for steps of its own).
+The steps are shared by the batch: the norm is the maximum over its members (for steps of its own,
+solve member ``i`` on ``tree.select([i])``, which answers bitwise as member ``i`` does).
 
 The step size
 -------------

@@ -191,3 +191,20 @@ def test_compiled_split_matches_the_numpy_reference_and_keeps_chen():
         W, A = reduce_node(fine[:, n:], GR)                               # a non-contiguous view, as cached
         assert np.allclose(W, fine[:, n:].sum(axis=1), atol=1e-15)
         assert np.allclose(A, naive(fine[:, n:]) + GR, atol=1e-15)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_select_answers_bitwise_as_the_selected_members(dim):
+    tree = rp.BrownianTree(dim, seed=21, batch_shape=(2, 3))
+    sub = tree.select([4, 0, -1])
+    grid = np.array([0.0, 0.1234, 0.5, 0.71, 1.0])
+    W, A = tree.increments_and_levy_areas(grid)
+    w, a = sub.increments_and_levy_areas(grid)
+    flat_W, flat_A = W.reshape(6, 4, dim), A.reshape(6, 4, dim, dim)
+    assert np.array_equal(w, flat_W[[4, 0, 5]]) and np.array_equal(a, flat_A[[4, 0, 5]])
+    assert np.array_equal(sub.area(0.3, 0.31), tree.area(0.3, 0.31).reshape(6, dim, dim)[[4, 0, 5]])
+    assert sub.batch_shape == (3,)
+    with pytest.raises(ValueError, match="outside"):
+        tree.select([6])
+    with pytest.raises(TypeError, match="integer"):
+        tree.select([0.5])
