@@ -239,8 +239,9 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
                 if save_all or i in save_idx:
                     saved_t.append(t_acc[-1])
                     saved_y.append(y.copy())
-                    check_memory(8.0 * members * e * len(saved_t), f"the saved states ({len(saved_t)} times so far)",
-                                 "save fewer times (save_at='end' or an array of times)")
+                    if len(saved_t) & (len(saved_t) - 1) == 0:       # at every doubling: the budget read is slow
+                        check_memory(16.0 * members * e * len(saved_t), f"the saved states ({len(saved_t)} times "
+                                     f"so far, and growing)", "save fewer times (save_at='end' or an array of times)")
                 f = control._factor(r, r_prev, after_reject)
                 r_prev, after_reject = max(r, 1e-10), False
             else:
