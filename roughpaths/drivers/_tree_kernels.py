@@ -46,9 +46,10 @@ import numpy as np
 from numba import njit
 
 from ._bridge import _pair_solve
+from ._random import _entropy_words, _fast_streams_ok, _pcg64_normals, _pcg64_seed, _seed_states, _uint32_words
 
 __all__ = ["split_width", "refine_segments", "refine_segments_fast", "polygon_area", "reduce_node",
-           "antisym_from_normals"]
+           "antisym_from_normals", "seed_prefix", "split_seeded"]
 
 
 def split_width(n: int, d: int) -> int:
@@ -324,3 +325,54 @@ def reduce_node(w, G):
     A = np.empty((P, d, d))
     _reduce_nb(w, G, W, A)
     return W, A
+
+
+def seed_prefix(seed_seq):
+    """The entropy words every stream of ``seed_seq`` starts with (uint32), or None off the fast path.
+
+    A stream keyed by ``(tag, path, depth, index_hi, index_lo)`` hashes ``prefix + key`` (as
+    :class:`~roughpaths.drivers._random.PathStreams` does for keys of 32-bit words).
+    """
+    if seed_seq.pool_size != 4 or not _fast_streams_ok():
+        return None
+    run = _entropy_words(seed_seq)
+    run = run + [0] * max(0, 4 - len(run))
+    base = [w for v in seed_seq.spawn_key for w in _uint32_words(int(v))]
+    return np.array(run + base, dtype=np.uint32)
+
+
+@njit(cache=True, nogil=True)
+def _split_seeded_nb(prefix, paths, tag, depth, index, width, w, G, delta, fine, GL, GR):
+    P = w.shape[0]
+    m = prefix.size
+    ent = np.empty((P, m + 5), dtype=np.uint32)
+    for r in range(P):
+        for q in range(m):
+            ent[r, q] = prefix[q]
+        ent[r, m] = tag
+        ent[r, m + 1] = paths[r]
+        ent[r, m + 2] = depth
+        ent[r, m + 3] = index >> 32
+        ent[r, m + 4] = index & 0xFFFFFFFF
+    seeds = np.empty((P, 4), dtype=np.uint64)
+    _seed_states(ent, seeds)
+    states = np.empty((P, 4), dtype=np.uint64)
+    _pcg64_seed(seeds, states)
+    z = np.empty((P, width))
+    _pcg64_normals(states, z)
+    _refine_segments_nb(w, G, delta, z, fine, GL, GR)
+
+
+def split_seeded(prefix, paths, tag, depth, index, w, G, delta):
+    """:func:`refine_segments_fast` with the normals of stream ``(tag, path, depth, index)`` of each path.
+
+    One compiled call: the streams' seeding, their normals and the split (the same numbers as seeding
+    :class:`~roughpaths.drivers._random.PathStreams` with those keys and filling ``split_width`` normals).
+    """
+    P, n, d = w.shape
+    fine = np.empty((P, 2 * n, d))
+    GL = np.empty((P, d, d))
+    GR = np.empty((P, d, d))
+    _split_seeded_nb(prefix, paths, np.int64(tag), np.int64(depth), np.int64(index), split_width(n, d),
+                     np.ascontiguousarray(w), np.ascontiguousarray(G), float(delta), fine, GL, GR)
+    return fine, GL, GR

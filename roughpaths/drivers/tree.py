@@ -70,7 +70,7 @@ from ..paths.rough_path import RoughPath
 from ..validation import as_float_array, check_batch_shape, check_positive_int, check_real
 from ._random import PathStreams
 from ._seeded import check_seed
-from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, split_width
+from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width
 from .areas import _Sampler
 
 __all__ = ["BrownianTree"]
@@ -160,6 +160,7 @@ class BrownianTree:
         self._cache: OrderedDict = OrderedDict()
         self._root_node = None
         self._paths = np.arange(self.n_paths, dtype=np.int64)
+        self._prefix = seed_prefix(self.seed_sequence)          # None: seed the splits' streams in numpy
 
     def __repr__(self) -> str:
         return (f"BrownianTree(dim={self.dim}, t0={self.t0}, t1={self.t1}, batch_shape={self.batch_shape}, "
@@ -249,10 +250,13 @@ class BrownianTree:
             return hit
         w, G = node
         P, n, d = w.shape
-        z = np.empty((P, split_width(n, d)))
-        self._streams(_SPLIT, depth, index).fill(z)
         delta = (self.t1 - self.t0) / 2 ** depth / n
-        fine, GL, GR = refine_segments_fast(w, G, delta, z)
+        if self._prefix is not None and P:
+            fine, GL, GR = split_seeded(self._prefix, self._paths, _SPLIT, depth, index, w, G, delta)
+        else:
+            z = np.empty((P, split_width(n, d)))
+            self._streams(_SPLIT, depth, index).fill(z)
+            fine, GL, GR = refine_segments_fast(w, G, delta, z)
         pair = ((fine[:, :n], GL), (fine[:, n:], GR))
         self._cache[key] = pair
         while 2 * len(self._cache) > self.cache_size:
