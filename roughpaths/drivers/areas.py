@@ -108,12 +108,16 @@ class _Sampler:
             return max(w for _, _, w in self.plan.values())
         return 0
 
-    def fill_rows(self, dW, h, states, ito, zbuf, out) -> bool:
+    def fill_rows(self, dW, h, states, ito, zbuf, out, tables=None) -> bool:
         """Write the areas of the paths ``dW (p, k, d)`` with PCG64 ``states (p, 4)`` (advanced) into ``out``
-        ``(p, k, d, d)``; False (nothing done) for the kinds that need the whole block (``"fourier"``,
-        none). A path's areas depend on its own increments and stream only, so any split of the paths into
-        row ranges gives the same numbers (:class:`~roughpaths.BrownianDriver` samples ranges on threads)."""
+        ``(p, k, d, d)``; False (nothing done) for no area and for exact areas at ``d != 2``. A path's areas
+        depend on its own increments and stream only, so any split of the paths into row ranges gives the
+        same numbers (:class:`~roughpaths.BrownianDriver` samples ranges on threads). ``tables``: the
+        block's ``step_tables`` for ``"fourier"`` (computed here if omitted)."""
         d = dW.shape[2]
+        if self.kind == "fourier":
+            _fourier_areas(dW, h, *(tables if tables is not None else step_tables(self.plan, h)), states, ito, out)
+            return True
         if self.kind == "bridge":
             na = self.width
             _block_areas(dW, h, zbuf[:na].reshape(1, 1, na), states, self.substeps, self.name == "davie" and d > 1,

@@ -94,6 +94,7 @@ import numpy as np
 from ..validation import as_float_array, check_memory, check_positive_int
 from .. import _threads
 from ._area_kernels import _scale_accumulate
+from ._fourier_kernels import step_tables
 from ._random import PathStreams, _fast_streams_ok, _pcg64_normals
 from .areas import _Sampler
 from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
@@ -406,15 +407,17 @@ class BrownianDriver(SeededDriver):
         P, k, d = dW.shape
         sqh = np.sqrt(h)
         ito = self.kind == "ito"
-        rows = self.level == 2 and (self._sampler.kind == "bridge" or (self._sampler.kind == "exact" and d == 2))
+        kind = self._sampler.kind
+        rows = self.level == 2 and (kind in ("bridge", "fourier") or (kind == "exact" and d == 2))
         areas = np.empty((P, k, d, d)) if rows else None
+        tables = step_tables(self._sampler.plan, h) if rows and kind == "fourier" else None
         flat = dW.reshape(P, k * d)
 
         def sample(lo, hi):
             _pcg64_normals(inc_streams.states[lo:hi], flat[lo:hi])
             _scale_accumulate(dW[lo:hi], sqh, x[lo:hi])
             if rows:
-                self._sampler.fill_rows(dW[lo:hi], h, area_streams.states[lo:hi], ito, zbuf, areas[lo:hi])
+                self._sampler.fill_rows(dW[lo:hi], h, area_streams.states[lo:hi], ito, zbuf, areas[lo:hi], tables)
 
         per_path = k * (d + (self._sampler.width + d * d if rows else 0)) * 16.0
         _threads.run(sample, _threads.ranges(P, per_path))
