@@ -15,7 +15,7 @@ from .. import _threads
 from ..algebra.flat import level_offsets
 from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array, check_memory, check_positive_int
-from . import _lanes
+from . import _blocked, _lanes
 from . import _level2 as _l2
 
 # Work splitting depends on each path's length only (never on the thread count nor on the batch), so
@@ -139,7 +139,7 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
     return out
 
 
-#: From this width on every unit runs alone (:func:`_lanes.scalar_units`, the same bits as the lanes):
+#: From this width on every unit runs alone (:func:`_blocked.block_units`, the same bits as the lanes):
 #: ``LANES`` signatures of d >= 6 at depth >= 4 no longer fit in the L2 cache, and the one-unit loops
 #: over the first letters are long enough to vectorise on their own.
 _WIDE = 6
@@ -174,8 +174,8 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
         _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES))
     if first_alone < nunits:
-        _threads.run(lambda lo, hi: _lanes.scalar_units(x, *units, depth, off, first_alone + lo,
-                                                        first_alone + hi, part),
+        _threads.run(lambda lo, hi: _blocked.block_units(x, *units, depth, off, first_alone + lo,
+                                                         first_alone + hi, part),
                      _threads.ranges(nunits - first_alone, per_unit))
     return part
 
@@ -204,7 +204,11 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
         out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
-    return out[:, _reversed_to_rowmajor(d, depth)]
+    perm = _reversed_to_rowmajor(d, depth)
+    res = np.empty_like(out)
+    _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, _offsets(d, depth), depth, lo, hi, res),
+                 _threads.ranges(nb, 4 * perm.shape[0]))
+    return res
 
 
 @lru_cache(maxsize=None)
