@@ -178,7 +178,7 @@ def peer_table(cases: dict, args, rng) -> None:
             g1 = np.concatenate([np.zeros(g.shape[:-1] + (1,)), g], axis=-1)
             gl = rng.standard_normal(x.shape[:-2] + (iisignature.logsiglength(d, m),))
             pysiglib.prepare_log_sig(d, m, method=2)
-            prep = iisignature.prepare(d, m) if "logsig" in kinds else None
+            prep = iisignature.prepare(d, m) if {"logsig", "log vjp"} & set(kinds) else None
 
             def peer_log_vjp(jobs):
                 s = pysiglib.sig(x, m, scalar_term=True, n_jobs=jobs)

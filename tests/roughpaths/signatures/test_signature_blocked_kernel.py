@@ -53,3 +53,25 @@ def test_tiled_permutation_equals_numpy_gather(rng):
     out = np.empty_like(src)
     _blocked.to_rowmajor(src, perm, off, m, 0, 2, out)
     assert out.tobytes() == src[:, perm].tobytes()
+
+
+@pytest.mark.parametrize("d,m", [(6, 3), (6, 4), (8, 3), (20, 3), (7, 3)])
+def test_wide_vjp_in_blocks_matches_iisignature(rng, d, m):
+    from roughpaths import sigdim, signature_vjp
+    from roughpaths.signatures import _vjp_wide
+
+    n = 2 * _vjp_wide.KB + 5                      # two full blocks of segments and a partial one
+    x = np.cumsum(rng.standard_normal((2, n, d)) / np.sqrt(n), axis=-2)
+    g = rng.standard_normal((2, sigdim(d, m)))
+    ref = iisignature.sigbackprop(g, x, m)        # iisignature's gradients agree to about 1e-7 only
+    np.testing.assert_allclose(signature_vjp(x, m, g), ref, rtol=0, atol=1e-6 * np.abs(ref).max())
+
+
+def test_wide_vjp_bits_do_not_depend_on_the_batch(rng):
+    from roughpaths import sigdim, signature_vjp
+
+    x = np.cumsum(rng.standard_normal((5, 2 * 1024 + 40, 6)) * 0.03, axis=-2)   # two chunks a path
+    g = rng.standard_normal((5, sigdim(6, 3)))
+    whole = signature_vjp(x, 3, g)
+    for b in (0, 3):
+        assert signature_vjp(x[b:b + 1], 3, g[b:b + 1])[0].tobytes() == whole[b].tobytes()
