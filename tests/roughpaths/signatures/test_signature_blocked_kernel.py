@@ -1,6 +1,7 @@
 """Claim: the one-unit kernel that defers the top level over blocks of segments is exact and keeps the bits.
 
-* ``signature`` equals ``iisignature.sig`` to 1e-12 on paths longer than a block (so the top level
+* ``signature`` equals ``iisignature.sig`` to 1e-12 on paths longer than a block (so the top level, or
+  at depth 2 the table of areas (``_level2``, d >= 6, 16 points a sweep),
   is added in several sweeps, the last one partial), at the compiled widths (d = 6, 8, 20 at depths
   3/4) and at run-time ones (d = 7; d = 4 at depth 6, a lone path);
 * :func:`_blocked.block_units` gives the bits of the segment-by-segment kernel
@@ -21,7 +22,7 @@ from roughpaths.algebra.flat import level_offsets
 from roughpaths.signatures import _blocked, _lanes
 from roughpaths.signatures._engine import _reversed_to_rowmajor, _units
 
-CASES = [(6, 3), (6, 4), (8, 3), (8, 4), (20, 3), (7, 3), (4, 6)]
+CASES = [(6, 3), (6, 4), (8, 3), (8, 4), (20, 3), (7, 3), (4, 6), (7, 2), (20, 2)]   # depth 2: _level2
 
 
 @pytest.mark.parametrize("d,m", CASES)
