@@ -229,14 +229,18 @@ def to_rowmajor(src, perm, offsets, m, lo, hi, out):
         nw = d ** (k - h)
         ra = (perm[offsets[h]:offsets[h] + na] - offsets[h]) * nw + ok
         rw = (perm[offsets[k - h]:offsets[k - h] + nw] - offsets[k - h]) * na + ok
+        ua = np.uint64(na - na % 8)
+        uw = np.uint64(nw - nw % 8)
+        e = np.uint64(8)
         for b in range(lo, hi):
             sb = src[b]
             ob = out[b]
-            for r0 in range(0, na, 8):
-                r1 = min(r0 + 8, na)
-                for w0 in range(0, nw, 8):
-                    w1 = min(w0 + 8, nw)
-                    for r in range(r0, r1):
-                        dst = ra[r]
-                        for w in range(w0, w1):
-                            ob[dst + w] = sb[r + rw[w]]
+            for r0 in range(np.uint64(0), ua, e):           # 8 x 8 tiles
+                for w0 in range(np.uint64(0), uw, e):
+                    for r in range(r0, r0 + e):
+                        dst = np.uint64(ra[r]) + w0
+                        for w in range(e):
+                            ob[dst + w] = sb[np.uint64(rw[w0 + w]) + r]
+            for r in range(np.uint64(0), np.uint64(na)):       # the edges
+                for w in range(uw if r < ua else np.uint64(0), np.uint64(nw)):
+                    ob[np.uint64(ra[r]) + w] = sb[np.uint64(rw[w]) + r]

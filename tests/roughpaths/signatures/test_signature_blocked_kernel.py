@@ -45,9 +45,9 @@ def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     assert a.tobytes() == b.tobytes()
 
 
-def test_tiled_permutation_equals_numpy_gather(rng):
-    d, m = 4, 8                                   # level 8 has 65536 entries: permuted in tiles
-    assert d ** m > _blocked._TILED
+@pytest.mark.parametrize("d,m", [(4, 8), (5, 7)])   # 8 x 8 tiles only; tiles and edges (125 x 625)
+def test_tiled_permutation_equals_numpy_gather(rng, d, m):
+    assert d ** m > _blocked._TILED               # the top level is permuted in tiles
     off = level_offsets(d, m)
     perm = _reversed_to_rowmajor(d, m)
     src = rng.standard_normal((2, off[m + 1]))
