@@ -223,28 +223,32 @@ def _mul_rev(x0, xs, a, d, m, offsets, out):
 
 @njit(cache=True)
 def _log_vjp_one(a, g, d, m, offsets, ga):
-    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion."""
+    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion
+    ``r_m = c_m a``, ``r_n = (c_n + r_{n+1}) ⊗ a``, ``log(1 + a) = r_1``. Only levels ``<= m - n + 1``
+    of ``r_n`` (and of its cotangent) reach the result: each step runs at that depth (about
+    ``1 + 1/d + ...`` full products instead of ``m - 1``; the dropped terms are exact zeros)."""
     dim = offsets[m + 1]
     r = np.zeros((m + 2, dim))
-    for u in range(dim):
+    for u in range(d):
         r[m, u] = a[u] * ((-1.0) ** (m + 1) / m)
     for n in range(m - 1, 0, -1):
         c = (-1.0) ** (n + 1) / n
-        _mul_rev(c, r[n + 1], a, d, m, offsets, r[n])
+        _mul_rev(c, r[n + 1], a, d, m - n + 1, offsets, r[n])
     gc = g.copy()
     tmp = np.empty(dim)
     for u in range(dim):
         ga[u] = 0.0
     for n in range(1, m):
         c = (-1.0) ** (n + 1) / n
-        _lcon(c, r[n + 1], gc, d, m, offsets, tmp)
-        for u in range(dim):
+        mm = m - n + 1                                      # gc: the cotangent of r_n, levels <= mm
+        _lcon(c, r[n + 1], gc, d, mm, offsets, tmp)
+        for u in range(offsets[mm + 1]):
             ga[u] += tmp[u]
-        _rcon(0.0, gc, a, d, m, offsets, tmp)
-        for u in range(dim):
+        _rcon(0.0, gc, a, d, mm, offsets, tmp)              # levels < mm: the cotangent of r_{n+1}
+        for u in range(offsets[mm]):
             gc[u] = tmp[u]
     cm = (-1.0) ** (m + 1) / m
-    for u in range(dim):
+    for u in range(d):
         ga[u] += cm * gc[u]
 
 
