@@ -100,8 +100,7 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 @njit(cache=True, inline="always")
 def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, wide):
-    dim = offsets[m + 1]
-    for r in range(dim):
+    for r in range(offsets[m]):                             # levels < m (gprev_m = g_m: never copied)
         gprev[r] = g[r]
     for q in range(d):
         gdelta[q] = g[q]
@@ -181,11 +180,11 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
         for i in range(d):
             delta[i] = x[b, k, i] - x[b, k - 1, i]
             neg[i] = -delta[i]
-        _horner_step(s, neg, d, m, offsets, buf)
+        _horner_step(s, neg, d, m - 1, offsets, buf)        # S_prev: its top level is never read
         _step_vjp(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
         for i in range(d):
             gd[b, k - 1, i] = gdelta[i]
-        for r in range(dim):
+        for r in range(offsets[m]):                         # the top level of g never changes
             g[r] = gn[r]
 
 

@@ -120,8 +120,8 @@ def _gd_block(g, ok, n, d, tk, nk, gdl, tmp):
 def _top_back(s, g, delta, d, m, offsets, gbt, go, gprev, tb, ga, gb, gdelta):
     """The top level's share of the step's backward pass, given ``gB_{m-1}`` (``gbt[go:]``).
 
-    Forms ``T_1 .. T_{m-1}`` (into ``tb`` at the level offsets), adds ``gB_{m-1}`` to ``gprev``'s
-    level ``m - 1``, then walks ``gB_j`` down as :func:`~roughpaths.signatures._vjp._step_vjp_d`."""
+    Forms ``T_1 .. T_{m-1}`` (into ``tb`` at the level offsets), sets ``gprev``'s level ``m - 1`` to
+    ``G_{m-1} + gB_{m-1}``, then walks ``gB_j`` down as :func:`~roughpaths.signatures._vjp._step_vjp_d`."""
     inv = 1.0 / m
     for q in range(d):
         tb[q] = delta[q] * inv + s[q]
@@ -137,7 +137,7 @@ def _top_back(s, g, delta, d, m, offsets, gbt, go, gprev, tb, ga, gb, gdelta):
     nt = d ** (m - 1)
     ot = offsets[m - 1]
     for p in range(nt):
-        gprev[ot + p] += gbt[go + p]
+        gprev[ot + p] = g[ot + p] + gbt[go + p]
         ga[p] = gbt[go + p]
     for j in range(m - 2, 0, -1):
         f = 1.0 / (m - j)
