@@ -17,7 +17,7 @@ from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
 from . import _level2 as _l2
-from . import _vjp, _vjp_wide
+from . import _rough_vjp, _vjp, _vjp_wide
 from ._engine import (_WIDE, _check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array, _offsets,
                       _reversed_parts, _reversed_to_rowmajor, _sigdim, _signature_flat, _split_units, _units)
 from .signature import rough_path_signature
@@ -235,7 +235,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
     off = _offsets(d, depth)
-    _threads.run(lambda lo, hi: _vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
+    _threads.run(lambda lo, hi: _rough_vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
                  _threads.ranges(inc.shape[0], 4 * n * depth * depth * _sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
     return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))
