@@ -36,20 +36,9 @@ def _tb_row(tb, to, x, xo, n, e, s, so):
 
 
 @njit(cache=True, inline="always")
-def _dot(a, ao, b, bo, n):
-    """``sum_p a[ao+p] b[bo+p]``, summed in order of ``p`` (as every lane of the lane kernel)."""
-    u = np.uint64(ao)
-    v = np.uint64(bo)
-    acc = 0.0
-    for p in range(np.uint64(n)):
-        acc += a[u + p] * b[v + p]
-    return acc
-
-
-@njit(cache=True, inline="always")
 def _dot_wide(a, ao, b, bo, n):
-    """:func:`_dot` in four running sums (``p mod 4``) added as ``(s0 + s1) + (s2 + s3)``: a fixed
-    order (a function of ``n`` only) without one long chain of dependent additions (d >= 6 only)."""
+    """``sum_p a[ao+p] b[bo+p]`` in four running sums (``p mod 4``) added as ``(s0 + s1) + (s2 + s3)``:
+    a fixed order (a function of ``n`` only) without one long chain of dependent additions."""
     u = np.uint64(ao)
     v = np.uint64(bo)
     n4 = np.uint64(n - n % 4)
@@ -98,7 +87,7 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 
 @njit(cache=True, inline="always")
-def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, wide):
+def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
     for r in range(offsets[m]):                             # levels < m (gprev_m = g_m: never copied)
         gprev[r] = g[r]
     for q in range(d):
@@ -129,11 +118,11 @@ def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, wide):
                 if j == k - 1:
                     base = ok + nj * q
                     _axpy(gb, 0, g, base, nj, delta[q] * f)
-                    gdelta[q] += (_dot_wide(g, base, tb, oj, nj) if wide else _dot(g, base, tb, oj, nj)) * f
+                    gdelta[q] += _dot_wide(g, base, tb, oj, nj) * f
                 else:
                     base = nj * q
                     _axpy(gb, 0, ga, base, nj, delta[q] * f)
-                    gdelta[q] += (_dot_wide(ga, base, tb, oj, nj) if wide else _dot(ga, base, tb, oj, nj)) * f
+                    gdelta[q] += _dot_wide(ga, base, tb, oj, nj) * f
             _addto(gprev, oj, gb, 0, nj)
             for p in range(nj):
                 ga[p] = gb[p]
@@ -149,18 +138,17 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
     ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
     the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
     ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
-    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``. For d <= 5
-    the same operations, in the same order, as every lane of :func:`_lane_step_vjp_d`; from d = 6
-    (``_engine._WIDE``: no lanes) the dot products run in :func:`_dot_wide`.
+    ``gdelta`` (cotangent of delta) are written (levels ``< m`` of ``gprev``: its top level is
+    ``G_m``); ``ga``, ``gb`` are scratch of ``d^m``. The same operations, in the same order, as
+    every lane of :func:`_lane_step_vjp_d`, the dot products in the four sums of :func:`_dot_wide`
+    (one chain of dependent additions measured 3x slower on a lone 4^8 path).
     """
     if d == 2:
-        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta, False)
+        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta)
     elif d == 3:
-        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta, False)
-    elif d < 6:
-        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, False)
-    else:                   # every unit runs alone (no lane to match): the dot products in 4 sums
-        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, True)
+        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta)
+    else:
+        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta)
 
 
 @njit(cache=True)
@@ -313,11 +301,25 @@ def _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gprev, tb, ga, gb, gdelta):
             for q in range(d):
                 e = vmul(vload(blk, do + q * L), f)
                 base = nj * q * L
-                acc = vsplat(0.0)
-                for p in range(nj):
+                a0 = a1 = a2 = a3 = vsplat(0.0)                  # the sums of _dot_wide, per lane
+                for p in range(0, nj - nj % 4, 4):
                     a = vload(ga, base + p * L)
                     vstore(gb, p * L, vadd(vload(gb, p * L), vmul(a, e)))
-                    acc = vadd(acc, vmul(a, vload(tb, oj + p * L)))
+                    a0 = vadd(a0, vmul(a, vload(tb, oj + p * L)))
+                    a = vload(ga, base + (p + 1) * L)
+                    vstore(gb, (p + 1) * L, vadd(vload(gb, (p + 1) * L), vmul(a, e)))
+                    a1 = vadd(a1, vmul(a, vload(tb, oj + (p + 1) * L)))
+                    a = vload(ga, base + (p + 2) * L)
+                    vstore(gb, (p + 2) * L, vadd(vload(gb, (p + 2) * L), vmul(a, e)))
+                    a2 = vadd(a2, vmul(a, vload(tb, oj + (p + 2) * L)))
+                    a = vload(ga, base + (p + 3) * L)
+                    vstore(gb, (p + 3) * L, vadd(vload(gb, (p + 3) * L), vmul(a, e)))
+                    a3 = vadd(a3, vmul(a, vload(tb, oj + (p + 3) * L)))
+                for p in range(nj - nj % 4, nj):
+                    a = vload(ga, base + p * L)
+                    vstore(gb, p * L, vadd(vload(gb, p * L), vmul(a, e)))
+                    a0 = vadd(a0, vmul(a, vload(tb, oj + p * L)))
+                acc = vadd(vadd(a0, a1), vadd(a2, a3))
                 vstore(gdelta, q * L, vadd(vload(gdelta, q * L), vmul(acc, f)))
             for p in range(nj):
                 b = vload(gb, p * L)

@@ -175,7 +175,7 @@ def _unit_back_d(x, b, lo, hi, s, g, d, m, offsets, gd, w):
                 delta[i] = dl[k * d + i]
                 neg[i] = -delta[i]
             _horner_step(s, neg, d, m - 1, offsets, buf)      # S_prev, levels < m
-            _step_vjp_d(s, g, delta, d, m - 1, offsets, gn, tb, ga, gb, gdelta, True)
+            _step_vjp_d(s, g, delta, d, m - 1, offsets, gn, tb, ga, gb, gdelta)
             _top_back(s, g, delta, d, m, offsets, gbt, k * n, gn, tb, ga, gb, gdelta)
             for p in range(n):                              # T_{m-1} of this segment
                 tk[k * n + p] = tb[offsets[m - 1] + p]
