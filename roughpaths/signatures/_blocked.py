@@ -24,9 +24,9 @@ the L2) cache is streamed once a block instead of once a segment.
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
 0.125 at 2 GHz); per segment d = 8 depth 3 about 120 ns (the one-segment kernel: 290), depth 4
-about 1300 (1900), d = 6 depth 4 400 (760), d = 20 depth 3 1400 (2800). Widths 6, 8 and 20 at
-depths 3 and 4 are compiled with constant ``d`` and ``m`` (loops unrolled; the lower levels 30%
-faster).
+about 1300 (1900), d = 6 depth 4 400 (760), d = 20 depth 3 1400 (2800). d = 8 at depths 3 and
+4, d = 6 at depth 4 and d = 20 at depth 3 are compiled with constant ``d`` and ``m`` (loops
+unrolled: the lower levels 30% faster), d = 4 with a constant ``d``.
 """
 
 from __future__ import annotations
@@ -181,19 +181,16 @@ def block_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
         fac[k] = 1.0 / k
     for u in range(lo, hi):
         b, k0, k1, out = ub[u], ulo[u], uhi[u], part[u]
-        # compile-time widths (and depths): LLVM unrolls the loops over the letters and the levels
+        # compile-time widths (and depths): LLVM unrolls the loops over the letters and the levels.
+        # Each variant costs compile time once (the kernel: about 60 s on this machine, then cached)
         if m == 3 and d == 8:
             _unit_d(x, b, k0, k1, out, 8, 3, offsets, fac, buf, tb, dl, delta)
         elif m == 4 and d == 8:
             _unit_d(x, b, k0, k1, out, 8, 4, offsets, fac, buf, tb, dl, delta)
-        elif m == 3 and d == 6:
-            _unit_d(x, b, k0, k1, out, 6, 3, offsets, fac, buf, tb, dl, delta)
         elif m == 4 and d == 6:
             _unit_d(x, b, k0, k1, out, 6, 4, offsets, fac, buf, tb, dl, delta)
         elif m == 3 and d == 20:
             _unit_d(x, b, k0, k1, out, 20, 3, offsets, fac, buf, tb, dl, delta)
-        elif d == 3:
-            _unit_d(x, b, k0, k1, out, 3, m, offsets, fac, buf, tb, dl, delta)
         elif d == 4:
             _unit_d(x, b, k0, k1, out, 4, m, offsets, fac, buf, tb, dl, delta)
         else:
