@@ -211,16 +211,14 @@ def to_rowmajor(src, perm, offsets, m, lo, hi, out):
     row-major order measured 5x slower on a 4^8-entry level).
     """
     d = offsets[2]
-    for k in range(1, m + 1):
+    kt = 1                                          # levels below kt fit in cache: a plain gather
+    while kt <= m and offsets[kt + 1] - offsets[kt] <= _TILED:
+        kt += 1
+    for b in range(lo, hi):
+        for i in range(offsets[kt]):
+            out[b, i] = src[b, perm[i]]
+    for k in range(kt, m + 1):
         ok = offsets[k]
-        nk = offsets[k + 1] - ok
-        if nk <= _TILED:                            # in cache: a plain gather
-            for b in range(lo, hi):
-                sb = src[b]
-                ob = out[b]
-                for i in range(ok, ok + nk):
-                    ob[i] = sb[perm[i]]
-            continue
         h = k // 2
         na = d ** h
         nw = d ** (k - h)
