@@ -132,9 +132,10 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
     (through the increments on both sides of it, and NaN/inf never cancel), so a non-finite
     input always gives a non-finite output: scanning the small output replaces scanning the whole
     path on every call. A finite input whose signature overflows returns the overflowed values,
-    as before.
+    as before. When the input is the smaller array (short paths at high depth) it is scanned
+    instead: the same outcome.
     """
-    if not np.isfinite(out).all():
+    if not np.isfinite(x if x.size < out.size else out).all():
         as_float_array(x, "paths")
     return out
 
