@@ -173,7 +173,10 @@ def block_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
     """
     d = x.shape[2]
     buf = np.empty((2 * m + 2) * d ** max(m - 2, 1))        # the chains C^l_j (_fused_d)
-    tb = np.empty(KBLOCK * d ** (m - 1))
+    most = 1
+    for u in range(lo, hi):
+        most = max(most, uhi[u] - ulo[u])
+    tb = np.empty(min(KBLOCK, most) * d ** (m - 1))           # a short path's block: its segments
     dl = np.empty(KBLOCK * d)
     delta = np.empty(d)
     fac = np.empty(m + 1)
