@@ -24,7 +24,8 @@ iisignature (single-threaded); the gradient at depth 4 on (b); ``logsignature`` 
 at depth 10 in a fresh process; level 2 on (a) beside a CPU-bound process; bitwise equality of
 results with 1 and 2 threads.
 
-Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick]``
+Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
+[--depths 3,4]`` (the last three select peer-table cells and skip the rest).
 """
 
 from __future__ import annotations
@@ -177,7 +178,7 @@ def peer_table(cases: dict, args, rng) -> None:
             g1 = np.concatenate([np.zeros(g.shape[:-1] + (1,)), g], axis=-1)
             gl = rng.standard_normal(x.shape[:-2] + (iisignature.logsiglength(d, m),))
             pysiglib.prepare_log_sig(d, m, method=2)
-            prep = iisignature.prepare(d, m) if "logsig" in kinds else None
+            prep = iisignature.prepare(d, m) if {"logsig", "log vjp"} & set(kinds) else None
 
             def peer_log_vjp(jobs):
                 s = pysiglib.sig(x, m, scalar_term=True, n_jobs=jobs)
@@ -223,6 +224,10 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--quick", action="store_true", help="smaller sizes (smoke test)")
     parser.add_argument("--only-peer-table", action="store_true", help="print the pysiglib table only")
+    parser.add_argument("--cells", default="", help="peer-table cases to run, by letter (e.g. 'd,e,h'); "
+                        "implies --only-peer-table")
+    parser.add_argument("--kinds", default="", help="peer-table kinds to run (e.g. 'sig,log vjp')")
+    parser.add_argument("--depths", default="", help="peer-table depths to run (e.g. '3,4')")
     args = parser.parse_args()
 
     import iisignature
@@ -252,6 +257,15 @@ def main() -> None:
         "(h) 16 x 256, d=6": (np.cumsum(rng.standard_normal((16, 256, 6)), axis=-2) / 16, (4,),
                               ("sig", "logsig", "sig vjp")),
     }
+    if args.cells:
+        keep = {c.strip() for c in args.cells.split(",")}
+        wide = {k: v for k, v in wide.items() if k[1:k.index(")")] in keep}
+        args.only_peer_table = True
+    if args.kinds or args.depths:
+        kinds = {k.strip() for k in args.kinds.split(",")} if args.kinds else None
+        depths = {int(m) for m in args.depths.split(",")} if args.depths else None
+        wide = {k: (x, tuple(m for m in ms if depths is None or m in depths),
+                    tuple(c for c in cs if kinds is None or c in kinds)) for k, (x, ms, cs) in wide.items()}
     threads = numba.get_num_threads()
     print(f"numba threads {threads}, cpu count {os.cpu_count()}, load average {os.getloadavg()[0]:.1f}, "
           f"median of {args.repeats} interleaved pairs; times in ms\n")

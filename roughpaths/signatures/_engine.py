@@ -15,7 +15,7 @@ from .. import _threads
 from ..algebra.flat import level_offsets
 from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array, check_memory, check_positive_int
-from . import _lanes
+from . import _blocked, _lanes
 from . import _level2 as _l2
 
 # Work splitting depends on each path's length only (never on the thread count nor on the batch), so
@@ -132,14 +132,15 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
     (through the increments on both sides of it, and NaN/inf never cancel), so a non-finite
     input always gives a non-finite output: scanning the small output replaces scanning the whole
     path on every call. A finite input whose signature overflows returns the overflowed values,
-    as before.
+    as before. When the input is the smaller array (short paths at high depth) it is scanned
+    instead: the same outcome.
     """
-    if not np.isfinite(out).all():
+    if not np.isfinite(x if x.size < out.size else out).all():
         as_float_array(x, "paths")
     return out
 
 
-#: From this width on every unit runs alone (:func:`_lanes.scalar_units`, the same bits as the lanes):
+#: From this width on every unit runs alone (:func:`_blocked.block_units`, the same bits as the lanes):
 #: ``LANES`` signatures of d >= 6 at depth >= 4 no longer fit in the L2 cache, and the one-unit loops
 #: over the first letters are long enough to vectorise on their own.
 _WIDE = 6
@@ -174,8 +175,8 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
         _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES))
     if first_alone < nunits:
-        _threads.run(lambda lo, hi: _lanes.scalar_units(x, *units, depth, off, first_alone + lo,
-                                                        first_alone + hi, part),
+        _threads.run(lambda lo, hi: _blocked.block_units(x, *units, depth, off, first_alone + lo,
+                                                         first_alone + hi, part),
                      _threads.ranges(nunits - first_alone, per_unit))
     return part
 
@@ -204,7 +205,11 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
         out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
-    return out[:, _reversed_to_rowmajor(d, depth)]
+    perm = _reversed_to_rowmajor(d, depth)
+    res = np.empty_like(out)
+    _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, _offsets(d, depth), depth, lo, hi, res),
+                 _threads.ranges(nb, 4 * perm.shape[0]))
+    return res
 
 
 @lru_cache(maxsize=None)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
+
 _NOGIL = dict(cache=True, nogil=True)
 
 
@@ -126,32 +128,49 @@ def _area_chunk_d5(x, b, lo, hi, out):
     out[14] = a34
 
 
+#: Points whose area terms the generic kernel adds in one sweep of the table.
+_KB2 = 16
+
+
 @njit(cache=True)
 def _area_chunk_generic(x, b, lo, hi, out):
-    # the full d x d table (the same expression per pair i < j as the d = 2..5 kernels): the loop
-    # over j runs over contiguous rows with unsigned indices, so it vectorises for any d
+    # the d x d table above its diagonal, acc[i, j] += y_{k-1}[i] y_k[j] - y_{k-1}[j] y_k[i] (the same
+    # expression per pair i < j as the d = 2..5 kernels), for _KB2 points at a time: each packed row
+    # of LANES entries stays in registers while the points' terms are added in order (the same bits
+    # as one point at a time; a - b computed as a + b (-1), the same IEEE operation). Entries below the
+    # diagonal in the row's first packed block, and past d, are computed and never read.
     d = x.shape[2]
     ud = np.uint64(d)
-    prev = np.zeros(d)
-    cur = np.empty(d)
-    acc = np.zeros(d * d)
-    for k in range(lo + 1, hi + 1):
-        for i in range(d):
-            cur[i] = x[b, k, i] - x[b, lo, i]
+    L = np.uint64(LANES)
+    dp = ud + (L - ud % L) % L                 # rows padded to whole packed rows (zeros past d)
+    K = _KB2
+    pv = np.zeros(K * dp)                      # y_{k-1}, one row of dp a point
+    cv = np.zeros(K * dp)                      # y_k
+    nc = np.zeros(K * dp)                      # -y_k
+    acc = np.zeros(d * dp)
+    for k0 in range(lo + 1, hi + 1, K):
+        nk = np.uint64(min(K, hi + 1 - k0))
+        for t in range(nk):
+            for i in range(d):
+                c = x[b, k0 + t, i] - x[b, lo, i]
+                pv[t * dp + i] = x[b, k0 + t - 1, i] - x[b, lo, i] if k0 + t - 1 > lo else 0.0
+                cv[t * dp + i] = c
+                nc[t * dp + i] = -c
         for i in range(ud):
-            pi = prev[i]
-            ci = cur[i]
-            row = i * ud
-            for j in range(ud):
-                acc[row + j] += pi * cur[j] - prev[j] * ci
-        for i in range(d):
-            prev[i] = cur[i]
+            row = i * dp
+            for j in range((i + np.uint64(1)) - (i + np.uint64(1)) % L, dp, L):
+                a = vload(acc, row + j)
+                for t in range(nk):
+                    o = t * dp
+                    a = vadd(a, vadd(vmul(vsplat(pv[o + i]), vload(cv, o + j)),
+                                     vmul(vload(pv, o + j), vsplat(nc[o + i]))))
+                vstore(acc, row + j, a)
     for i in range(d):
-        out[i] = prev[i]
+        out[i] = x[b, hi, i] - x[b, lo, i]
     q = d
     for i in range(d):
         for j in range(i + 1, d):
-            out[q] = acc[i * d + j]
+            out[q] = acc[i * dp + j]
             q += 1
 
 

@@ -21,7 +21,6 @@ from numba import njit
 
 from ._lanes import BLOCK, _addto, _axpy, _horner_step, _lane_step_d, mul_inplace
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
-from ._kernels import _exp_lie2
 
 _NOGIL = dict(cache=True, nogil=True)
 
@@ -37,20 +36,9 @@ def _tb_row(tb, to, x, xo, n, e, s, so):
 
 
 @njit(cache=True, inline="always")
-def _dot(a, ao, b, bo, n):
-    """``sum_p a[ao+p] b[bo+p]``, summed in order of ``p`` (as every lane of the lane kernel)."""
-    u = np.uint64(ao)
-    v = np.uint64(bo)
-    acc = 0.0
-    for p in range(np.uint64(n)):
-        acc += a[u + p] * b[v + p]
-    return acc
-
-
-@njit(cache=True, inline="always")
 def _dot_wide(a, ao, b, bo, n):
-    """:func:`_dot` in four running sums (``p mod 4``) added as ``(s0 + s1) + (s2 + s3)``: a fixed
-    order (a function of ``n`` only) without one long chain of dependent additions (d >= 6 only)."""
+    """``sum_p a[ao+p] b[bo+p]`` in four running sums (``p mod 4``) added as ``(s0 + s1) + (s2 + s3)``:
+    a fixed order (a function of ``n`` only) without one long chain of dependent additions."""
     u = np.uint64(ao)
     v = np.uint64(bo)
     n4 = np.uint64(n - n % 4)
@@ -99,9 +87,8 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 
 @njit(cache=True, inline="always")
-def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, wide):
-    dim = offsets[m + 1]
-    for r in range(dim):
+def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    for r in range(offsets[m]):                             # levels < m (gprev_m = g_m: never copied)
         gprev[r] = g[r]
     for q in range(d):
         gdelta[q] = g[q]
@@ -131,11 +118,11 @@ def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, wide):
                 if j == k - 1:
                     base = ok + nj * q
                     _axpy(gb, 0, g, base, nj, delta[q] * f)
-                    gdelta[q] += (_dot_wide(g, base, tb, oj, nj) if wide else _dot(g, base, tb, oj, nj)) * f
+                    gdelta[q] += _dot_wide(g, base, tb, oj, nj) * f
                 else:
                     base = nj * q
                     _axpy(gb, 0, ga, base, nj, delta[q] * f)
-                    gdelta[q] += (_dot_wide(ga, base, tb, oj, nj) if wide else _dot(ga, base, tb, oj, nj)) * f
+                    gdelta[q] += _dot_wide(ga, base, tb, oj, nj) * f
             _addto(gprev, oj, gb, 0, nj)
             for p in range(nj):
                 ga[p] = gb[p]
@@ -151,18 +138,17 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
     ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
     the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
     ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
-    ``gdelta`` (cotangent of delta) are written; ``ga``, ``gb`` are scratch of ``d^m``. For d <= 5
-    the same operations, in the same order, as every lane of :func:`_lane_step_vjp_d`; from d = 6
-    (``_engine._WIDE``: no lanes) the dot products run in :func:`_dot_wide`.
+    ``gdelta`` (cotangent of delta) are written (levels ``< m`` of ``gprev``: its top level is
+    ``G_m``); ``ga``, ``gb`` are scratch of ``d^m``. The same operations, in the same order, as
+    every lane of :func:`_lane_step_vjp_d`, the dot products in the four sums of :func:`_dot_wide`
+    (one chain of dependent additions measured 3x slower on a lone 4^8 path).
     """
     if d == 2:
-        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta, False)
+        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta)
     elif d == 3:
-        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta, False)
-    elif d < 6:
-        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, False)
-    else:                   # every unit runs alone (no lane to match): the dot products in 4 sums
-        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta, True)
+        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta)
+    else:
+        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta)
 
 
 @njit(cache=True)
@@ -181,11 +167,11 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
         for i in range(d):
             delta[i] = x[b, k, i] - x[b, k - 1, i]
             neg[i] = -delta[i]
-        _horner_step(s, neg, d, m, offsets, buf)
+        _horner_step(s, neg, d, m - 1, offsets, buf)        # S_prev: its top level is never read
         _step_vjp(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
         for i in range(d):
             gd[b, k - 1, i] = gdelta[i]
-        for r in range(dim):
+        for r in range(offsets[m]):                         # the top level of g never changes
             g[r] = gn[r]
 
 
@@ -223,101 +209,33 @@ def _mul_rev(x0, xs, a, d, m, offsets, out):
 
 @njit(cache=True)
 def _log_vjp_one(a, g, d, m, offsets, ga):
-    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion."""
+    """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion
+    ``r_m = c_m a``, ``r_n = (c_n + r_{n+1}) ⊗ a``, ``log(1 + a) = r_1``. Only levels ``<= m - n + 1``
+    of ``r_n`` (and of its cotangent) reach the result: each step runs at that depth (about
+    ``1 + 1/d + ...`` full products instead of ``m - 1``; the dropped terms are exact zeros)."""
     dim = offsets[m + 1]
     r = np.zeros((m + 2, dim))
-    for u in range(dim):
+    for u in range(d):
         r[m, u] = a[u] * ((-1.0) ** (m + 1) / m)
     for n in range(m - 1, 0, -1):
         c = (-1.0) ** (n + 1) / n
-        _mul_rev(c, r[n + 1], a, d, m, offsets, r[n])
+        _mul_rev(c, r[n + 1], a, d, m - n + 1, offsets, r[n])
     gc = g.copy()
     tmp = np.empty(dim)
     for u in range(dim):
         ga[u] = 0.0
     for n in range(1, m):
         c = (-1.0) ** (n + 1) / n
-        _lcon(c, r[n + 1], gc, d, m, offsets, tmp)
-        for u in range(dim):
+        mm = m - n + 1                                      # gc: the cotangent of r_n, levels <= mm
+        _lcon(c, r[n + 1], gc, d, mm, offsets, tmp)
+        for u in range(offsets[mm + 1]):
             ga[u] += tmp[u]
-        _rcon(0.0, gc, a, d, m, offsets, tmp)
-        for u in range(dim):
+        _rcon(0.0, gc, a, d, mm, offsets, tmp)              # levels < mm: the cotangent of r_{n+1}
+        for u in range(offsets[mm]):
             gc[u] = tmp[u]
     cm = (-1.0) ** (m + 1) / m
-    for u in range(dim):
+    for u in range(d):
         ga[u] += cm * gc[u]
-
-
-@njit(cache=True)
-def _rough_vjp_one(inc, lev, s, g, d, m, offsets, ginc, glev):
-    """Backward through ``S = prod_k exp(inc_k + lev_k)`` for one path (reversed layout).
-
-    ``s`` is the final signature (overwritten), ``g`` its cotangent (overwritten). Per step, last
-    to first: ``S_prev = S ⊗ exp(-z)``, cotangent of ``E = exp(z)`` is ``S_prev ▷ G``,
-    ``G <- G ◁ E``, and the cotangent of ``z`` comes from the powers ``P_n = P_{n-1} ⊗ z / n``.
-    """
-    dim = offsets[m + 1]
-    nsteps = inc.shape[0]
-    e = np.empty(dim)
-    en = np.empty(dim)
-    p = np.empty(dim)
-    q = np.empty(dim)
-    ge = np.empty(dim)
-    gn = np.empty(dim)
-    z = np.zeros(dim)
-    pw = np.zeros((m + 1, dim))
-    gp = np.empty(dim)
-    gz = np.empty(dim)
-    tmp = np.empty(dim)
-    neg_x = np.empty(d)
-    neg_a = np.empty((d, d))
-    o2 = offsets[2] if m >= 2 else 0
-    for k in range(nsteps - 1, -1, -1):
-        for i in range(d):
-            neg_x[i] = -inc[k, i]
-            for j in range(d):
-                neg_a[i, j] = -lev[k, i, j]
-        _exp_lie2(neg_x, neg_a, d, m, offsets, en, p, q)
-        mul_inplace(s, en, d, m, offsets)                     # s = S_prev
-        _exp_lie2(inc[k], lev[k], d, m, offsets, e, p, q)
-        _lcon(1.0, s, g, d, m, offsets, ge)                   # cotangent of E
-        _rcon(1.0, g, e, d, m, offsets, gn)
-        # powers of z (levels 1 and 2 only)
-        for r in range(dim):
-            z[r] = 0.0
-        for i in range(d):
-            z[i] = inc[k, i]
-        if m >= 2:
-            for i in range(d):
-                for j in range(d):
-                    z[o2 + i + d * j] = lev[k, i, j]
-        for r in range(dim):
-            pw[1, r] = z[r]
-        for n in range(2, m + 1):
-            _mul_rev(0.0, pw[n - 1], z, d, m, offsets, pw[n])
-            for r in range(dim):
-                pw[n, r] /= n
-        # backward: E = sum_n P_n, P_n = P_{n-1} ⊗ z / n
-        for r in range(dim):
-            gp[r] = ge[r]
-            gz[r] = 0.0
-        for n in range(m, 1, -1):
-            _lcon(0.0, pw[n - 1], gp, d, m, offsets, tmp)      # P_{n-1} ▷ gP_n
-            for r in range(dim):
-                gz[r] += tmp[r] / n
-            _rcon(0.0, gp, z, d, m, offsets, tmp)              # gP_n ◁ z
-            for r in range(dim):
-                gp[r] = ge[r] + tmp[r] / n
-        for r in range(dim):
-            gz[r] += gp[r]
-        for i in range(d):
-            ginc[k, i] = gz[i]
-        if m >= 2:
-            for i in range(d):
-                for j in range(d):
-                    glev[k, i, j] = gz[o2 + i + d * j]
-        for r in range(dim):
-            g[r] = gn[r]
 
 
 @njit(**_NOGIL)
@@ -336,14 +254,6 @@ def log_vjp_rows(a, g, d, m, offsets, lo, hi, out):
     """Row-wise :func:`_log_vjp_one` (reversed layout) for rows ``lo..hi-1``."""
     for b in range(lo, hi):
         _log_vjp_one(a[b], g[b], d, m, offsets, out[b])
-
-
-@njit(**_NOGIL)
-def rough_vjp_rows(inc, lev, s, g, m, offsets, lo, hi, ginc, glev):
-    """Cotangents of the step increments / Lévy areas of paths ``lo..hi-1``."""
-    d = inc.shape[2]
-    for b in range(lo, hi):
-        _rough_vjp_one(inc[b], lev[b], s[b].copy(), g[b].copy(), d, m, offsets, ginc[b], glev[b])
 
 
 # ---------------------------------------------------------------------------------- lanes
@@ -391,11 +301,25 @@ def _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gprev, tb, ga, gb, gdelta):
             for q in range(d):
                 e = vmul(vload(blk, do + q * L), f)
                 base = nj * q * L
-                acc = vsplat(0.0)
-                for p in range(nj):
+                a0 = a1 = a2 = a3 = vsplat(0.0)                  # the sums of _dot_wide, per lane
+                for p in range(0, nj - nj % 4, 4):
                     a = vload(ga, base + p * L)
                     vstore(gb, p * L, vadd(vload(gb, p * L), vmul(a, e)))
-                    acc = vadd(acc, vmul(a, vload(tb, oj + p * L)))
+                    a0 = vadd(a0, vmul(a, vload(tb, oj + p * L)))
+                    a = vload(ga, base + (p + 1) * L)
+                    vstore(gb, (p + 1) * L, vadd(vload(gb, (p + 1) * L), vmul(a, e)))
+                    a1 = vadd(a1, vmul(a, vload(tb, oj + (p + 1) * L)))
+                    a = vload(ga, base + (p + 2) * L)
+                    vstore(gb, (p + 2) * L, vadd(vload(gb, (p + 2) * L), vmul(a, e)))
+                    a2 = vadd(a2, vmul(a, vload(tb, oj + (p + 2) * L)))
+                    a = vload(ga, base + (p + 3) * L)
+                    vstore(gb, (p + 3) * L, vadd(vload(gb, (p + 3) * L), vmul(a, e)))
+                    a3 = vadd(a3, vmul(a, vload(tb, oj + (p + 3) * L)))
+                for p in range(nj - nj % 4, nj):
+                    a = vload(ga, base + p * L)
+                    vstore(gb, p * L, vadd(vload(gb, p * L), vmul(a, e)))
+                    a0 = vadd(a0, vmul(a, vload(tb, oj + p * L)))
+                acc = vadd(vadd(a0, a1), vadd(a2, a3))
                 vstore(gdelta, q * L, vadd(vload(gdelta, q * L), vmul(acc, f)))
             for p in range(nj):
                 b = vload(gb, p * L)

@@ -17,8 +17,8 @@ from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
 from . import _level2 as _l2
-from . import _vjp
-from ._engine import (_check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array, _offsets,
+from . import _rough_vjp, _vjp, _vjp_wide
+from ._engine import (_WIDE, _check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array, _offsets,
                       _reversed_parts, _reversed_to_rowmajor, _sigdim, _signature_flat, _split_units, _units)
 from .signature import rough_path_signature
 
@@ -70,7 +70,10 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     if ngroups:
         _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES))
-    if first_alone < nunits:
+    if d >= _WIDE:                                          # every unit alone, the top level in blocks
+        _threads.run(lambda lo, hi: _vjp_wide.sig_vjp_wide(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+                     _threads.ranges(nunits, per_unit))
+    elif first_alone < nunits:
         _threads.run(lambda lo, hi: _vjp.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev,
                                                        first_alone + lo, first_alone + hi, gd),
                      _threads.ranges(nunits - first_alone, per_unit))
@@ -232,7 +235,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
     off = _offsets(d, depth)
-    _threads.run(lambda lo, hi: _vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
+    _threads.run(lambda lo, hi: _rough_vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
                  _threads.ranges(inc.shape[0], 4 * n * depth * depth * _sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))
     return ginc.reshape(batch + (n, d)), garea.reshape(batch + (n, d, d))
