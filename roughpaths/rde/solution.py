@@ -40,7 +40,7 @@ class Solution:
     Attributes
     ----------
     times : ndarray, shape ``(K,)``
-        The saved times (all grid times by default).
+        The saved times (all grid times by default; with adaptive steps, every accepted step's end).
     states : ndarray, shape ``(..., K, e)``
         The solution at ``times``; leading axes are the broadcast batch of driver and ``y0``.
     failed_step : ndarray of int, shape ``(...)``
@@ -48,7 +48,9 @@ class Solution:
         a healthy member (all ``-1`` unless ``on_failure="mask"`` kept a batch with failures). The
         states of a failed member are NaN from that step on.
     stats : dict
-        ``solver``, ``n_steps``, ``n_blocks``, ``batch_shape``, ``wall_time`` (seconds).
+        ``solver``, ``n_steps``, ``n_blocks``, ``batch_shape``, ``wall_time`` (seconds); with adaptive steps
+        (``step_control``) ``step_control``, ``accepted`` (``= n_steps``), ``rejected`` and ``at_dt_min``
+        instead of ``n_blocks``.
     """
 
     times: np.ndarray
