@@ -285,7 +285,8 @@ def bench_threads(n_paths, n_steps, repeats):
           f"{repeats} interleaved runs, ns per path-step")
     print(f"  {'problem':26s} {'wall 1':>8s} {'wall N':>8s} {'N/1':>5s} {'cpu 1':>8s} {'cpu N':>8s} {'N/1':>5s} "
           f"{'caller cpu N':>12s} {'/ cpu 1':>7s} {'bitwise':>7s}")
-    for label, area in (("LieHeun + Davie area", "davie"), ("LieHeun, no area", None)):
+    for label, area in (("LieHeun + default area", "auto"), ("LieHeun + Davie area", "davie"),
+                        ("LieHeun, no area", None)):
         def run():
             drv = BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,), levy_area=area)
             return solve(rb, drv, mu0, LieHeun(), save_at="end").final
