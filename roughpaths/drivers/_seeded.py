@@ -62,6 +62,25 @@ def phys_bytes() -> float:
         return float("inf")
 
 
+
+def selected_paths(paths, n: int, owner: str) -> np.ndarray:
+    """Flat path indices (int64, negatives wrapped) of a ``select(paths)`` on an ``owner`` of ``n`` paths.
+
+    ``paths``: a slice, a range or a 1-D array of integers in ``[-n, n)``; anything else is refused
+    with a message naming the argument.
+    """
+    if isinstance(paths, slice):
+        return np.arange(n)[paths]
+    if isinstance(paths, range):
+        paths = np.arange(paths.start, paths.stop, paths.step)
+    idx = np.asarray(paths)
+    if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
+        raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, got {paths!r}.")
+    if idx.size and (idx.min() < -n or idx.max() >= n):
+        raise ValueError(f"paths holds indices outside [0, {n}) (this {owner} has {n} paths), "
+                         f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
+    return np.where(idx < 0, idx + n, idx).astype(np.int64)
+
 class SeededDriver(Driver):
     """Base of the per-path seeded drivers: grid, batch, path indices, ``x0``-like start, ``select``."""
 
@@ -132,20 +151,7 @@ class SeededDriver(Driver):
         Driver
             Of the same class.
         """
-        n = self.n_paths
-        if isinstance(paths, slice):
-            idx = np.arange(n)[paths]
-        else:
-            if isinstance(paths, range):
-                paths = np.arange(paths.start, paths.stop, paths.step)
-            idx = np.asarray(paths)
-            if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
-                raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, "
-                                f"got {paths!r}.")
-            if idx.size and (idx.min() < -n or idx.max() >= n):
-                raise ValueError(f"paths holds indices outside [0, {n}) (this driver has {n} paths), "
-                                 f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
-            idx = np.where(idx < 0, idx + n, idx).astype(np.int64)
+        idx = selected_paths(paths, self.n_paths, "driver")
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         new._paths = self.path_indices[idx]

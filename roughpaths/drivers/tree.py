@@ -69,7 +69,7 @@ import numpy as np
 from ..paths.rough_path import RoughPath
 from ..validation import as_float_array, check_batch_shape, check_positive_int, check_real
 from ._random import PathStreams
-from ._seeded import check_seed
+from ._seeded import check_seed, selected_paths
 from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width
 from .areas import _Sampler
 
@@ -194,20 +194,7 @@ class BrownianTree:
         >>> bool(np.array_equal(tree.select([2]).area(0.1, 0.3)[0], tree.area(0.1, 0.3)[2]))
         True
         """
-        n = self.n_paths
-        if isinstance(paths, slice):
-            idx = np.arange(n)[paths]
-        else:
-            if isinstance(paths, range):
-                paths = np.arange(paths.start, paths.stop, paths.step)
-            idx = np.asarray(paths)
-            if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
-                raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, "
-                                f"got {paths!r}.")
-            if idx.size and (idx.min() < -n or idx.max() >= n):
-                raise ValueError(f"paths holds indices outside [0, {n}) (this tree has {n} paths), "
-                                 f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
-            idx = np.where(idx < 0, idx + n, idx).astype(np.int64)
+        idx = selected_paths(paths, self.n_paths, "tree")
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         new._paths = self._paths[idx]
