@@ -132,33 +132,25 @@ class _Sampler:
         """Areas ``(P, k, d, d)`` of a block ``dW (P, k, d)``, steps ``h (k,)``, from ``streams`` (advanced)."""
         P, k, d = dW.shape
         states = streams.states
-        if self.kind == "fourier" and states is not None:   # each step's normals drawn inside the kernel
-            out = np.empty((P, k, d, d))
-            _fourier_areas(dW, h, *step_tables(self.plan, h), states, ito, out)
-            return out
+        out = np.empty((P, k, d, d))
+        if states is not None and self.fill_rows(dW, h, states, ito, zbuf, out):
+            return out                                # the kernels draw each step's normals from the states
         if self.kind == "fourier":
             widths = [self.plan[float(hk)][2] for hk in h]
             z = np.empty((P, int(sum(widths))))
             streams.fill(z)                          # each path's stream: the block's steps in order
             return block_areas(dW, h, self.plan, z, ito)
-        out = np.empty((P, k, d, d))
         if self.kind == "exact":
             if d == 1:
                 out[..., 0, 0] = 0.5 * dW[..., 0] ** 2 - (0.5 * h if ito else 0.0)
                 return out
-            if states is None:  # pragma: no cover - only if numpy's algorithms change
-                raise RuntimeError("levy_area='exact' needs the numba PCG64 streams, whose self-check against "
-                                   "numpy failed in this process; use levy_area='mrongowius-rossler'.")
-            _exact_areas_d2(dW, h, states, load_table(), TABLE_STEP, _EXACT_TERMS, _EXACT_T1, _EXACT_T2, ito, out)
-            return out
-        na = self.width
-        davie = self.name == "davie" and d > 1
-        if states is not None:                       # draw each step's normals inside the kernel
-            _block_areas(dW, h, zbuf[:na].reshape(1, 1, na), states, self.substeps, davie, ito, out)
-        else:
-            z = np.empty((P, k * na))
-            streams.fill(z)
-            _block_areas(dW, h, z.reshape(P, k, na), _NO_STATES, self.substeps, davie, ito, out)
+            # only if numpy's algorithms change (the numba streams' self-check failed)
+            raise RuntimeError("levy_area='exact' needs the numba PCG64 streams, whose self-check against "
+                               "numpy failed in this process; use levy_area='mrongowius-rossler'.")
+        na = self.width                              # the bridge methods on numpy streams
+        z = np.empty((P, k * na))
+        streams.fill(z)
+        _block_areas(dW, h, z.reshape(P, k, na), _NO_STATES, self.substeps, self.name == "davie" and d > 1, ito, out)
         return out
 
 
