@@ -265,42 +265,11 @@ class BrownianTree:
         return i, j
 
     def _chen(self, i: int, j: int):
-        """``(W (P, d), A (P, d, d))`` over grid cells ``[i, j)``: the Chen product of the canonical nodes.
-
-        A depth-first walk from the root, left to right: a node inside ``[i, j)`` is reduced to its
-        ``(W, A)`` at once, a node straddling an end is split (at most two per depth), so only a few node
-        states are alive at a time whatever the cache holds.
-        """
-        P, d, L = self.n_paths, self.dim, self.resolution
-        if self._root_node is None:
-            self._root_node = self._root()
-        Ws, As = [], []
-        stack = [(0, 0, self._root_node)]
-        while stack:
-            depth, index, node = stack.pop()
-            if depth < 0:                                    # a reduced node: (W, A) in ``node``
-                Ws.append(node[0])
-                As.append(node[1])
-                continue
-            size = 1 << (L - depth)
-            lo = index * size
-            if lo + size <= i or lo >= j:
-                continue
-            if i <= lo and lo + size <= j:
-                stack.append((-1, 0, _reduce(node)))
-                continue
-            left, right = self._children(depth, index, node)
-            for k, child in ((2 * index + 1, right), (2 * index, left)):
-                clo = k * (size >> 1)
-                if i <= clo and clo + (size >> 1) <= j:
-                    child = _reduce(child)
-                    stack.append((-1, 0, child))
-                else:
-                    stack.append((depth + 1, k, child))
-        if not Ws:
-            return np.zeros((P, d)), np.zeros((P, d, d))
-        Wk = np.stack(Ws, axis=1)
-        return Wk.sum(axis=1), sum(As) + polygon_area(Wk)
+        """``(W (P, d), A (P, d, d))`` over grid cells ``[i, j)``: the one cell of :meth:`_cells` (zeros if empty)."""
+        if i == j:
+            return np.zeros((self.n_paths, self.dim)), np.zeros((self.n_paths, self.dim, self.dim))
+        W, A = self._cells(np.array([i, j], dtype=np.int64))
+        return W[:, 0], A[:, 0]
 
     def _out(self, x):
         return x.reshape(self.batch_shape + x.shape[1:])
@@ -337,9 +306,11 @@ class BrownianTree:
     def _cells(self, idx):
         """``(W (P, n, d), A (P, n, d, d))`` of the cells ``[idx[k], idx[k+1])`` in one walk of the tree.
 
-        The walk splits exactly the nodes that hold a grid point strictly inside, so each cell is the Chen
-        product of the same canonical nodes as in :meth:`_chen`, in the same order: the answers are
-        bitwise those of :meth:`_chen` cell by cell, without walking down from the root once per cell.
+        A depth-first walk from the root, left to right, that splits exactly the nodes holding a grid point
+        strictly inside (at most two per depth and grid point): every other node lies in one cell and is
+        reduced to its ``(W, A)`` at once. So a cell is the Chen product of its canonical dyadic nodes,
+        whatever the other grid points, and only a few node states are alive at a time whatever the cache
+        holds.
         """
         P, d, L = self.n_paths, self.dim, self.resolution
         n = idx.size - 1
