@@ -177,11 +177,6 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
     e = y.shape[-1]
     members = int(np.prod(batch, dtype=np.int64))
 
-    def query(i, m, j):
-        ts = t0 + cell * np.array([i, m, j], dtype=np.float64)
-        W, A = tree.increments_and_levy_areas(ts)
-        return (np.broadcast_to(W, batch + W.shape[-2:]), np.broadcast_to(_areas(W, A), batch + A.shape[-3:]))
-
     saved_t = [t0] if (save_all or 0 in save_idx) else []
     saved_y = [y.copy()] if saved_t else []
     failed_step = np.full(batch, -1, dtype=np.int64)
@@ -208,9 +203,9 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
             if j >= target or target - j < min_cells:
                 j = target
             at_floor = (j - i) <= min_cells or (j - i) * cell <= dt_min * (1 + 1e-12)
-            m = (i + j) // 2
-            W, XX = query(i, m, j)
-            ts = t0 + cell * np.array([i, m, j], dtype=np.float64)
+            ts = t0 + cell * np.array([i, (i + j) // 2, j], dtype=np.float64)
+            W, A = tree.increments_and_levy_areas(ts)
+            W, XX = np.broadcast_to(W, batch + W.shape[-2:]), np.broadcast_to(_areas(W, A), batch + A.shape[-3:])
             W1, W2 = W[..., 0, :], W[..., 1, :]
             XXw = XX[..., 0, :, :] + XX[..., 1, :, :] + W1[..., :, None] * W2[..., None, :]
             y2, _, _ = solver.integrate(fields, y, ts, W, XX, no_save, stop_on_failure=False)
