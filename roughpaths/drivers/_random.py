@@ -290,6 +290,14 @@ def _entropy_words(seed_seq: np.random.SeedSequence) -> list:
     return words
 
 
+def stream_prefix(seed_seq: np.random.SeedSequence) -> np.ndarray:
+    """The entropy words (uint32) that every stream of ``seed_seq`` hashes before its key: the run entropy
+    padded to the pool size 4 (numpy's ``hashmix(0)`` fill), then the spawn key."""
+    run = _entropy_words(seed_seq)
+    run = run + [0] * max(0, 4 - len(run))
+    return np.array(run + [w for v in seed_seq.spawn_key for w in _uint32_words(int(v))], dtype=np.uint32)
+
+
 _FAST_OK: list = []
 
 
@@ -357,9 +365,7 @@ class PathStreams:
         kint = np.asarray(keys, dtype=np.int64) if keys.dtype != object else None
         if kint is not None and kint.ndim == 2 and kint.min(initial=0) >= 0 and kint.max(initial=0) < 2**32:
             # the common case: every key element is one 32-bit word, the entropy rows have one length
-            if len(run) < 4:
-                run = run + [0] * (4 - len(run))
-            prefix = np.array(run + base, dtype=np.uint32)
+            prefix = stream_prefix(ss)
             ent = np.empty((P, prefix.size + kint.shape[1]), dtype=np.uint32)
             ent[:, :prefix.size] = prefix
             ent[:, prefix.size:] = kint.astype(np.uint32)

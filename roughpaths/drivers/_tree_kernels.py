@@ -46,7 +46,7 @@ import numpy as np
 from numba import njit
 
 from ._bridge import _pair_solve
-from ._random import _entropy_words, _fast_streams_ok, _pcg64_normals, _pcg64_seed, _seed_states, _uint32_words
+from ._random import _fast_streams_ok, _pcg64_normals, _pcg64_seed, _seed_states, stream_prefix
 
 __all__ = ["split_width", "refine_segments", "refine_segments_fast", "polygon_area", "reduce_node",
            "antisym_from_normals", "seed_prefix", "split_seeded"]
@@ -335,10 +335,7 @@ def seed_prefix(seed_seq):
     """
     if seed_seq.pool_size != 4 or not _fast_streams_ok():
         return None
-    run = _entropy_words(seed_seq)
-    run = run + [0] * max(0, 4 - len(run))
-    base = [w for v in seed_seq.spawn_key for w in _uint32_words(int(v))]
-    return np.array(run + base, dtype=np.uint32)
+    return stream_prefix(seed_seq)
 
 
 @njit(cache=True, nogil=True)
