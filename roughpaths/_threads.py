@@ -63,8 +63,12 @@ def ranges(n_items: int, work_per_item: float) -> list:
 
 def run(fn, parts: list) -> None:
     """Call ``fn(lo, hi)`` for every range in ``parts``, shared between the caller and the pool."""
+    if len(parts) <= 1:                     # decided before asking numba (its query costs ~5 us)
+        for lo, hi in parts:
+            fn(lo, hi)
+        return
     threads = numba.get_num_threads()
-    if threads <= 1 or len(parts) <= 1:
+    if threads <= 1:
         for lo, hi in parts:
             fn(lo, hi)
         return

@@ -33,9 +33,10 @@ def warm() -> None:
         return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
 
     lone, wide, batch = path(9, 3), path(2, 7, 6), path(10, 9, 3)
+    wide_batch = path(9, 7, 6)                             # d >= 6: lane groups of paths at level 2
     long_path = path(2 * 1024 + 8, 2)                     # cut into chunks (Chen glue)
     long_l2 = path(2 * 8192 + 8, 3)                       # level 2, chunked
-    for x in (lone, wide, batch, long_path, lone.tolist(), lone[None, None]):
+    for x in (lone, wide, wide_batch, batch, long_path, lone.tolist(), lone[None, None]):
         for m in (1, 2, 3):
             rp.signature(x, m)
             rp.logsignature(x, m)

@@ -13,6 +13,8 @@ compiled kernels (private to :mod:`roughpaths.algebra`) split over threads by
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from .. import _threads
@@ -22,8 +24,12 @@ from ._lyndon import lyndon_projection
 __all__ = ["level_offsets", "log_flat", "lyndon_flat", "lyndon_flat_vjp"]
 
 
+@lru_cache(maxsize=512)
 def level_offsets(dim: int, depth: int) -> np.ndarray:
     """Start of each level in the flat layout: ``off[k]`` for ``k = 1..depth+1`` (``off[1] = 0``).
+
+    Cached and shared by every caller: never write to it. (Left writeable: numba compiles a separate
+    kernel for a read-only array.)
 
     >>> level_offsets(2, 3)[1:]
     array([ 0,  2,  6, 14])
@@ -56,12 +62,15 @@ def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Lyndon coordinates ``(B, logsigdim)`` of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
     off = level_offsets(dim, depth)
     projections = [lyndon_projection(dim, k) for k in range(1, depth + 1)]
-    out = np.empty((z.shape[0], sum(p[0].shape[0] for p in projections)))
-    start = 0
-    for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
-        _run(lambda lo, hi: _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, start, lo, hi),
-             _threads.ranges(z.shape[0], float(lidx.shape[0] + indices.shape[0])))
-        start += lidx.shape[0]
+    sizes = [p[0].shape[0] for p in projections]
+    out = np.empty((z.shape[0], sum(sizes)))
+    parts = _threads.ranges(z.shape[0], float(sum(p[0].shape[0] + p[2].shape[0] for p in projections)))
+    starts = [sum(sizes[:k]) for k in range(depth)]
+
+    def rows(lo, hi):                       # every level of rows lo .. hi-1, one hand-off in all
+        for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
+            _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, starts[k - 1], lo, hi)
+    _run(rows, parts)
     return out
 
 

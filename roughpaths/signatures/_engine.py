@@ -77,10 +77,13 @@ def _sigdim(d: int, depth: int) -> int:
     return int(sigdim(d, depth))
 
 
+_offsets = level_offsets                    # cached (shared: never written to)
+
+
 @lru_cache(maxsize=512)
-def _offsets(d: int, depth: int) -> np.ndarray:
-    """:func:`roughpaths.algebra.flat.level_offsets`, cached (shared: never written to)."""
-    return level_offsets(d, depth)
+def _logsigdim(d: int, depth: int) -> int:
+    """:func:`roughpaths.logsigdim`, cached (its argument checks and Witt's sums cost ~15 us a call)."""
+    return int(logsigdim(d, depth))
 
 
 def _check_depth(depth) -> int:
@@ -101,7 +104,7 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     dim = _sigdim(d, depth)
     need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
     if log and depth > 1 and d > 1:
-        need += 12 * min(logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+        need += 12 * min(_logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
     if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
         return
     what = "logsignature" if log else "signature"
@@ -187,8 +190,14 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     nb, n, d = x.shape
     nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
     part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
-    _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, lo, hi, part),
-                 _threads.ranges(nb * nchunks, (n / nchunks) * d * d))
+    per_task = (n / nchunks) * d * d
+    groups = nb // _lanes.LANES if d >= _l2.LANE_WIDTH else 0      # same bits either way
+    if groups:
+        _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
+                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES))
+    first = groups * _lanes.LANES * nchunks
+    _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, first + lo, first + hi, part),
+                 _threads.ranges(nb * nchunks - first, per_task))
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
@@ -202,6 +211,16 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if depth == 2:
         return _level2_flat(x, log=False)
     nchunks = _horner_chunks(n, d, depth)
+    if n * d < _sigdim(d, depth):
+        # Word reversal w -> w* is an anti-automorphism that fixes every exp(Δ), so S(x)_w = S(y)_{w*} for the
+        # path y = -x reversed in time (increments Δ_n, ..., Δ_1). The reversed layout stores S(y)_{w*} where
+        # the row-major one stores S(x)_w: the kernels' output for y is x's signature in row-major order.
+        # One pass over the (smaller) input replaces the permutation of the output; the choice depends on
+        # (n, d, depth) only, so a member's bits do not depend on its batch.
+        out = _reversed_parts(np.negative(x[:, ::-1, :]), depth, nchunks)
+        if nchunks > 1:
+            out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
+        return out
     out = _reversed_parts(x, depth, nchunks)
     if nchunks > 1:
         out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))

@@ -6,6 +6,9 @@
   at d = 6, 8 and (depth 2, the closed-form level-2 kernel) 20;
 * a path computed alone equals, bit for bit, the same path inside batches of 1..10 members (which
   move it between the lane kernel and the one-unit kernel), for the signature and its VJP.
+* both layout routes (the time-reversed input, and the permutation of the output) equal iisignature
+  on either side of their threshold ``n d = sigdim``; level 2 at d >= 6 in lane groups of paths, chunked,
+  with a member left over, equals iisignature and each member alone.
 
 Oracle: iisignature (an independent C++ implementation), and the public function on the single member.
 """
@@ -80,3 +83,24 @@ def test_wide_vjp_matches_central_differences_of_iisignature(rng, d, m):
           - np.sum(g * iisignature.sig(x - h * v, m), axis=-1)) / (2 * h)
     got = np.sum(signature_vjp(x, m, g) * v, axis=(-2, -1))
     np.testing.assert_allclose(got, fd, rtol=1e-7, atol=1e-7)
+
+
+@pytest.mark.parametrize("n", [62, 63, 64])
+def test_both_layout_routes_match_iisignature(rng, n):
+    """d = 2, depth 6 (sigdim 126): paths with n d < 126 go through the time-reversed input (whose
+    reversed-layout signature is the row-major one), the others through the permutation."""
+    x = _paths(rng, 3, n, 2)
+    np.testing.assert_allclose(signature(x, 6), iisignature.sig(x, 6), rtol=0, atol=TOL)
+    np.testing.assert_array_equal(signature(x[1:2], 6)[0], signature(x, 6)[1])
+
+
+def test_wide_level2_lane_groups_with_chunks_and_a_tail(rng):
+    """d >= 6 level 2: 9 paths run as one lane group of 8 and one path alone; a path of 16 500 points is
+    cut into 2 chunks. Equal to iisignature, and every member equal bit for bit to itself alone."""
+    x = _paths(rng, 9, 16_500, 6)
+    s = signature(x, 2)
+    np.testing.assert_allclose(s, iisignature.sig(x, 2), rtol=0, atol=1e-11)
+    ls = logsignature(x, 2)
+    for b in (0, 7, 8):
+        np.testing.assert_array_equal(signature(x[b:b + 1], 2)[0], s[b])
+        np.testing.assert_array_equal(logsignature(x[b:b + 1], 2)[0], ls[b])
