@@ -270,82 +270,70 @@ def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, thet
     return nnew
 
 
+@functools.lru_cache(maxsize=32)
+def _pairs(nm: int):
+    """The pairs ``i < j`` of ``nm`` noise components (``numpy.triu_indices`` order), as int64 arrays."""
+    pi, pj = np.triu_indices(nm, 1)
+    return pi.astype(np.int64), pj.astype(np.int64)
+
+
+#: Steps whose stochastic velocities are formed at a time (a (members, steps, 3) tile that stays in cache).
+_TILE = 32
+
+
 @numba.njit(cache=True)
-def _so3_eta_block(m, eta, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
-                   first_bad, reason, stop):
-    """Advance m (3, B) over stochastic velocities eta (B, K, 3); after step k with ``save[k]`` the state
-    goes to the next slot of out (B, S, 3). With ``stop``, returns after the first step at which a
-    member failed. Returns the number of steps done."""
-    nb = m.shape[1]
-    slot = 0
-    for k in range(eta.shape[1]):
-        for p in range(nb):
-            e[0, p] = eta[p, k, 0]
-            e[1, p] = eta[p, k, 1]
-            e[2, p] = eta[p, k, 2]
-        nnew = _so3_block_step(m, e, dts[k], coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad,
-                               reason, k)
-        if save[k]:
-            for p in range(nb):
-                out[p, slot, 0] = m[0, p]
-                out[p, slot, 1] = m[1, p]
-                out[p, slot, 2] = m[2, p]
-            slot += 1
-        if stop and nnew > 0:
-            return k + 1
-    return eta.shape[1]
+def _velocities(dX, dXX, xi, brk, pi, pj, k0, tile):
+    """``tile[p, t]`` <- the stochastic velocity of member ``p`` at step ``k0 + t``:
+    Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], ``A = ½(XX - XXᵀ)`` (no area term when ``dXX`` is empty).
 
-
-#: Members per block of the thread split (each block runs all its steps on one thread).
-BLOCK = 256
-
-
-@numba.njit(cache=True, nogil=True)
-def _so3_range(y, eta, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out, first_bad, reason, stop, lo,
-               hi):
-    """Run :func:`_so3_eta_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
-    a member's result does not depend on its block)."""
-    bc = hi - lo
-    m = np.empty((3, bc))
-    for p in range(bc):
-        for i in range(3):
-            m[i, p] = y[lo + p, i]
-    _so3_eta_block(m, eta[lo:hi], dts, np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, code, tol,
-                   max_iter, q, lin, minv, theta, save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
-    for p in range(bc):
-        for i in range(3):
-            y[lo + p, i] = m[i, p]
-
-
-def integrate_so3(data, code, tol, max_iter, y, eta, dts, save, stop_on_failure):
-    """Run the so(3) kernel on ``y`` (B, 3) with ``eta`` (B, K, 3); returns (y, saved, first_bad, reason).
-
-    Blocks of :data:`BLOCK` members run in parallel (:func:`roughpaths.validation.parallel_ranges`; ``numba.set_num_threads``)."""
-    nb = y.shape[0]
-    coef = coefficients(data)
-    lin = np.concatenate([data["linear"], data["dissipation_change"]])
-    y = np.array(y, dtype=np.float64, order="C")
-    out = np.full((nb, int(np.count_nonzero(save)), 3), np.nan)
-    first_bad = np.full(nb, -1, dtype=np.int64)
-    reason = np.zeros(nb, dtype=np.int8)
-    args = (y, np.ascontiguousarray(eta), np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol),
-            int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
-            np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure))
-    parallel_ranges(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
-    return y, out, first_bad, reason
-
-
-@numba.njit(cache=True, nogil=True)
-def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
-    """Stochastic velocities out (B, K, 3) = Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], A = ½(XX - XXᵀ).
-
-    ``dX`` (B, K, m); ``dXX`` (B, K, m, m) or an empty array (level-1 driving: no area term);
-    ``xi`` (m, 3); ``brk`` (npair, 3) the brackets of the pairs ``pi < pj``.
+    ``dX`` (B, K, m); ``dXX`` (B, K, m, m) or empty; ``xi`` (m, 3); ``brk`` (npair, 3) the brackets of the
+    pairs ``pi < pj`` (``numpy.triu_indices`` order); ``tile`` (B, T, 3). Each sum runs from 0.0 in this
+    order (``LiePoissonSystem.stochastic_velocity`` up to round-off). Member by member, so the increments
+    and areas are read in memory order.
     """
-    nb, nk, nm = dX.shape
+    nb, nt = tile.shape[0], min(tile.shape[1], dX.shape[1] - k0)
+    nm = dX.shape[2]
     area = dXX.shape[0] > 0
+    if nm == 3:                                 # the same sums written out (measured 2x faster with the area)
+        x00, x01, x02, x10, x11, x12 = xi[0, 0], xi[0, 1], xi[0, 2], xi[1, 0], xi[1, 1], xi[1, 2]
+        x20, x21, x22 = xi[2, 0], xi[2, 1], xi[2, 2]
+        b00, b01, b02, b10, b11, b12 = brk[0, 0], brk[0, 1], brk[0, 2], brk[1, 0], brk[1, 1], brk[1, 2]
+        b20, b21, b22 = brk[2, 0], brk[2, 1], brk[2, 2]
+        for p in range(nb):
+            for t in range(nt):
+                k = k0 + t
+                x = dX[p, k, 0]
+                e0 = 0.0 + x * x00
+                e1 = 0.0 + x * x01
+                e2 = 0.0 + x * x02
+                x = dX[p, k, 1]
+                e0 += x * x10
+                e1 += x * x11
+                e2 += x * x12
+                x = dX[p, k, 2]
+                e0 += x * x20
+                e1 += x * x21
+                e2 += x * x22
+                if area:
+                    a = 0.5 * (dXX[p, k, 0, 1] - dXX[p, k, 1, 0])
+                    e0 += a * b00
+                    e1 += a * b01
+                    e2 += a * b02
+                    a = 0.5 * (dXX[p, k, 0, 2] - dXX[p, k, 2, 0])
+                    e0 += a * b10
+                    e1 += a * b11
+                    e2 += a * b12
+                    a = 0.5 * (dXX[p, k, 1, 2] - dXX[p, k, 2, 1])
+                    e0 += a * b20
+                    e1 += a * b21
+                    e2 += a * b22
+                tile[p, t, 0] = e0
+                tile[p, t, 1] = e1
+                tile[p, t, 2] = e2
+        return
     for p in range(nb):
-        for k in range(nk):
+        for t in range(nt):
+            k = k0 + t
             e0 = 0.0
             e1 = 0.0
             e2 = 0.0
@@ -361,82 +349,86 @@ def _eta_from_increments(dX, dXX, xi, brk, pi, pj, out):
                     e0 += a * brk[r, 0]
                     e1 += a * brk[r, 1]
                     e2 += a * brk[r, 2]
-            out[p, k, 0] = e0
-            out[p, k, 1] = e1
-            out[p, k, 2] = e2
+            tile[p, t, 0] = e0
+            tile[p, t, 1] = e1
+            tile[p, t, 2] = e2
+
+
+@numba.njit(cache=True)
+def _so3_dx_block(m, dX, dXX, xi, brk, pi, pj, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta, save,
+                  out, first_bad, reason, stop):
+    """Advance m (3, B) over the increments ``dX`` (B, K, m) and areas ``dXX`` (:func:`_velocities`, formed
+    :data:`_TILE` steps at a time); after step k with ``save[k]`` the state goes to the next slot of out
+    (B, S, 3). With ``stop``, returns after the first step at which a member failed. Returns the number of
+    steps done."""
+    nb = m.shape[1]
+    slot = 0
+    tile = np.empty((nb, _TILE, 3))
+    for k in range(dX.shape[1]):
+        t = k % _TILE
+        if t == 0:
+            _velocities(dX, dXX, xi, brk, pi, pj, k, tile)
+        for p in range(nb):
+            e[0, p] = tile[p, t, 0]
+            e[1, p] = tile[p, t, 1]
+            e[2, p] = tile[p, t, 2]
+        nnew = _so3_block_step(m, e, dts[k], coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad,
+                               reason, k)
+        if save[k]:
+            for p in range(nb):
+                out[p, slot, 0] = m[0, p]
+                out[p, slot, 1] = m[1, p]
+                out[p, slot, 2] = m[2, p]
+            slot += 1
+        if stop and nnew > 0:
+            return k + 1
+    return dX.shape[1]
+
+
+#: Members per block of the thread split (each block runs all its steps on one thread).
+BLOCK = 256
 
 
 @numba.njit(cache=True, nogil=True)
-def _eta_from_increments3(dX, dXX, xi, brk, out):
-    """:func:`_eta_from_increments` for three noise components, the sums written out in the same order (so
-    the same bits; measured 9 against 19 ns per path-step with the area)."""
-    nb, nk, _ = dX.shape
-    area = dXX.shape[0] > 0
-    x00, x01, x02, x10, x11, x12 = xi[0, 0], xi[0, 1], xi[0, 2], xi[1, 0], xi[1, 1], xi[1, 2]
-    x20, x21, x22 = xi[2, 0], xi[2, 1], xi[2, 2]
-    b00, b01, b02, b10, b11, b12 = brk[0, 0], brk[0, 1], brk[0, 2], brk[1, 0], brk[1, 1], brk[1, 2]
-    b20, b21, b22 = brk[2, 0], brk[2, 1], brk[2, 2]
-    for p in range(nb):
-        for k in range(nk):
-            x = dX[p, k, 0]
-            e0 = 0.0 + x * x00
-            e1 = 0.0 + x * x01
-            e2 = 0.0 + x * x02
-            x = dX[p, k, 1]
-            e0 += x * x10
-            e1 += x * x11
-            e2 += x * x12
-            x = dX[p, k, 2]
-            e0 += x * x20
-            e1 += x * x21
-            e2 += x * x22
-            if area:
-                a = 0.5 * (dXX[p, k, 0, 1] - dXX[p, k, 1, 0])
-                e0 += a * b00
-                e1 += a * b01
-                e2 += a * b02
-                a = 0.5 * (dXX[p, k, 0, 2] - dXX[p, k, 2, 0])
-                e0 += a * b10
-                e1 += a * b11
-                e2 += a * b12
-                a = 0.5 * (dXX[p, k, 1, 2] - dXX[p, k, 2, 1])
-                e0 += a * b20
-                e1 += a * b21
-                e2 += a * b22
-            out[p, k, 0] = e0
-            out[p, k, 1] = e1
-            out[p, k, 2] = e2
+def _so3_range(y, dX, dXX, xi, brk, pi, pj, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
+               first_bad, reason, stop, lo, hi):
+    """Run :func:`_so3_dx_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
+    a member's result does not depend on its block)."""
+    bc = hi - lo
+    m = np.empty((3, bc))
+    for p in range(bc):
+        for i in range(3):
+            m[i, p] = y[lo + p, i]
+    _so3_dx_block(m, dX[lo:hi], dXX[lo:hi] if dXX.shape[0] > 0 else dXX, xi, brk, pi, pj, dts,
+                  np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, code, tol, max_iter, q, lin, minv, theta,
+                  save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
+    for p in range(bc):
+        for i in range(3):
+            y[lo + p, i] = m[i, p]
 
 
-@functools.lru_cache(maxsize=32)
-def _pairs(nm: int):
-    """The pairs ``i < j`` of ``nm`` noise components (``numpy.triu_indices`` order), as int64 arrays."""
-    pi, pj = np.triu_indices(nm, 1)
-    return pi.astype(np.int64), pj.astype(np.int64)
+def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
+    """Run the so(3) kernel on ``y`` (B, 3) driven by ``dX`` (B, K, m) and ``dXX`` (B, K, m, m) or None;
+    returns (y, saved, first_bad, reason).
 
-
-def stochastic_velocities(system, dX, dXX, batch):
-    """``system.stochastic_velocity`` of a block for the so(3) kernels, shape ``(prod(batch), K, 3)``."""
-    nk, nm = dX.shape[-2:]
-    nb = int(np.prod(batch, dtype=np.int64))
-    shape = batch + (nk, nm)
-    dX = np.ascontiguousarray(dX if dX.shape == shape else np.broadcast_to(dX, shape), dtype=np.float64)
-    dX = dX.reshape(nb, nk, nm)
-    if dXX is None:
-        dXX = np.empty((0, 0, 0, 0))
-    else:
-        shape = batch + (nk, nm, nm)
-        dXX = np.ascontiguousarray(dXX if dXX.shape == shape else np.broadcast_to(dXX, shape), dtype=np.float64)
-        dXX = dXX.reshape(nb, nk, nm, nm)
+    Blocks of :data:`BLOCK` members run in parallel (:func:`roughpaths.validation.parallel_ranges`;
+    ``numba.set_num_threads``); each forms its stochastic velocities step by step, so no (B, K, 3) array
+    of them is written."""
+    data = system.quadratic_velocity_data()
+    nb, nk, nm = dX.shape
+    coef = coefficients(data)
+    lin = np.concatenate([data["linear"], data["dissipation_change"]])
+    y = np.array(y, dtype=np.float64, order="C")
+    out = np.full((nb, int(np.count_nonzero(save)), 3), np.nan)
+    first_bad = np.full(nb, -1, dtype=np.int64)
+    reason = np.zeros(nb, dtype=np.int8)
     pi, pj = _pairs(nm)
     brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
-    out = np.empty((nb, nk, 3))
-    xi = np.ascontiguousarray(system.xi)
-    area = dXX.shape[0] > 0
-    if nm == 3:
-        parallel_ranges(lambda lo, hi: _eta_from_increments3(dX[lo:hi], dXX[lo:hi] if area else dXX, xi, brk,
-                                                             out[lo:hi]), nb, BLOCK)
-    else:
-        parallel_ranges(lambda lo, hi: _eta_from_increments(dX[lo:hi], dXX[lo:hi] if area else dXX, xi, brk, pi,
-                                                            pj, out[lo:hi]), nb, BLOCK)   # per member: any split
-    return out
+    args = (y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi, dtype=np.float64),
+            brk, pi, pj, np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol), int(max_iter),
+            data["q"], lin, data["metric_inv"], float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out,
+            first_bad, reason, bool(stop_on_failure))
+    parallel_ranges(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
+    return y, out, first_bad, reason
+
+

@@ -210,20 +210,16 @@ class CoadjointSolver(Solver):
         nk = dts.size
         nsave = int(np.count_nonzero(save))
         plain = system.hamiltonian.is_quadratic and not system.has_forces      # forces: the numpy path
-        if isinstance(system.algebra, SO3Algebra) and plain:
-            nb = int(np.prod(batch, dtype=np.int64))
-            eta_b = _so3_kernels.stochastic_velocities(system, dX, dXX, batch)
-            y2, saved, first_bad, reason = _so3_kernels.integrate_so3(
-                system.quadratic_velocity_data(), self._code, getattr(self, "tol", 1e-13),
-                getattr(self, "max_iter", 1), y.reshape(nb, n), eta_b, dts, save, stop_on_failure)
-            y2, saved = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n))
-            first_bad, chord = first_bad.reshape(batch), (reason == _so3_kernels.CHORD_FAILED).reshape(batch)
-        elif plain:
-            # se(3) (the heavy top): the hand-written kernel for the implicit midpoint rule; every other case
-            # (se(3) Lie-Euler / Lie-Heun included, where it measured faster): the generic one
-            hand = isinstance(system.algebra, SE3Algebra) and self._code == 2
-            kernels = _se3_kernels if hand else _generic_kernels
-            run = _se3_kernels.integrate_se3 if hand else _generic_kernels.integrate_generic
+        if plain:
+            # so(3): the hand-written kernel; se(3) (the heavy top): the hand-written kernel for the implicit
+            # midpoint rule; every other case (se(3) Lie-Euler / Lie-Heun included, where it measured faster):
+            # the generic one
+            if isinstance(system.algebra, SO3Algebra):
+                kernels, run = _so3_kernels, _so3_kernels.integrate_so3
+            elif isinstance(system.algebra, SE3Algebra) and self._code == 2:
+                kernels, run = _se3_kernels, _se3_kernels.integrate_se3
+            else:
+                kernels, run = _generic_kernels, _generic_kernels.integrate_generic
             nb = int(np.prod(batch, dtype=np.int64))
             d = dX.shape[-1]
             dX = np.ascontiguousarray(np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d), dtype=np.float64)
