@@ -18,12 +18,14 @@ sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scale
 Reported: median wall (or, with ``--clock cpu``, process CPU) time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
 max ||Π(T)| - 1| over the paths, and ratios peer / ours.
 
-Then the cost of Davie's area (issue 24, item 4): a path-step of the full solve and of the driver alone with
-the area and without it, CPU time, interleaved runs, and the ratio (target <= 1.6).
+Then the cost of Davie's area (issue 24, item 4): a path-step of the solver on a sampled path, of the full
+solve and of the driver alone, with the area and without it, CPU time, interleaved runs, the ratio (target
+<= 1.6), and the floor that numpy's normals put under the full-solve ratio.
 
 Last, one thread against all of numba's threads on the full solve (driver included, ``n_paths`` x 1,000
 steps), with and without the area: wall, CPU, and the calling thread's CPU time (the idle-machine wall
-estimate on a shared machine), with a bitwise check.
+estimate on a shared machine), with a bitwise check; and, on two cores, what two threads give a loop bound
+by arithmetic and one that streams from the L2 cache on this machine.
 
 Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R] [--clock wall|cpu]
 [--skip diffrax,torchsde,sdeint] [--threads-only] [--area-only]``.
@@ -222,28 +224,51 @@ def bench_sdeint(n_paths, n_steps, repeats):
 def bench_area_ratio(n_paths, n_steps, repeats):
     """The cost of Davie's area: a path-step with the area against one without (issue 24, item 4; target <= 1.6x).
 
-    The full solve (driver sampling included, LieHeun, ``save_at="end"``) and the driver alone, with
-    ``levy_area="davie"`` and ``None``, in process CPU time, as interleaved runs (with, without, with, ...);
-    medians per configuration, and the median of the per-pair ratios.
+    Three measures, each in process CPU time, as interleaved runs (with, without, with, ...), medians per
+    configuration and the median of the per-pair ratios:
+
+    * the solver given the driver's increments and areas (a sampled ``RoughPath`` in memory, one thread): the
+      measure of the issue's 70-76 against 26 ns;
+    * the full solve (driver sampling included, LieHeun, ``save_at="end"``);
+    * the driver alone.
+
+    And the floor of the full-solve ratio while the normals are numpy's, bit for bit: the 6 normals per
+    path-step that Davie's area adds at d = 3 (d normals of space-time area and d(d-1)/2 of Davie's own)
+    cost what a driver of d = 9 without area costs over one of d = 3; even if every other area cost were
+    zero, the full solve could not beat (no-area solve + that) / no-area solve.
     """
+    import numba
+
     from mechanics import LieHeun, rigid_body
     from roughpaths import BrownianDriver, solve
 
     rb = rigid_body(INERTIA, sigma=SIGMA, theta=THETA)
     mu0 = np.array([0.0, 0.0, 1.0])
 
-    def driver(area):
-        return BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,), levy_area=area)
+    def driver(area, dim=3, steps=n_steps):
+        return BrownianDriver(dim, seed=1, dt=DT, n_steps=steps, batch_shape=(n_paths,), levy_area=area)
 
     def run_solve(area):
         return solve(rb, driver(area), mu0, LieHeun(), save_at="end").final
 
-    def run_driver(area):
-        for _ in driver(area).blocks():
+    def run_driver(area, dim=3):
+        for _ in driver(area, dim).blocks():
             pass
 
-    cfg = [("solve", run_solve, "davie"), ("solve", run_solve, None), ("driver", run_driver, "davie"),
-           ("driver", run_driver, None)]
+    k_steps = max(n_steps // 2, 1)                      # the sampled paths are held in memory (96 B/path-step)
+    sampled = {a: driver(a, steps=k_steps).rough_path() for a in ("davie", None)}
+
+    def run_kernel(area):
+        threads = numba.get_num_threads()
+        numba.set_num_threads(1)
+        try:
+            return solve(rb, sampled[area], mu0, LieHeun(), save_at="end").final
+        finally:
+            numba.set_num_threads(threads)
+
+    cfg = [("kernel", run_kernel, "davie"), ("kernel", run_kernel, None), ("solve", run_solve, "davie"),
+           ("solve", run_solve, None), ("driver", run_driver, "davie"), ("driver", run_driver, None),
+           ("driver d=9", lambda a: run_driver(None, 9), None)]
     for _, fn, area in cfg:
         fn(area)
     times = {i: [] for i in range(len(cfg))}
@@ -252,17 +277,75 @@ def bench_area_ratio(n_paths, n_steps, repeats):
             t0 = time.process_time()
             fn(area)
             times[i].append(time.process_time() - t0)
-    ns = {i: 1e9 * statistics.median(t) / (n_paths * n_steps) for i, t in times.items()}
-    pair = statistics.median(a / b for a, b in zip(times[0], times[1]))
-    print(f"area cost: {n_paths} x {n_steps}, LieHeun, CPU time (all threads), medians of {repeats} interleaved runs, "
-          f"ns per path-step")
-    print(f"  {'':22s} {'Davie area':>10s} {'no area':>8s} {'ratio':>6s}")
-    print(f"  {'full solve':22s} {ns[0]:10.1f} {ns[1]:8.1f} {ns[0] / ns[1]:6.2f}   (median of pair ratios {pair:.2f}; "
-          f"target <= 1.6)")
-    print(f"  {'driver alone':22s} {ns[2]:10.1f} {ns[3]:8.1f} {ns[2] / ns[3]:6.2f}")
-    print(f"  {'solver (solve - driver)':22s} {ns[0] - ns[2]:10.1f} {ns[1] - ns[3]:8.1f} "
-          f"{(ns[0] - ns[2]) / (ns[1] - ns[3]):6.2f}")
+    steps = [k_steps if name == "kernel" else n_steps for name, _, _ in cfg]
+    ns = {i: 1e9 * statistics.median(t) / (n_paths * steps[i]) for i, t in times.items()}
+
+    def pair(i, j):
+        return statistics.median(a / b for a, b in zip(times[i], times[j]))
+
+    print(f"area cost: {n_paths} paths x {n_steps} steps ({k_steps} for the sampled path), LieHeun, CPU time "
+          f"(all threads), medians of {repeats} interleaved runs, ns per path-step")
+    print(f"  {'':34s} {'Davie area':>10s} {'no area':>8s} {'ratio':>6s} {'pairs':>6s}")
+    print(f"  {'solver on a sampled path, 1 thread':34s} {ns[0]:10.1f} {ns[1]:8.1f} {ns[0] / ns[1]:6.2f} "
+          f"{pair(0, 1):6.2f}   (target <= 1.6)")
+    print(f"  {'full solve':34s} {ns[2]:10.1f} {ns[3]:8.1f} {ns[2] / ns[3]:6.2f} {pair(2, 3):6.2f}")
+    print(f"  {'driver alone':34s} {ns[4]:10.1f} {ns[5]:8.1f} {ns[4] / ns[5]:6.2f} {pair(4, 5):6.2f}")
+    six = ns[6] - ns[5]
+    print(f"  6 more normals a path-step (driver d=9 - d=3, no area): {six:.1f} ns; floor of the full-solve ratio "
+          f"with numpy's normals: ({ns[3]:.1f} + {six:.1f}) / {ns[3]:.1f} = {(ns[3] + six) / ns[3]:.2f}")
     return ns[0] / ns[1]
+
+
+def _machine_scaling(repeats):
+    """This machine's wall-time ratio for two copies of a job on two threads against both on one, for a loop
+    bound by its own arithmetic (8 independent multiply-add chains in registers) and for a loop that streams
+    a 256 KiB array from the L2 cache: what two threads can give a compute-bound and a memory-bound kernel."""
+    import threading
+
+    import numba
+
+    @numba.njit(nogil=True)
+    def registers(n):
+        a0 = a1 = a2 = a3 = a4 = a5 = a6 = a7 = 1.0
+        for _ in range(n):
+            a0 = a0 * 1.0000001 + 1e-9
+            a1 = a1 * 1.0000002 + 1e-9
+            a2 = a2 * 1.0000003 + 1e-9
+            a3 = a3 * 1.0000004 + 1e-9
+            a4 = a4 * 1.0000005 + 1e-9
+            a5 = a5 * 1.0000006 + 1e-9
+            a6 = a6 * 1.0000007 + 1e-9
+            a7 = a7 * 1.0000008 + 1e-9
+        return a0 + a1 + a2 + a3 + a4 + a5 + a6 + a7
+
+    @numba.njit(nogil=True)
+    def streaming(a, reps):
+        s = 0.0
+        for r in range(reps):
+            for i in range(a.size):
+                s += a[i] * 1.5 + r
+        return s
+
+    arr = np.ones(1 << 15)
+    jobs = (("registers", registers, (20_000_000,)), ("L2 stream", streaming, (arr, 600)))
+    out = []
+    for name, fn, args in jobs:
+        fn(*args)
+        ratios = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            fn(*args)
+            fn(*args)
+            one = time.perf_counter() - t0
+            ts = [threading.Thread(target=fn, args=args) for _ in range(2)]
+            t0 = time.perf_counter()
+            for t in ts:
+                t.start()
+            for t in ts:
+                t.join()
+            ratios.append((time.perf_counter() - t0) / one)
+        out.append(f"{name} {statistics.median(ratios):.2f}")
+    return ", ".join(out)
 
 
 def bench_threads(n_paths, n_steps, repeats):
@@ -283,6 +366,8 @@ def bench_threads(n_paths, n_steps, repeats):
     n_all = numba.get_num_threads()
     print(f"threads: 1 against {n_all} (numba.set_num_threads), full solve {n_paths} x {n_steps}, medians of "
           f"{repeats} interleaved runs, ns per path-step")
+    if n_all == 2:
+        print(f"  this machine, 2 jobs on 2 threads / on 1 (wall): {_machine_scaling(repeats)}")
     print(f"  {'problem':26s} {'wall 1':>8s} {'wall N':>8s} {'N/1':>5s} {'cpu 1':>8s} {'cpu N':>8s} {'N/1':>5s} "
           f"{'caller cpu N':>12s} {'/ cpu 1':>7s} {'bitwise':>7s}")
     for label, area in (("LieHeun + default area", "auto"), ("LieHeun + Davie area", "davie"),

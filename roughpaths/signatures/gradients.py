@@ -66,7 +66,7 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
     gd = np.zeros((nb, n - 1, d))
     nunits = nb * nchunks
     per_unit = (n / nchunks) * 5 * d ** depth
-    ngroups, first_alone = _split_units(nunits, d)         # the same bits either way
+    ngroups, first_alone = _split_units(nunits, d, depth)         # the same bits either way
     if ngroups:
         _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES))
