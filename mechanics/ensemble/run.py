@@ -28,6 +28,10 @@ or anything with the same ``submit`` interface, e.g. a ``dask.distributed`` clus
 ``client.get_executor()`` (optional extra ``mechanics[dask]``). Tasks are ``(spec, first_path,
 last_path)`` with a picklable spec: the system and the observable must be picklable for process
 pools and clusters (a module-level function, not a lambda, as ``observable``).
+
+Threads. Within a process, the driver's sampling and the coadjoint kernels split each chunk's paths over
+numba's threads (``numba.set_num_threads(k)``, ``NUMBA_NUM_THREADS``), as in :func:`roughpaths.solve`; the
+results are bitwise the same for every thread count.
 """
 
 from __future__ import annotations

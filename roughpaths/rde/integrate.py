@@ -121,6 +121,15 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     TypeError
         A solver class instead of an instance ("did you mean Davie()?"), wrong argument types.
 
+    Notes
+    -----
+    Threads: the compiled parts of a solve (a Brownian driver's sampling, the coadjoint solvers of
+    :mod:`mechanics`) split the paths over numba's threads, the calling thread included; set their number
+    with ``numba.set_num_threads(k)`` (per calling thread) or the ``NUMBA_NUM_THREADS`` environment
+    variable. Every member's result is bitwise the same for every thread count (each member is computed
+    by the same instructions, from its own random streams). ``executor`` adds parallelism over groups of
+    members on top (processes, or a cluster).
+
     Examples
     --------
     Friz–Oberhauser: a perturbed area equals an extra drift (exactly, step by step, for ``LogODE`` on

@@ -1,6 +1,10 @@
-"""roughpaths.validation.parallel_ranges: every item once, the caller's exceptions, bad block sizes."""
+"""roughpaths.validation.parallel_ranges: every item once, the caller's exceptions, bad block sizes; and the
+polling workers behind it: several callers at once, nested calls, a worker joining a job within a few hundred
+microseconds of its post, and a forked child that starts workers of its own."""
 
+import multiprocessing
 import threading
+import time
 
 import numba
 import numpy as np
@@ -50,3 +54,71 @@ def test_exception_reaches_the_caller_and_empty_is_a_no_op():
 def test_bad_block_is_refused(block):
     with pytest.raises(ValueError, match="block must be a positive int"):
         parallel_ranges(lambda lo, hi: None, 10, block)
+
+
+def _fill(n, block):
+    out = np.zeros(n, dtype=np.int64)
+
+    def fn(lo, hi):
+        out[lo:hi] += np.arange(lo, hi)
+
+    parallel_ranges(fn, n, block)
+    return out
+
+
+def test_several_callers_at_once_and_nested_calls():
+    want = np.arange(5000)
+    results, errors = [], []
+
+    def caller():
+        try:
+            for _ in range(20):
+                results.append(np.array_equal(_fill(5000, 97), want))
+                inner = np.zeros(40, dtype=np.int64)
+
+                def outer(lo, hi):                 # a range that runs a parallel job of its own
+                    for i in range(lo, hi):
+                        inner[i] = _fill(50, 7).sum()
+                parallel_ranges(outer, 40, 3)
+                results.append(bool(np.all(inner == 1225)))
+        except BaseException as exc:             # pragma: no cover - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=caller) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert not any(t.is_alive() for t in threads), "a caller hung"
+    assert not errors and len(results) == 160 and all(results)
+
+
+@pytest.mark.skipif(numba.get_num_threads() < 2, reason="needs two numba threads")
+def test_a_polling_worker_joins_a_new_job_quickly():
+    names = []
+
+    def fn(lo, hi):
+        names.append(threading.current_thread().name)
+        time.sleep(0.002)                          # holds its range long enough for a second thread to come
+
+    parallel_ranges(fn, 2, 1)                      # starts the workers
+    joined = 0
+    for _ in range(10):
+        names.clear()
+        parallel_ranges(fn, 2, 1)
+        joined += any(n.startswith("roughpaths-worker") for n in names)
+    assert joined >= 5                             # a 2 ms range: a worker joins in most calls
+
+
+def _child(q):
+    q.put(bool(np.array_equal(_fill(3000, 11), np.arange(3000))))
+
+
+def test_forked_child_gets_workers_of_its_own():
+    _fill(3000, 11)                                # the parent's workers exist before the fork
+    ctx = multiprocessing.get_context("fork")
+    q = ctx.Queue()
+    p = ctx.Process(target=_child, args=(q,))
+    p.start()
+    p.join(timeout=120)
+    assert p.exitcode == 0 and q.get(timeout=5)
