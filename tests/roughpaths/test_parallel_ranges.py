@@ -2,7 +2,9 @@
 polling workers behind it: several callers at once, nested calls, a worker joining a job within a few hundred
 microseconds of its post, and a forked child that starts workers of its own."""
 
-import multiprocessing
+import os
+import subprocess
+import sys
 import threading
 import time
 
@@ -110,15 +112,36 @@ def test_a_polling_worker_joins_a_new_job_quickly():
     assert joined >= 5                             # a 2 ms range: a worker joins in most calls
 
 
-def _child(q):
-    q.put(bool(np.array_equal(_fill(3000, 11), np.arange(3000))))
+_FORK_SCRIPT = """
+import multiprocessing, numpy as np
+from roughpaths.validation import parallel_ranges
 
+def fill():
+    out = np.zeros(3000, dtype=np.int64)
+    def fn(lo, hi):
+        out[lo:hi] += np.arange(lo, hi)
+    parallel_ranges(fn, 3000, 11)
+    return bool(np.array_equal(out, np.arange(3000)))
 
-def test_forked_child_gets_workers_of_its_own():
-    _fill(3000, 11)                                # the parent's workers exist before the fork
+def child(q):
+    q.put(fill())
+
+if __name__ == "__main__":
+    assert fill()                       # the parent's workers exist before the fork
     ctx = multiprocessing.get_context("fork")
     q = ctx.Queue()
-    p = ctx.Process(target=_child, args=(q,))
+    p = ctx.Process(target=child, args=(q,))
     p.start()
     p.join(timeout=120)
     assert p.exitcode == 0 and q.get(timeout=5)
+    print("ok")
+"""
+
+
+def test_forked_child_gets_workers_of_its_own(tmp_path):
+    """In a fresh interpreter (this one may hold other libraries' threads, which fork does not copy)."""
+    script = tmp_path / "fork_child.py"
+    script.write_text(_FORK_SCRIPT)
+    env = dict(os.environ, NUMBA_NUM_THREADS="2")
+    res = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300, env=env)
+    assert res.returncode == 0 and res.stdout.strip() == "ok", res.stderr
