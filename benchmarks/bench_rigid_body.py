@@ -15,8 +15,8 @@ inertia, noise and θ (target ≤ 3x the rigid body per path-step; its column sh
 a Casimir). Peers (where installed, in the
 same run): diffrax Heun on a batched (3, N) state (jit), torchsde Heun (noise_type="general",
 sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scaled per path-step).
-Reported: median wall (or, with ``--clock cpu``, process CPU) time of ``--repeats`` runs (after a warm-up/compile run), ns per path-step,
-max ||Π(T)| - 1| over the paths, and ratios peer / ours.
+Reported: median wall time and median process CPU time (all threads) of ``--repeats`` runs (after a
+warm-up/compile run), ns per path-step, max ||Π(T)| - 1| over the paths, and ratios row / ours in both.
 
 Then the cost of Davie's area (issue 24, item 4): a path-step of the solver on a sampled path, of the full
 solve and of the driver alone, with the area and without it, CPU time, interleaved runs, the ratio (target
@@ -27,7 +27,7 @@ steps), with and without the area: wall, CPU, and the calling thread's CPU time 
 estimate on a shared machine), with a bitwise check; and, on two cores, what two threads give a loop bound
 by arithmetic and one that streams from the L2 cache on this machine.
 
-Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R] [--clock wall|cpu]
+Usage: ``python benchmarks/bench_rigid_body.py [--quick] [--repeats R]
 [--skip diffrax,torchsde,sdeint] [--threads-only] [--area-only]``.
 """
 
@@ -44,16 +44,15 @@ INERTIA = np.array([1.0, 2.0, 3.0])
 THETA, SIGMA, DT = 1.0, 0.05, 1e-3
 
 
-_CLOCK = [time.perf_counter]     # --clock cpu: time.process_time (all threads' CPU time of this process)
-
-
 def _median_time(fn, repeats):
-    times, out = [], None
+    """``((median wall, median CPU), last result)``; CPU is the process's time summed over its threads."""
+    wall, cpu, out = [], [], None
     for _ in range(repeats):
-        t0 = _CLOCK[0]()
+        w0, c0 = time.perf_counter(), time.process_time()
         out = fn()
-        times.append(_CLOCK[0]() - t0)
-    return statistics.median(times), out
+        wall.append(time.perf_counter() - w0)
+        cpu.append(time.process_time() - c0)
+    return (statistics.median(wall), statistics.median(cpu)), out
 
 
 def _norm_err(final):
@@ -399,15 +398,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="100 paths x 1,000 steps (smoke run)")
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--clock", choices=("wall", "cpu"), default="wall",
-                    help="wall time, or the process's CPU time summed over its threads (steadier on a "
-                         "shared machine; counts a peer's extra threads as cost)")
     ap.add_argument("--skip", default="", help="comma-separated peers to skip: diffrax,torchsde,sdeint")
     ap.add_argument("--threads-only", action="store_true", help="only the table of 1 thread against all")
     ap.add_argument("--area-only", action="store_true", help="only the table of the area's cost (with / without)")
     args = ap.parse_args(argv)
-    if args.clock == "cpu":
-        _CLOCK[0] = time.process_time
     n_paths, n_steps = (100, 1_000) if args.quick else (1_000, 10_000)
     sde_paths = 1 if args.quick else 4
     skip = set(filter(None, args.skip.split(",")))
@@ -419,18 +413,20 @@ def main(argv=None):
         return 0
     print(f"rigid body: I = diag(1,2,3), theta = {THETA}, sigma = {SIGMA}, dt = {DT}, "
           f"{n_paths} paths x {n_steps} steps, float64, repeats = {args.repeats}, "
-          f"cpus = {os.cpu_count()}, clock = {args.clock}")
+          f"cpus = {os.cpu_count()}; wall and process CPU time (all threads), medians")
     rows = []
+
+    print(f"  {'':32s} {'wall s':>8s} {'ns/path-step':>12s} {'CPU s':>8s} {'ns/path-step':>12s}   max||Pi(T)|-1|")
 
     def record(name, paths, fn):
         try:
-            t, final = fn()
+            (tw, tc), final = fn()
         except ImportError as exc:
             print(f"  {name:32s} not installed ({exc.name}); skipped")
             return
-        ns = t / (paths * n_steps) * 1e9
-        rows.append((name, t, ns, _norm_err(final)))
-        print(f"  {name:32s} {t:9.3f} s  {ns:10.1f} ns/path-step   max||Pi(T)|-1| = {_norm_err(final):.2e}")
+        nw, nc = (t / (paths * n_steps) * 1e9 for t in (tw, tc))
+        rows.append((name, nw, nc))
+        print(f"  {name:32s} {tw:8.3f} {nw:12.1f} {tc:8.3f} {nc:12.1f}   {_norm_err(final):.2e}")
 
     record("ours LieHeun + Levy area", n_paths, lambda: bench_ours(n_paths, n_steps, args.repeats, True))
     record("ours LieHeun, no area", n_paths, lambda: bench_ours(n_paths, n_steps, args.repeats, False))
@@ -446,10 +442,9 @@ def main(argv=None):
                lambda: bench_sdeint(sde_paths, n_steps, max(1, args.repeats // 3)))
     ran = [r[0] for r in rows]
     print("peers that ran:", ", ".join(ran[5:]) or "none")
-    ours = rows[0][2]
-    print("ratios (ns per path-step, peer / ours with Levy area):")
-    for name, _, ns, _ in rows[1:]:
-        print(f"  {name:32s} {ns / ours:8.2f}x")
+    print("ratios (ns per path-step, row / ours with Levy area):  wall    CPU")
+    for name, nw, nc in rows[1:]:
+        print(f"  {name:32s} {nw / rows[0][1]:20.2f}x {nc / rows[0][2]:6.2f}x")
     bench_area_ratio(n_paths, min(n_steps, 2_000), max(args.repeats, 5))
     bench_threads(n_paths, min(n_steps, 1_000), max(args.repeats, 5))
     return 0

@@ -11,8 +11,10 @@ thread only (no thread hand-off at all).
 Hand-off: a worker that has finished a job keeps polling for the next one for :data:`SPIN_NS`
 nanoseconds in compiled code, without the GIL, before it sleeps on a condition variable. Waking a
 sleeping thread took 40-100 us on this project's 2-core machines (a halted virtual CPU must be woken);
-a polling worker joins a new job within a few microseconds, so jobs of a few hundred microseconds
-split profitably (as TBB's and OpenMP's workers do).
+a polling worker joins a new job in about 25 us (the GIL hand-off), as TBB's and OpenMP's workers do.
+Jobs below :data:`SERIAL_WORK` still stay on the caller: splitting them (tried at a quarter of it) was no
+faster alone and slower beside a CPU-bound process (a worker that takes a range and is then descheduled
+delays the whole call).
 
 The split into ranges never changes a result: every item is computed by the same code whatever
 thread runs it. The number of threads is numba's (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``),
@@ -36,7 +38,7 @@ from numba.extending import intrinsic
 __all__ = ["run", "ranges", "parallel_ranges"]
 
 #: Below this much work (roughly, floating-point operations) a job stays on the calling thread.
-SERIAL_WORK = 1 << 18
+SERIAL_WORK = 1 << 20
 #: Target work per range (enough to amortise a hand-off of a few tens of microseconds).
 RANGE_WORK = 1 << 17
 #: How long an idle worker polls for the next job before it sleeps (nanoseconds).
