@@ -55,8 +55,6 @@ def warm() -> None:
     rp.tensor_exp(z, dim=3)
     rp.lyndon_coordinates(z, dim=3)
     rp.p_variation(lone, 2.5)
-    from roughpaths.validation import parallel_ranges
-    parallel_ranges(lambda lo, hi: None, 2, 1)           # the thread pool's polling loop (with >= 2 threads)
 
 
 def warm_signature_kernels() -> None:

@@ -1,12 +1,10 @@
-"""roughpaths.validation.parallel_ranges: every item once, the caller's exceptions, bad block sizes; and the
-polling workers behind it: several callers at once, nested calls, a worker joining a job within a few hundred
-microseconds of its post, and a forked child that starts workers of its own."""
+"""roughpaths.validation.parallel_ranges: every item once, the caller's exceptions, bad block sizes; several
+callers at once, nested calls, and a forked child that starts a pool of its own."""
 
 import os
 import subprocess
 import sys
 import threading
-import time
 
 import numba
 import numpy as np
@@ -93,23 +91,6 @@ def test_several_callers_at_once_and_nested_calls():
         t.join(timeout=120)
     assert not any(t.is_alive() for t in threads), "a caller hung"
     assert not errors and len(results) == 160 and all(results)
-
-
-@pytest.mark.skipif(numba.get_num_threads() < 2, reason="needs two numba threads")
-def test_a_polling_worker_joins_a_new_job_quickly():
-    names = []
-
-    def fn(lo, hi):
-        names.append(threading.current_thread().name)
-        time.sleep(0.002)                          # holds its range long enough for a second thread to come
-
-    parallel_ranges(fn, 2, 1)                      # starts the workers
-    joined = 0
-    for _ in range(10):
-        names.clear()
-        parallel_ranges(fn, 2, 1)
-        joined += any(n.startswith("roughpaths-worker") for n in names)
-    assert joined >= 5                             # a 2 ms range: a worker joins in most calls
 
 
 _FORK_SCRIPT = """
