@@ -80,7 +80,7 @@ def bench_driver_only(n_paths, n_steps, repeats):
     from roughpaths import BrownianDriver
 
     def run():
-        for _ in BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,)).blocks():
+        for _ in BrownianDriver(3, seed=1, dt=DT, n_steps=n_steps, batch_shape=(n_paths,), levy_area="davie").blocks():
             pass
         return np.broadcast_to(np.array([0.0, 0.0, 1.0]), (n_paths, 3))
     return _median_time(run, repeats)
