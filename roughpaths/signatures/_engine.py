@@ -2,7 +2,9 @@
 
 Shared by :mod:`roughpaths.signatures.signature` and :mod:`roughpaths.signatures.gradients`. The
 kernels store words with the first letter fastest (the *reversed* layout); results are returned in
-row-major order (:func:`_reversed_to_rowmajor`).
+row-major order: by a permutation of the output (:func:`_reversed_to_rowmajor`), or, where the path is
+smaller than its signature, by running the kernels on the path negated and reversed in time, whose
+reversed-layout signature is the row-major one of the path (:func:`_signature_flat`).
 """
 
 from __future__ import annotations
