@@ -56,13 +56,20 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
         g2 = _kernel_array(g_row, g_row.shape)
         _threads.run(lambda lo, hi: _l2.sig2_vjp_rows(x, g2, lo, hi, gx), _threads.ranges(nb, n * d * d))
         return gx
-    off = _offsets(d, depth)
-    perm = _reversed_to_rowmajor(d, depth)
     g_rev = np.empty_like(g_row)
-    g_rev[:, perm] = g_row
+    g_rev[:, _reversed_to_rowmajor(d, depth)] = g_row
+    return _signature_vjp_rev(x, depth, g_rev)
+
+
+def _signature_vjp_rev(x: np.ndarray, depth: int, g_rev: np.ndarray, part: np.ndarray | None = None) -> np.ndarray:
+    """:func:`_signature_vjp_flat` (``n >= 2``, ``depth >= 3``) for a cotangent ``g_rev`` in the kernels' reversed
+    layout; ``part``, the forward signatures of the work units (:func:`_reversed_parts`), if already computed."""
+    nb, n, d = x.shape
+    off = _offsets(d, depth)
     nchunks = _horner_chunks(n, d, depth)
     units = _units(nb, n, nchunks)
-    part = _reversed_parts(x, depth, nchunks)
+    if part is None:
+        part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
     nunits = nb * nchunks
     per_unit = (n / nchunks) * 5 * d ** depth
@@ -170,16 +177,26 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     _check_fits(flat.shape[0], d, depth, log=True)
     off = _offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
-    sig = _signature_flat(flat, depth)
     g_log_row = lyndon_flat_vjp(g, d, depth)
-    sig_rev = np.empty_like(sig)
-    sig_rev[:, perm] = sig
     g_log_rev = np.empty_like(g_log_row)
     g_log_rev[:, perm] = g_log_row
+    small = depth == 2 or n == 1 or flat.shape[0] == 0      # the general route's special cases
+    if small:
+        sig = _signature_flat(flat, depth)
+        sig_rev = np.empty_like(sig)
+        sig_rev[:, perm] = sig
+    else:
+        # the forward signatures of the work units, computed once: glued for the log's backward pass, and
+        # handed to the signature's backward pass (which would otherwise recompute them)
+        nchunks = _horner_chunks(n, d, depth)
+        part = _reversed_parts(flat, depth, nchunks)
+        sig_rev = part if nchunks == 1 else _lanes.lane_glue(part, flat.shape[0], nchunks, depth, off)
     g_sig_rev = np.empty_like(sig_rev)
     _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
                  _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
-    return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
+    if small:
+        return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
+    return _signature_vjp_rev(flat, depth, g_sig_rev, part).reshape(x.shape)
 
 
 def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
