@@ -72,12 +72,13 @@ class PIController:
     dt_max : float, optional
         Largest step (default ``t1 - t0``).
     safety : float
-        Factor applied to the predicted step (default 0.9).
+        Factor applied to the predicted step (default 0.8).
     factor_min, factor_max : float
         Bounds on the ratio of consecutive steps (defaults 0.2 and 5).
     icoeff, pcoeff : float
-        Integral and proportional exponents :math:`\beta_I`, :math:`\beta_P` (defaults 1 and 0: an
-        integral controller; the error ratio is proportional to the step, so 1 is the dead-beat exponent).
+        Integral and proportional exponents :math:`\beta_I`, :math:`\beta_P` (defaults 0.7 and 0.3). The
+        error ratio is proportional to the step, so :math:`\beta_I + \beta_P = 1` is the dead-beat sum;
+        ``icoeff=1, pcoeff=0`` is the plain integral controller (``docs/adaptive-steps.md`` compares them).
     max_steps : int
         Most attempts (accepted plus rejected) before ``solve`` gives up with a ``ValueError`` (default
         10⁵), so a tolerance that cannot be met never hangs.
@@ -108,7 +109,7 @@ class PIController:
             raise ValueError(f"dt_min={dt_min!r} exceeds dt_max={dt_max!r}; swap them.")
         self.safety = check_positive_real(safety, "safety")
         if self.safety > 1.0:
-            raise ValueError(f"safety must lie in (0, 1], got {safety!r}; 0.9 is usual.")
+            raise ValueError(f"safety must lie in (0, 1], got {safety!r}; the default is 0.8.")
         self.factor_min = check_positive_real(factor_min, "factor_min")
         self.factor_max = check_positive_real(factor_max, "factor_max")
         if not self.factor_min < 1.0 < self.factor_max:
