@@ -138,6 +138,14 @@ def _areas(W, A):
     return A + 0.5 * W[..., :, None] * W[..., None, :]
 
 
+def _whole_step(W, XX):
+    """Increment and area of a step from those of its halves ``W (..., 2, d)``, ``XX (..., 2, d, d)``, by Chen:
+    ``X = X_1 + X_2``, ``XX = XX_1 + XX_2 + X_1 ⊗ X_2``; shapes ``(..., 1, d)`` and ``(..., 1, d, d)``."""
+    W1, W2 = W[..., 0, :], W[..., 1, :]
+    XXw = XX[..., 0, :, :] + XX[..., 1, :, :] + W1[..., :, None] * W2[..., None, :]
+    return (W1 + W2)[..., None, :], XXw[..., None, :, :]
+
+
 def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_at, on_failure, batch):
     """The adaptive loop of :func:`~roughpaths.solve` (arguments already checked there; ``y`` broadcast)."""
     if not isinstance(control, PIController):
@@ -207,11 +215,9 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
             ts = t0 + cell * np.array([i, (i + j) // 2, j], dtype=np.float64)
             W, A = tree.increments_and_levy_areas(ts)
             W, XX = np.broadcast_to(W, batch + W.shape[-2:]), np.broadcast_to(_areas(W, A), batch + A.shape[-3:])
-            W1, W2 = W[..., 0, :], W[..., 1, :]
-            XXw = XX[..., 0, :, :] + XX[..., 1, :, :] + W1[..., :, None] * W2[..., None, :]
             y2, _, _ = solver.integrate(fields, y, ts, W, XX, no_save, stop_on_failure=False)
-            y1, _, _ = solver.integrate(fields, y, ts[[0, 2]], (W1 + W2)[..., None, :], XXw[..., None, :, :],
-                                        no_save[:1], stop_on_failure=False)
+            y1, _, _ = solver.integrate(fields, y, ts[[0, 2]], *_whole_step(W, XX), no_save[:1],
+                                        stop_on_failure=False)
             hstep = (j - i) * cell
             scale = control.atol + control.rtol * np.maximum(np.abs(y), np.abs(y2))
             err = np.sqrt(np.mean(((y2 - y1) / scale) ** 2, axis=-1))

@@ -48,6 +48,23 @@ def test_strong_error_is_proportional_to_rtol_full():
     assert 0.85 <= slope <= 1.15, (slope, errs)
 
 
+def test_the_whole_step_is_the_trees_answer_on_the_whole_interval():
+    """The error estimate's one-step attempt sees the same path as its two halves: the Chen product of the
+    halves' increments and areas equals the tree's own answer on the whole interval (a transposed or missing
+    cross term X_1 ⊗ X_2, or a lost ½ in the areas, would not)."""
+    from roughpaths.rde.adaptive import _areas, _whole_step
+
+    tree = rp.BrownianTree(3, seed=6, batch_shape=(4,))
+    a, b = 0.15625, 0.40625
+    W, A = tree.increments_and_levy_areas([a, 0.5 * (a + b), b])
+    Ww, XXw = _whole_step(W, _areas(W, A))
+    W_ref, A_ref = tree.increments_and_levy_areas([a, b])
+    XX_ref = A_ref + 0.5 * W_ref[..., :, None] * W_ref[..., None, :]          # Stratonovich: Lévy area + ½ W⊗W
+    np.testing.assert_allclose(Ww, W_ref, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(XXw, XX_ref, rtol=0, atol=1e-14)
+    assert np.abs(A_ref).max() > 1e-3                                    # a genuine area to get right
+
+
 def test_accepted_path_is_the_trees_path():
     """Rejected attempts leave no trace: the adaptive answer is a fixed-step solve on the accepted steps' halves."""
     V = rp.LinearVectorFields(M)
