@@ -79,9 +79,6 @@ def _sigdim(d: int, depth: int) -> int:
     return int(sigdim(d, depth))
 
 
-_offsets = level_offsets                    # cached (shared: never written to)
-
-
 @lru_cache(maxsize=512)
 def _logsigdim(d: int, depth: int) -> int:
     """:func:`roughpaths.logsigdim`, cached (its argument checks and Witt's sums cost ~15 us a call)."""
@@ -176,7 +173,7 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     """Signature (reversed layout) of every work unit of a ``(B, n, d)`` batch, shape ``(units, sigdim)``."""
     nb, n, d = x.shape
     units = _units(nb, n, nchunks)
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     dim = _sigdim(d, depth)
     nunits = nb * nchunks
     part = np.empty((nunits, dim))
@@ -219,24 +216,29 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if depth == 2:
         return _level2_flat(x, log=False)
     nchunks = _horner_chunks(n, d, depth)
-    if n * d < _sigdim(d, depth):
-        # Word reversal w -> w* is an anti-automorphism that fixes every exp(Δ), so S(x)_w = S(y)_{w*} for the
-        # path y = -x reversed in time (increments Δ_n, ..., Δ_1). The reversed layout stores S(y)_{w*} where
-        # the row-major one stores S(x)_w: the kernels' output for y is x's signature in row-major order.
-        # One pass over the (smaller) input replaces the permutation of the output; the choice depends on
-        # (n, d, depth) only, so a member's bits do not depend on its batch.
-        out = _reversed_parts(np.negative(x[:, ::-1, :]), depth, nchunks)
-        if nchunks > 1:
-            out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
+    # Word reversal w -> w* is an anti-automorphism that fixes every exp(Δ), so S(x)_w = S(y)_{w*} for the
+    # path y = -x reversed in time (increments Δ_n, ..., Δ_1). The reversed layout stores S(y)_{w*} where the
+    # row-major one stores S(x)_w: the kernels' output for y is x's signature in row-major order. Where the
+    # path is the smaller array, one pass over it replaces the permutation of the output; the choice depends
+    # on (n, d, depth) only, so a member's bits do not depend on its batch.
+    flipped = n * d < _sigdim(d, depth)
+    _, out = _reversed_signature(np.negative(x[:, ::-1, :]) if flipped else x, depth, nchunks)
+    if flipped:
         return out
-    out = _reversed_parts(x, depth, nchunks)
-    if nchunks > 1:
-        out = _lanes.lane_glue(out, nb, nchunks, depth, _offsets(d, depth))
     perm = _reversed_to_rowmajor(d, depth)
     res = np.empty_like(out)
-    _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, _offsets(d, depth), depth, lo, hi, res),
+    _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
                  _threads.ranges(nb, 4 * perm.shape[0]))
     return res
+
+
+def _reversed_signature(x: np.ndarray, depth: int, nchunks: int) -> tuple:
+    """``(parts, signatures)`` in the reversed layout: those of the work units (:func:`_reversed_parts`) and
+    of the paths (the units glued by Chen; the same array when ``nchunks == 1``)."""
+    part = _reversed_parts(x, depth, nchunks)
+    if nchunks == 1:
+        return part, part
+    return part, _lanes.lane_glue(part, x.shape[0], nchunks, depth, level_offsets(x.shape[2], depth))
 
 
 @lru_cache(maxsize=None)

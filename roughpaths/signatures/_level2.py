@@ -236,10 +236,10 @@ def sig2_lane_tasks(x, nchunks, lo, hi, part):
         a = min(c * seg, n - 1)
         e = min(a + seg, n - 1)
         b0 = g * LANES
-        for r in range(part.shape[1]):
-            for l in range(LANES):
-                part[(b0 + l) * nchunks + c, r] = 0.0
-        if e <= a:
+        if e <= a:                             # an empty chunk: no increment, no area
+            for r in range(part.shape[1]):
+                for l in range(LANES):
+                    part[(b0 + l) * nchunks + c, r] = 0.0
             continue
         for i in range(d):
             for l in range(LANES):

@@ -12,14 +12,15 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _threads
-from ..algebra.flat import lyndon_flat_vjp
+from ..algebra.flat import level_offsets, lyndon_flat_vjp
 from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
 from . import _level2 as _l2
 from . import _rough_vjp, _vjp, _vjp_wide
-from ._engine import (_WIDE, _check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array, _offsets,
-                      _reversed_parts, _reversed_to_rowmajor, _sigdim, _signature_flat, _split_units, _units)
+from ._engine import (_WIDE, _check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array,
+                      _reversed_parts, _reversed_signature, _reversed_to_rowmajor, _sigdim, _signature_flat,
+                      _split_units, _units)
 from .signature import rough_path_signature
 
 __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]
@@ -65,7 +66,7 @@ def _signature_vjp_rev(x: np.ndarray, depth: int, g_rev: np.ndarray, part: np.nd
     """:func:`_signature_vjp_flat` (``n >= 2``, ``depth >= 3``) for a cotangent ``g_rev`` in the kernels' reversed
     layout; ``part``, the forward signatures of the work units (:func:`_reversed_parts`), if already computed."""
     nb, n, d = x.shape
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     nchunks = _horner_chunks(n, d, depth)
     units = _units(nb, n, nchunks)
     if part is None:
@@ -175,7 +176,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
         g_sig[:, :d] = g
         return _signature_vjp_flat(flat, depth, g_sig).reshape(x.shape)
     _check_fits(flat.shape[0], d, depth, log=True)
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
     g_log_row = lyndon_flat_vjp(g, d, depth)
     g_log_rev = np.empty_like(g_log_row)
@@ -188,9 +189,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     else:
         # the forward signatures of the work units, computed once: glued for the log's backward pass, and
         # handed to the signature's backward pass (which would otherwise recompute them)
-        nchunks = _horner_chunks(n, d, depth)
-        part = _reversed_parts(flat, depth, nchunks)
-        sig_rev = part if nchunks == 1 else _lanes.lane_glue(part, flat.shape[0], nchunks, depth, off)
+        part, sig_rev = _reversed_signature(flat, depth, _horner_chunks(n, d, depth))
     g_sig_rev = np.empty_like(sig_rev)
     _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
                  _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
@@ -251,7 +250,7 @@ def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:
     lev = _kernel_array(X.step_levy_areas, (-1, n, d, d))
     ginc = np.zeros(inc.shape)
     glev = np.zeros(lev.shape)
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     _threads.run(lambda lo, hi: _rough_vjp.rough_vjp_rows(inc, lev, s_rev, g_rev, depth, off, lo, hi, ginc, glev),
                  _threads.ranges(inc.shape[0], 4 * n * depth * depth * _sigdim(d, depth)))
     garea = 0.5 * (glev - np.swapaxes(glev, -1, -2))

@@ -29,11 +29,11 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _threads
-from ..algebra.flat import log_flat, lyndon_flat
+from ..algebra.flat import level_offsets, log_flat, lyndon_flat
 from ..algebra.tensor import logsigdim, sigdim
 from . import _kernels as _k
 from ._engine import (_check_depth, _check_fits, _check_paths, _finite_or_raise, _kernel_array, _level2_flat,
-                      _offsets, _reversed_to_rowmajor, _sigdim, _signature_flat)
+                      _reversed_to_rowmajor, _sigdim, _signature_flat)
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
@@ -166,7 +166,7 @@ def rough_path_signature(X, depth: int) -> np.ndarray:
     inc = _kernel_array(X.increments, (-1, n, d))
     lev = _kernel_array(X.step_levy_areas, (-1, n, d, d))
     out = np.empty((inc.shape[0], _sigdim(d, depth)))
-    off = _offsets(d, depth)
+    off = level_offsets(d, depth)
     _threads.run(lambda lo, hi: _k.rough_sig_rows(inc, lev, depth, off, lo, hi, out),
                  _threads.ranges(inc.shape[0], n * depth * _sigdim(d, depth)))
     return out[:, _reversed_to_rowmajor(d, depth)].reshape(batch + (_sigdim(d, depth),))
