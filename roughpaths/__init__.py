@@ -37,8 +37,9 @@ from .signatures import (LinearKernel, MMDTestResult, RBFKernel, brownian_expect
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
-    "solve", "Solution", "NonFiniteStateError", "PIController", "Driver", "Solver", "Euler", "Heun", "Davie", "LogODE", "LogODE3",
-    "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift", "central_jacobian", "rough_integral",
+    "solve", "Solution", "NonFiniteStateError", "PIController", "Driver", "Solver", "Euler", "Heun", "Davie",
+    "LogODE", "LogODE3", "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift",
+    "central_jacobian", "rough_integral",
     # coloured noise
     "coloured_noise_limit", "ColouredNoiseDriver", "ColouredNoiseLimit", "ColouredNoiseSample",
     "sample_coloured_noise", "iter_coloured_noise", "coloured_noise_limit_path", "paper_coloured_noise_matrices",

@@ -62,7 +62,6 @@ def phys_bytes() -> float:
         return float("inf")
 
 
-
 def selected_paths(paths, n: int, owner: str) -> np.ndarray:
     """Flat path indices (int64, negatives wrapped) of a ``select(paths)`` on an ``owner`` of ``n`` paths.
 
@@ -80,6 +79,7 @@ def selected_paths(paths, n: int, owner: str) -> np.ndarray:
         raise ValueError(f"paths holds indices outside [0, {n}) (this {owner} has {n} paths), "
                          f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
     return np.where(idx < 0, idx + n, idx).astype(np.int64)
+
 
 class SeededDriver(Driver):
     """Base of the per-path seeded drivers: grid, batch, path indices, ``x0``-like start, ``select``."""

@@ -54,10 +54,11 @@ moment (invisible below about 10⁵ paths), and the increments are Brownian with
 depths and ``m = 2`` in ``docs/brownian-tree.md``.
 
 Cost and memory: a split is one compiled call over the batch that seeds its streams, draws its normals
-and bisects (``d = 2``, ``m = 3``: 15 µs for one path, 90 µs for 64, about 1 µs per path beyond); a query walks down from the root and splits at
-most two nodes per depth (at most ``2L``), holding a few node states at a time (``8 P (2^m d + d^2)``
-bytes each). Splits already made are found in a least-recently-used cache of at most ``cache_size``
-nodes (default: as many as fit in 64 MiB, at most 8192), which does not grow with the number of queries.
+and bisects (``d = 2``, ``m = 3``: 15 µs for one path, 90 µs for 64, about 1 µs per path beyond); a query
+walks down from the root and splits at most two nodes per depth (at most ``2L``), holding a few node
+states at a time (``8 P (2^m d + d^2)`` bytes each). Splits already made are found in a least-recently-used
+cache of at most ``cache_size`` nodes (default: as many as fit in 64 MiB, at most 8192), which does not grow
+with the number of queries.
 """
 
 from __future__ import annotations

@@ -18,6 +18,7 @@ from .logode import LogODE, LogODE3
 from .vector_fields import LinearDrift, VectorFields, central_jacobian
 
 __all__ = [
-    "PIController", "Solver", "Davie", "Davie3", "Euler", "Heun", "SOLVERS", "NonFiniteStateError", "Solution", "solve",
+    "PIController", "Solver", "Davie", "Davie3", "Euler", "Heun", "SOLVERS", "NonFiniteStateError", "Solution",
+    "solve",
     "LinearVectorFields", "LogODE", "LogODE3", "LinearDrift", "VectorFields", "central_jacobian",
 ]

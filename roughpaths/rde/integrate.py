@@ -70,8 +70,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     driver : RoughPath, RoughPathN, Driver or BrownianTree
         Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.Driver` is
         consumed block by block (memory for one block). A :class:`~roughpaths.BrownianTree` is
-        solved on ``[tree.t0, tree.t1]`` with adaptive steps (``step_control``). Level 2 for level-2 solvers, a
-        :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``).
+        solved on ``[tree.t0, tree.t1]`` with adaptive steps (``step_control``). Level 2 for level-2
+        solvers, a :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``).
         Convention: area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
     y0 : array_like, shape ``(..., e)``
         Initial condition(s); the batch ``B_y`` broadcasts against ``B_X``.
@@ -166,9 +166,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
                             on_failure=on_failure, block_steps=block_steps)
     if not isinstance(driver, (RoughPath, RoughPathN, Driver, BrownianTree)):
         raise TypeError(f"driver must be a RoughPath, a RoughPathN, a Driver (e.g. roughpaths.BrownianDriver) or a "
-                        f"BrownianTree, "
-                        f"got {type(driver).__name__}; build a path with RoughPath.from_path(values, times=...) "
-                        f"or RoughPath(increments, areas, times=...).")
+                        f"BrownianTree, got {type(driver).__name__}; build a path with "
+                        f"RoughPath.from_path(values, times=...) or RoughPath(increments, areas, times=...).")
     if on_failure not in ("raise", "mask"):
         raise ValueError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}.")
     if driver.dim != fields.dim_noise:
