@@ -80,6 +80,14 @@ def _sinc_coeffs(t2: np.ndarray):
     return a, b, c
 
 
+def _cross(a, b) -> np.ndarray:
+    """``np.cross(a, b)`` for shapes ``(..., 3)``, broadcast: the same operations per component (so the same
+    bits), without ``np.cross``'s axis handling, which costs ~10 µs a call on the small batches of a step."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
 def rodrigues_ad_star_exp(sigma, mu) -> np.ndarray:
     r""":math:`\exp(\mathrm{ad}^*_\sigma)\mu` on so(3)* ≅ R³ in closed form (Rodrigues).
 
@@ -91,8 +99,8 @@ def rodrigues_ad_star_exp(sigma, mu) -> np.ndarray:
     sigma = np.asarray(sigma, dtype=np.float64)
     mu = np.asarray(mu, dtype=np.float64)
     a, b, _ = _sinc_coeffs(np.einsum("...i,...i->...", sigma, sigma))
-    sxm = np.cross(sigma, mu)
-    return mu - a[..., None] * sxm + b[..., None] * np.cross(sigma, sxm)
+    sxm = _cross(sigma, mu)
+    return mu - a[..., None] * sxm + b[..., None] * _cross(sigma, sxm)
 
 
 class LieAlgebra:
@@ -398,9 +406,9 @@ def se3_ad_star_exp(sigma, mu) -> np.ndarray:
     w, v = sigma[..., :3], sigma[..., 3:]
     pi, gam = mu[..., :3], mu[..., 3:]
     _, b, c = _sinc_coeffs(np.einsum("...i,...i->...", w, w))
-    wxv = np.cross(w, v)
-    jv = v + b[..., None] * wxv + c[..., None] * np.cross(w, wxv)
-    p = pi - np.cross(jv, gam)
+    wxv = _cross(w, v)
+    jv = v + b[..., None] * wxv + c[..., None] * _cross(w, wxv)
+    p = pi - _cross(jv, gam)
     return np.concatenate([rodrigues_ad_star_exp(w, p), rodrigues_ad_star_exp(w, gam)], axis=-1)
 
 
