@@ -3,7 +3,7 @@ r"""numpy's ziggurat for standard normals over raw 64-bit words (private; see :m
 * :func:`_ziggurat_fill`: normals from a buffer of raw words, exactly as numpy's
   ``random_standard_normal`` (256 layers, ``distributions.c``) turns its bit generator's words into
   normals: same values, same number of words consumed. The accepted first-word case (~99 %) is a
-  branch-free loop body; the rest of an attempt is :func:`_ziggurat_slow`.
+  loop without calls (:func:`_ziggurat_run`); the rest of an attempt is :func:`_ziggurat_slow`.
 * :func:`standard_normal_into` ``(rng, out)``: ``rng.standard_normal(out=out)`` for a
   ``numpy.random.Generator``, same values and same end state of the generator, over
   ``bit_generator.random_raw`` (about 3x faster per normal: no per-draw function-pointer calls).
@@ -68,20 +68,17 @@ def _ziggurat_slow(raw, pos, idx, rabs, x, ki, wi, fi, r_tail, inv_r):
     return 0.0, pos, 0
 
 
-@njit(cache=True)
-def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
-    """Fill ``out[start:]`` from ``raw`` (uint64) with numpy's ziggurat; returns (raw consumed, next index).
+@njit(cache=True, nogil=True)
+def _ziggurat_run(raw, pos, out, i, ki, wi):
+    """The accepted first-word attempts from ``raw[pos:]`` into ``out[i:]``, up to the first rejection or
+    the end of either array; returns ``(pos, i)`` there.
 
-    Stops at the first attempt that would need more raw words than remain (that attempt is then
-    redone from its first word on the next call, so no word is skipped or reused). The accepted
-    first-word case (~99 %) is a branch-free loop body (the sign is a multiplication by ±1.0,
-    the same bits as negation); the rest of an attempt is :func:`_ziggurat_slow`. Measured 2.9x
-    faster than one loop with every branch inline.
+    Kept apart from the rest of an attempt on purpose: a loop with any call in it (even one taken for
+    ~1 % of the words) measured 2.4x slower per normal here. The sign is a multiplication by ±1.0 (the
+    same bits as negation); ``rabs < 2**52``, so the conversions through int64 are exact.
     """
     n = out.size
     nr = raw.size
-    pos = 0
-    i = start
     m255 = np.uint64(255)
     m52 = np.uint64(0x000FFFFFFFFFFFFF)
     one = np.uint64(1)
@@ -91,12 +88,37 @@ def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
         idx = np.intp(r & m255)
         r = r >> s8
         rabs = (r >> one) & m52
+        if rabs >= ki[idx]:
+            break
+        out[i] = float(np.int64(rabs)) * wi[idx] * (1.0 - 2.0 * float(np.int64(r & one)))
+        i += 1
+        pos += 1
+    return pos, i
+
+
+@njit(cache=True, nogil=True)
+def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
+    """Fill ``out[start:]`` from ``raw`` (uint64) with numpy's ziggurat; returns (raw consumed, next index).
+
+    Stops at the first attempt that would need more raw words than remain (that attempt is then
+    redone from its first word on the next call, so no word is skipped or reused). The accepted
+    first-word case (~99 %) is :func:`_ziggurat_run`, a loop without calls; the rest of an attempt
+    is :func:`_ziggurat_slow`. About 3.7 ns per normal here (the single loop with the rare path inline
+    took 5.5, and one loop with every branch inline 2.9x that).
+    """
+    n = out.size
+    nr = raw.size
+    m255 = np.uint64(255)
+    m52 = np.uint64(0x000FFFFFFFFFFFFF)
+    one = np.uint64(1)
+    s8 = np.uint64(8)
+    pos, i = _ziggurat_run(raw, 0, out, start, ki, wi)
+    while i < n and pos < nr:                  # raw[pos] was rejected by the box test
+        r = raw[pos]
+        idx = np.intp(r & m255)
+        r = r >> s8
+        rabs = (r >> one) & m52
         x = float(rabs) * wi[idx] * (1.0 - 2.0 * float(r & one))
-        if rabs < ki[idx]:
-            out[i] = x
-            i += 1
-            pos += 1
-            continue
         v, nxt, status = _ziggurat_slow(raw, pos + 1, idx, rabs, x, ki, wi, fi, r_tail, inv_r)
         if status < 0:
             break
@@ -104,6 +126,7 @@ def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
         if status == 1:
             out[i] = v
             i += 1
+        pos, i = _ziggurat_run(raw, pos, out, i, ki, wi)
     return pos, i
 
 
