@@ -146,7 +146,7 @@ class Chromium:
         """Open ``url`` in a new tab and wait for its load event."""
         target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = self.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
-        page = Page(self, session, since=len(self.events))
+        page = Page(self, session, since=len(self.events), target=target)
         for domain in ("Page", "Runtime", "Log", "Network"):
             self.send(f"{domain}.enable", session=session)
         self.send("Emulation.setDeviceMetricsOverride",
@@ -186,8 +186,12 @@ class Chromium:
 class Page:
     """A tab: evaluate JavaScript, collect its console errors, take screenshots."""
 
-    def __init__(self, browser: Chromium, session: str, since: int):
-        self.browser, self.session, self._since = browser, session, since
+    def __init__(self, browser: Chromium, session: str, since: int, target: str):
+        self.browser, self.session, self._since, self.target = browser, session, since, target
+
+    def close(self) -> None:
+        """Close the tab (its events stay readable: :meth:`errors` still works)."""
+        self.browser.send("Target.closeTarget", {"targetId": self.target})
 
     def evaluate(self, expression: str):
         """The JSON value of a JavaScript expression (awaited if it is a promise)."""
