@@ -219,6 +219,7 @@ def _run_tasks(opts: Options, folder: RunFolder, prog: Progress):
         for name, task in registry.items():
             if selected is not None and name not in selected:
                 continue
+            _stop_if_signalled()
             key = f"{kind} {name}"
             entry = folder.reused.get(key)
             if entry is not None and entry["result"].get("status") != ERROR:
@@ -252,6 +253,7 @@ def _run_tasks(opts: Options, folder: RunFolder, prog: Progress):
             sizes.update(task_sizes)
             timings[key] = seconds
             (figures if kind == "figure" else checks).append(res)
+    _stop_if_signalled()
     return figures, checks, sizes, timings, reused
 
 
@@ -271,8 +273,36 @@ def _list() -> int:
     return 0
 
 
-def _on_sigterm(signum, frame):
-    raise Terminated()
+#: The stop signals received by this run, kept after their exception is raised: a handler that runs
+#: inside a callback from C code (numba's compiler calls back into Python while it caches a kernel)
+#: raises into a frame that prints and drops the exception, and the run would go on as if no signal
+#: had come. :func:`_stop_if_signalled` raises it again at the next piece boundary.
+_SIGNALLED: list = []
+
+
+def _interruption(signum):
+    return Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def _on_stop_signal(signum, frame):
+    _SIGNALLED.append(signum)
+    raise _interruption(signum)
+
+
+def _quiet_unraisable(previous):
+    """A ``sys.unraisablehook`` that drops the interruptions of our stop signals (the run stops at the next
+    piece boundary instead, with its usual one-line message) and passes everything else on."""
+    def hook(unraisable):
+        if _SIGNALLED and isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return
+        previous(unraisable)
+    return hook
+
+
+def _stop_if_signalled() -> None:
+    """Raise the interruption of a stop signal whose exception was swallowed (see :data:`_SIGNALLED`)."""
+    if _SIGNALLED:
+        raise _interruption(_SIGNALLED[-1])
 
 
 def run(opts: Options) -> int:
@@ -287,7 +317,12 @@ def run(opts: Options) -> int:
     run_info = {"seed": opts.seed, "convention": opts.convention, "levy_area": opts.levy_area,
                 "scale": opts.scale, "only": opts.only, "versions": versions()}
     in_main_thread = threading.current_thread() is threading.main_thread()   # signals: main thread only
-    previous = signal.signal(signal.SIGTERM, _on_sigterm) if in_main_thread else None
+    _SIGNALLED.clear()
+    previous = ({sig: signal.signal(sig, _on_stop_signal) for sig in (signal.SIGTERM, signal.SIGINT)}
+                if in_main_thread else {})
+    previous_hook = sys.unraisablehook
+    if in_main_thread:
+        sys.unraisablehook = _quiet_unraisable(previous_hook)
     try:
         with folder:
             folder.open(run_info, overwrite=opts.overwrite, resume=opts.resume, notify=prog.message)
@@ -326,8 +361,10 @@ def run(opts: Options) -> int:
                          "INCOMPLETE): continue it with the same options and --resume")
         raise
     finally:
-        if in_main_thread:
-            signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            if handler is not None:                  # None: a handler not set from Python, left alone
+                signal.signal(sig, handler)
+        sys.unraisablehook = previous_hook
     bad = [r for r in checks + figures if r.status in (FAIL, ERROR)]
     n_pass = sum(c.status == PASS for c in checks)
     prog.message(f"{PROG}: {len(figures)} figures, checks {n_pass}/{len(checks)} passed"
