@@ -36,7 +36,8 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-from ._ziggurat import _ZIG_F, _ZIG_INV_R, _ZIG_K, _ZIG_R, _ZIG_W, _ziggurat_fill, standard_normal_into
+from ._ziggurat import (_ZIG_F, _ZIG_INV_R, _ZIG_K, _ZIG_R, _ZIG_W, _abscissa, _split_word, _ziggurat_fill,
+                        standard_normal_into)
 
 __all__ = ["standard_normal_into", "PathStreams"]
 
@@ -162,19 +163,14 @@ def _pcg64_normal(sh, sl, ih, il):
     compile time of its callers.
     """
     ki, wi, fi, r_tail, inv_r = _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R
-    m255 = np.uint64(255)
-    m52 = np.uint64(0x000FFFFFFFFFFFFF)
     one = np.uint64(1)
     s8 = np.uint64(8)
     s11 = np.uint64(11)
     scale = 1.0 / 9007199254740992.0
     while True:
         sh, sl = _lcg(sh, sl, ih, il)
-        r = _xsl_rr(sh, sl)
-        idx = np.intp(r & m255)
-        r = r >> s8
-        rabs = (r >> one) & m52
-        x = float(rabs) * wi[idx] * (1.0 - 2.0 * float(r & one))     # branch-free sign, same bits
+        idx, rabs, neg = _split_word(_xsl_rr(sh, sl))
+        x = _abscissa(idx, rabs, neg, wi)
         if rabs < ki[idx]:
             return x, sh, sl
         if idx == 0:
