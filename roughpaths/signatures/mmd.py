@@ -42,12 +42,32 @@ class MMDTestResult:
         Number of random relabellings of the pooled sample.
     null_statistics : ndarray, shape ``(n_permutations,)``
         The statistics of the relabelled samples.
+
+    The repr is short: the statistic, the p-value, the number of permutations and a summary of the null
+    (mean, standard deviation, 95 % quantile, maximum); the values themselves are in ``null_statistics``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> MMDTestResult(statistic=0.25, p_value=0.2, n_permutations=4,
+    ...               null_statistics=np.array([-0.5, 0.0, 0.5, 1.0]))
+    MMDTestResult(statistic=0.25, p_value=0.2, n_permutations=4, null_statistics=<4 values: mean 0.25, sd 0.559017, q95 0.925, max 1>)
     """
 
     statistic: float
     p_value: float
     n_permutations: int
     null_statistics: np.ndarray
+
+    def __repr__(self) -> str:
+        null = np.asarray(self.null_statistics, dtype=np.float64).ravel()
+        if null.size == 0:
+            summary = "<0 values>"
+        else:
+            summary = (f"<{null.size} values: mean {null.mean():.6g}, sd {null.std():.6g}, "
+                       f"q95 {np.quantile(null, 0.95):.6g}, max {null.max():.6g}>")
+        return (f"{type(self).__name__}(statistic={self.statistic:.6g}, p_value={self.p_value:.6g}, "
+                f"n_permutations={self.n_permutations}, null_statistics={summary})")
 
 
 @nb.njit(cache=True, nogil=True)
