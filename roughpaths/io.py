@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 import tempfile
 import zipfile
 from datetime import datetime, timezone
@@ -52,13 +53,16 @@ from .paths.rough_path import RoughPath
 from .validation import check_memory
 from .rde.solution import Solution
 
-__all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "FORMAT", "FORMAT_VERSION"]
+__all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "open_npz", "NpzReader", "FORMAT",
+           "FORMAT_VERSION"]
 
 FORMAT = "roughpaths-npz"
 FORMAT_VERSION = 1
 _META_KEY = "__metadata__"
 _MAX_DEPTH = 64                  # metadata nesting, on save and on load
 _MAX_EXPANSION = 200             # compressed entries expanding more than this (and past 64 MiB): refused
+_CHUNK = 1 << 24                 # bytes per read when an array is read from an archive
+_FIX = "it is not a file written by roughpaths.save, or it is truncated, corrupt or forged"
 _CONVENTIONS = {
     "area": "XX[..., i, j] over [s, t] = int_s^t (X^i_r - X^i_s) dX^j_r (iisignature/esig ordering: "
             "word (i, j) <-> entry [i, j])",
@@ -290,69 +294,240 @@ def _depth(value, limit: int = _MAX_DEPTH) -> None:
             stack.extend((x, level + 1) for x in v)
 
 
-def _check_entries(p: Path) -> None:
-    """Read every ``.npy`` header of the archive and check the declared sizes before any array is read."""
+class NpzReader:
+    """An ``.npz`` archive opened by :func:`open_npz`: its entries' headers checked, its arrays read on demand.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The file.
+    entries : dict
+        ``name -> (shape, dtype)`` of every array, as its ``.npy`` header declares it (``name`` without
+        ``.npy``); already checked against the stored bytes and the memory budget.
+    """
+
+    def __init__(self, path: Path, fh, zf: zipfile.ZipFile, entries: dict, infos: dict, fix: str):
+        self.path, self.entries, self._fh, self._zip, self._infos, self._fix = path, entries, fh, zf, infos, fix
+
+    def __enter__(self) -> "NpzReader":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the file (also done on leaving a ``with`` block)."""
+        self._zip.close()
+        self._fh.close()
+
+    def refuse(self, problem: str) -> ValueError:
+        """A ``ValueError`` naming the file, the problem and the fix given to :func:`open_npz` (to raise)."""
+        return ValueError(f"{self.path}: {problem}; {self._fix}.")
+
+    def read(self, name: str, *, dtype=None, shape=None) -> np.ndarray:
+        """The array ``name``, read in full (its size was checked when the file was opened).
+
+        Parameters
+        ----------
+        name : str
+            An entry of :attr:`entries`.
+        dtype : numpy dtype, optional
+            Refuse (``ValueError``) unless the array has exactly this dtype.
+        shape : tuple, optional
+            Refuse unless the array has exactly this shape. Both are checked from the header, before
+            the array is allocated.
+
+        Returns
+        -------
+        numpy.ndarray
+            A new array of the declared shape and dtype.
+        """
+        if name not in self.entries:
+            raise self.refuse(f"the array {name!r} is missing (the file holds {sorted(self.entries)})")
+        self.expect(name, dtype=dtype, shape=shape)
+        declared_shape, declared_dtype = self.entries[name]
+        try:
+            with self._zip.open(self._infos[name]) as fh:
+                header = _read_npy_header(fh)
+                if header[:2] != (declared_shape, declared_dtype):
+                    raise self.refuse(f"the header of {name!r} changed while the file was read")
+                fortran = header[2]
+                count = int(np.prod(declared_shape, dtype=np.int64))
+                flat = np.empty(count, dtype=declared_dtype)
+                view = memoryview(flat).cast("B") if flat.nbytes else memoryview(b"")
+                got = 0
+                while got < flat.nbytes:
+                    n = fh.readinto(view[got:got + _CHUNK])
+                    if not n:
+                        raise self.refuse(f"the array {name!r} is truncated ({got} of {flat.nbytes} bytes)")
+                    got += n
+                if fh.read(1):
+                    raise self.refuse(f"the array {name!r} holds more bytes than its header declares")
+        except (zipfile.BadZipFile, OSError, EOFError, RuntimeError, NotImplementedError) as exc:
+            raise self.refuse(f"the array {name!r} is unreadable ({type(exc).__name__}: {exc})") from None
+        if fortran:
+            return flat.reshape(declared_shape[::-1]).transpose()
+        return flat.reshape(declared_shape)
+
+    def expect(self, name: str, *, dtype=None, shape=None) -> None:
+        """Refuse (``ValueError`` naming the file) unless the entry ``name`` has this dtype and shape."""
+        if name not in self.entries:
+            raise self.refuse(f"the array {name!r} is missing (the file holds {sorted(self.entries)})")
+        got_shape, got_dtype = self.entries[name]
+        if dtype is not None and got_dtype != np.dtype(dtype):
+            raise self.refuse(f"the array {name!r} has dtype {got_dtype}, expected {np.dtype(dtype)}")
+        if shape is not None and tuple(got_shape) != tuple(shape):
+            raise self.refuse(f"the array {name!r} has shape {got_shape}, expected {tuple(shape)}")
+
+
+def _read_npy_header(fh):
+    """``(shape, dtype, fortran_order)`` from the ``.npy`` header at the start of ``fh`` (versions 1 and 2)."""
+    version = np.lib.format.read_magic(fh)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
+    elif version == (2, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
+    else:
+        raise ValueError(f".npy format version {version} (1.0 and 2.0 are read)")
+    return tuple(int(s) for s in shape), dtype, bool(fortran)
+
+
+def open_npz(path, *, fix: str = _FIX, what: str = "the arrays") -> NpzReader:
+    """Open an ``.npz`` file as untrusted input: the one reader of every file the library opens.
+
+    :func:`load`, :func:`load_metadata` and ``mechanics``' ensemble checkpoints read through it. Before
+    any array is read it checks that ``path`` is a regular file (opened without blocking, then
+    ``fstat``: a named pipe, a device or a folder is refused, never waited on), that it is a zip
+    archive of ``.npy`` entries (no pickled objects, no duplicate or foreign entries), that every
+    header declares exactly the bytes stored, that the compressed entries do not expand more than
+    ``200x`` past 64 MiB (a zip bomb), and that the declared sizes fit
+    :func:`roughpaths.validation.check_memory`. Reading an array then allocates what its header
+    declared and checks the stored CRC.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    fix : str
+        What the caller tells the user to do when the file is refused (ends every message).
+    what : str
+        What the arrays are, for the memory-budget message (e.g. ``"the checkpoint's arrays"``).
+
+    Returns
+    -------
+    NpzReader
+        Use it in a ``with`` block (it holds the open file).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        Anything above, each message naming the file, the problem and ``fix``.
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     f = atomic_savez(f"{tmp}/a.npz", {"x": np.arange(6.0).reshape(2, 3)})
+    ...     with open_npz(f) as npz:
+    ...         shapes = npz.entries
+    ...         x = npz.read("x", dtype=np.float64, shape=(2, 3))
+    >>> shapes["x"][0], float(x[1, 2])
+    ((2, 3), 5.0)
+    """
+    p = Path(_fspath(path))
+    try:
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise FileNotFoundError(f"no such file: {p}") from None
+    except OSError as exc:
+        raise ValueError(f"{p} cannot be opened ({exc}); {fix}.") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise ValueError(f"{p} is not a regular file (a folder, a pipe or a device); {fix}.")
+        fh = os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+    try:
+        return _scan(p, fh, st.st_size, fix, what)
+    except BaseException:
+        fh.close()
+        raise
+
+
+def _scan(p: Path, fh, size: int, fix: str, what: str) -> NpzReader:
+    """Check the archive's entries from their headers (see :func:`open_npz`)."""
+    def refuse(problem):
+        return ValueError(f"{p}: {problem}; {fix}.")
+
+    head = fh.read(6)
+    fh.seek(0)
+    if head == b"\x93NUMPY":
+        raise refuse("it is a single .npy array, not an .npz archive")
+    if not zipfile.is_zipfile(fh):
+        raise ValueError(f"{p} is not a readable .npz file (not a zip archive); {fix}.")
+    fh.seek(0)
+    entries, infos = {}, {}
     total, packed, compressed = 0.0, 0, False
     try:
-        with zipfile.ZipFile(p) as zf:
-            for info in zf.infolist():
-                with zf.open(info) as fh:
-                    version = np.lib.format.read_magic(fh)
-                    read = np.lib.format.read_array_header_1_0 if version == (1, 0) else \
-                        np.lib.format.read_array_header_2_0
-                    shape, _, dtype = read(fh)
-                    header = fh.tell()
-                if dtype.hasobject:
-                    raise ValueError(f"{p}: entry {info.filename!r} holds Python objects; not a roughpaths file.")
-                nbytes = float(np.prod(shape, dtype=float)) * dtype.itemsize
-                if info.file_size - header != nbytes:
-                    raise ValueError(f"{p}: entry {info.filename!r} declares shape {shape} of {dtype} "
-                                     f"({nbytes:.3g} bytes) but holds {info.file_size - header} bytes; the file is "
-                                     f"corrupt or forged.")
-                total += nbytes
-                packed += info.compress_size
-                compressed |= info.compress_type != zipfile.ZIP_STORED
-    except (zipfile.BadZipFile, OSError, EOFError) as exc:
-        raise ValueError(f"{p} is not a readable .npz file ({exc}); it is not a file written by roughpaths.save, "
-                         f"or it is truncated or corrupt.") from None
-    except ValueError as exc:
+        zf = zipfile.ZipFile(fh)
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError, RuntimeError, NotImplementedError) as exc:
+        raise ValueError(f"{p} is not a readable .npz file ({exc}); {fix}.") from None
+    try:
+        for info in zf.infolist():
+            name = info.filename
+            if not name.endswith(".npy") or name[:-4] in entries:
+                raise refuse(f"entry {name!r} is " + ("repeated" if name.endswith(".npy") else "not an .npy array"))
+            if info.compress_size > size or info.header_offset > size:
+                raise refuse(f"entry {name!r} claims {info.compress_size} stored bytes at offset "
+                             f"{info.header_offset} in a file of {size} bytes (truncated or forged)")
+            try:
+                with zf.open(info) as efh:
+                    shape, dtype, _ = _read_npy_header(efh)
+                    header = efh.tell()
+            except (zipfile.BadZipFile, OSError, EOFError, RuntimeError, NotImplementedError, ValueError,
+                    SyntaxError) as exc:
+                raise refuse(f"the header of entry {name!r} is unreadable ({type(exc).__name__}: {exc})") from None
+            if dtype.hasobject:
+                raise refuse(f"entry {name!r} holds Python objects (roughpaths never pickles)")
+            nbytes = float(np.prod(shape, dtype=float)) * dtype.itemsize
+            if info.file_size - header != nbytes:
+                raise refuse(f"entry {name!r} declares shape {shape} of {dtype} ({nbytes:.3g} bytes) but holds "
+                             f"{info.file_size - header} bytes (corrupt or forged)")
+            entries[name[:-4]] = (shape, dtype)
+            infos[name[:-4]] = info
+            total += nbytes
+            packed += info.compress_size
+            compressed |= info.compress_type != zipfile.ZIP_STORED
+        if compressed and total > _MAX_EXPANSION * max(packed, 1) and total > 2**26:
+            raise ValueError(f"{p} expands from {packed / 2**20:.3g} MiB of compressed entries to "
+                             f"{total / 2**30:.3g} GiB (more than {_MAX_EXPANSION}x): roughpaths never compresses, "
+                             f"and a file this compressible is forged (a zip bomb) or not ours; {fix}.")
+        check_memory(total, f"{what} of {p}", f"read it on a machine with more memory, or set "
+                     f"ROUGHPATHS_MAX_BYTES if you trust it; otherwise {fix}")
+    except BaseException:
+        zf.close()
+        raise
+    return NpzReader(p, fh, zf, entries, infos, fix)
+
+
+def _metadata(npz: NpzReader) -> dict:
+    p = npz.path
+    if _META_KEY not in npz.entries:
+        raise ValueError(f"{p} has no {_META_KEY!r} entry, so it was not written by roughpaths.save (it holds "
+                         f"the arrays {sorted(npz.entries)}; read it with numpy.load).")
+    shape, dtype = npz.entries[_META_KEY]
+    if shape != () or dtype.kind != "U":
+        raise npz.refuse(f"the metadata entry is an array of shape {shape} and dtype {dtype}, not a string")
+    try:
+        meta = json.loads(str(npz.read(_META_KEY)[()]))
+        _depth(meta)
+    except (ValueError, RecursionError) as exc:
         if str(exc).startswith(str(p)):
             raise
-        raise ValueError(f"{p}: an array header is unreadable ({exc}); the file is corrupt.") from None
-    if compressed and total > _MAX_EXPANSION * max(packed, 1) and total > 2**26:
-        raise ValueError(f"{p} expands from {packed / 2**20:.3g} MiB of compressed entries to {total / 2**30:.3g} GiB "
-                         f"(more than {_MAX_EXPANSION}x): roughpaths.save never compresses, and a file this "
-                         f"compressible is forged (a zip bomb) or not ours; load it with numpy.load if you trust it.")
-    check_memory(total, f"the arrays of {p}", "load it on a machine with more memory, or set ROUGHPATHS_MAX_BYTES")
-
-
-def _open(path):
-    p = Path(_fspath(path))
-    if not p.exists():
-        raise FileNotFoundError(f"no such file: {p}")
-    if not p.is_file():
-        raise ValueError(f"{p} is not a regular file (a folder, a pipe or a device); load reads .npz files written "
-                         f"by roughpaths.save.")
-    if zipfile.is_zipfile(p):
-        _check_entries(p)
-    try:
-        data = np.load(p, allow_pickle=False)
-    except (ValueError, OSError, zipfile.BadZipFile, EOFError) as exc:
-        raise ValueError(f"{p} is not a readable .npz file ({exc}); it is not a file written by "
-                         f"roughpaths.save, or it is truncated or corrupt.") from None
-    if not isinstance(data, np.lib.npyio.NpzFile):
-        raise ValueError(f"{p} is a single .npy array, not an .npz file written by roughpaths.save.")
-    return p, data
-
-
-def _metadata(p: Path, data) -> dict:
-    if _META_KEY not in data.files:
-        raise ValueError(f"{p} has no {_META_KEY!r} entry, so it was not written by roughpaths.save (it holds "
-                         f"the arrays {sorted(data.files)}; read it with numpy.load).")
-    try:
-        meta = json.loads(str(data[_META_KEY][()]))
-        _depth(meta)
-    except (ValueError, RecursionError, zipfile.BadZipFile, OSError, EOFError) as exc:
         raise ValueError(f"{p}: the metadata entry is unreadable ({type(exc).__name__}: {exc}); the file is "
                          f"corrupt.") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
@@ -388,17 +563,19 @@ def load_metadata(path) -> dict:
     FileNotFoundError
         No such file.
     ValueError
-        The file is not one written by :func:`save`, is corrupt or truncated, or uses a newer format
-        version than this package reads.
+        The file is not one written by :func:`save` (or not a regular file), is corrupt or truncated,
+        or uses a newer format version than this package reads.
     """
-    p, data = _open(path)
-    with data:
-        meta = _metadata(p, data)
+    with open_npz(path) as npz:
+        meta = _metadata(npz)
     return _from_json(meta)
 
 
 def load(path):
     """Read a :class:`~roughpaths.RoughPath` or :class:`~roughpaths.Solution` written by :func:`save`.
+
+    The file is read through :func:`open_npz` (regular files only; every header and declared size
+    checked before an array is read).
 
     Parameters
     ----------
@@ -416,18 +593,15 @@ def load(path):
     FileNotFoundError
         No such file.
     ValueError
-        The file is not one written by :func:`save`, is corrupt or truncated, lacks an array, or
-        uses a newer format version than this package reads.
+        The file is not one written by :func:`save` (or not a regular file), is corrupt or truncated,
+        lacks an array, or uses a newer format version than this package reads.
     """
-    p, data = _open(path)
-    with data:
-        meta = _metadata(p, data)
+    with open_npz(path) as npz:
+        p = npz.path
+        meta = _metadata(npz)
         kind = meta["type"]
         if kind in _CODECS:
-            try:
-                arrays = {n: data[n] for n in data.files if n != _META_KEY}
-            except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
-                raise ValueError(f"{p}: an array is unreadable ({exc}); the file is corrupt or truncated.") from None
+            arrays = {n: npz.read(n) for n in npz.entries if n != _META_KEY}
             try:
                 return _CODECS[kind][2](_from_json(meta), arrays)
             except (KeyError, ValueError, TypeError) as exc:
@@ -435,33 +609,30 @@ def load(path):
         names = _ARRAYS[kind] + (("areas",) if kind == "RoughPath" and meta.get("level") == 2 else ())
         if kind == "RoughPath" and meta.get("level") not in (1, 2):
             raise ValueError(f"{p}: metadata level {meta.get('level')!r}, expected 1 or 2; the file is corrupt.")
-        if kind == "RoughPath" and meta.get("level") == 1 and "areas" in data.files:
+        if kind == "RoughPath" and meta.get("level") == 1 and "areas" in npz.entries:
             raise ValueError(f"{p}: the metadata says level 1 but the file holds areas; the file is corrupt.")
-        missing = [n for n in names if n not in data.files]
+        missing = [n for n in names if n not in npz.entries]
         if missing:
             raise ValueError(f"{p}: the {kind} arrays {missing} are missing; the file is corrupt.")
-        try:
-            arrays = {n: data[n] for n in names}
-            data_files = tuple(data.files)
-            failed_arr = data["failed_step"] if "failed_step" in data_files else None
-        except (ValueError, zipfile.BadZipFile, OSError, EOFError) as exc:
-            raise ValueError(f"{p}: an array is unreadable ({exc}); the file is corrupt or truncated.") from None
-    if failed_arr is not None and (failed_arr.dtype != np.int64 or failed_arr.shape != arrays["states"].shape[:-2]):
+        for n in names:
+            dtype = npz.entries[n][1]
+            if dtype != np.float64:
+                raise ValueError(f"{p}: array {n!r} has dtype {dtype}, expected float64; the file is corrupt.")
+        has_failed = kind == "Solution" and "failed_step" in npz.entries
+        if has_failed:
+            npz.expect("failed_step", dtype=np.int64)
+        arrays = {n: npz.read(n) for n in names}
+        failed_arr = npz.read("failed_step") if has_failed else None
+    if failed_arr is not None and failed_arr.shape != arrays["states"].shape[:-2]:
         raise ValueError(f"{p}: array 'failed_step' has dtype {failed_arr.dtype} and shape {failed_arr.shape}, "
                          f"expected int64 of the batch shape; the file is corrupt.")
-    for n, a in arrays.items():
-        if a.dtype != np.float64:
-            raise ValueError(f"{p}: array {n!r} has dtype {a.dtype}, expected float64; the file is corrupt.")
     if kind == "Solution":
         if arrays["times"].ndim != 1 or arrays["states"].ndim < 2 or \
                 arrays["states"].shape[-2] != arrays["times"].shape[0]:
             raise ValueError(f"{p}: times of shape {arrays['times'].shape} and states of shape "
                              f"{arrays['states'].shape} disagree (states must be (..., len(times), e)); the file is "
                              f"corrupt.")
-        failed = None
-        if "failed_step" in data_files:
-            failed = failed_arr
-        return Solution(times=arrays["times"], states=arrays["states"], failed_step=failed,
+        return Solution(times=arrays["times"], states=arrays["states"], failed_step=failed_arr,
                         stats=_from_json(meta.get("stats", {})))
     try:
         X = RoughPath(arrays["increments"], arrays.get("areas"), times=arrays["times"], x0=arrays["x0"],
