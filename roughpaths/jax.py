@@ -23,6 +23,11 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad`` (and their compositio
   8 points, 2x at 32 paths of 128 points in d = 3) and hardly for large ones (1.45x at d = 8, depth 3);
   batch many paths into one call (``vmap`` does) to amortise it.
 
+The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
+:func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``
+(indexing and concatenation, no callback): JAX traces, jits and differentiates them itself (any order,
+forward mode included).
+
 Examples
 --------
 >>> import jax, jax.numpy as jnp
@@ -45,7 +50,8 @@ import jax.numpy as jnp
 import roughpaths as _rp
 from roughpaths._frontends import batch_broadcast, sum_to
 
-__all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable"]
+__all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
+           "time_augment", "basepoint", "invisibility_reset"]
 
 
 def _as_jax(x, name: str):
@@ -214,3 +220,85 @@ def signature_kernel_gram(X, Y, *, dyadic_order: int = 0, static_kernel=None):
     Backward: ``roughpaths.signature_kernel_gram_vjp``.
     """
     return _gram(X, Y, dyadic_order=dyadic_order, static_kernel=static_kernel)
+
+
+# ------------------------------------------------------------------------------ path transforms
+def _paths_array(paths, name: str = "paths"):
+    """``paths`` as a floating JAX array ``(..., n, d)`` with ``n, d >= 1``, or a clear error."""
+    x = _as_jax(paths, name)
+    if x.ndim < 2 or x.shape[-2] < 1 or x.shape[-1] < 1:
+        raise ValueError(f"{name} must have shape (..., n, d) with n >= 1 and d >= 1, got shape {x.shape}.")
+    return x
+
+
+def lead_lag(paths):
+    r"""Differentiable :func:`roughpaths.lead_lag` in ``jax.numpy``: ``(..., n, d)`` → ``(..., 2n - 1, 2d)``.
+
+    Point ``2k`` is ``(x_k, x_k)``, point ``2k + 1`` is ``(x_{k+1}, x_k)`` (lead channels first).
+
+    Examples
+    --------
+    >>> import jax.numpy as jnp
+    >>> lead_lag(jnp.array([[0.0], [1.0], [3.0]])).T
+    Array([[0., 1., 1., 3., 3.],
+           [0., 0., 1., 1., 3.]], dtype=float32)
+    """
+    x = _paths_array(paths)
+    k = np.arange(2 * x.shape[-2] - 1)
+    return jnp.concatenate([x[..., (k + 1) // 2, :], x[..., k // 2, :]], axis=-1)
+
+
+def time_augment(paths, times=None):
+    r"""Differentiable :func:`roughpaths.time_augment`: time as the first channel, ``(..., n, d)`` → ``(..., n, d + 1)``.
+
+    ``times`` (shape ``(n,)`` or ``(..., n)``) defaults to ``t_k = k / (n - 1)``; given times are not
+    checked for increase here (they may be traced values): check them before, or use the numpy function.
+
+    Examples
+    --------
+    >>> import jax.numpy as jnp
+    >>> time_augment(jnp.array([[5.0], [7.0], [6.0]]))
+    Array([[0. , 5. ],
+           [0.5, 7. ],
+           [1. , 6. ]], dtype=float32)
+    """
+    x = _paths_array(paths)
+    n = x.shape[-2]
+    t = jnp.arange(n, dtype=x.dtype) / max(n - 1, 1) if times is None else _as_jax(times, "times").astype(x.dtype)
+    if t.ndim < 1 or t.shape[-1] != n:
+        raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {t.shape}.")
+    return jnp.concatenate([jnp.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)
+
+
+def basepoint(paths):
+    r"""Differentiable :func:`roughpaths.basepoint`: the origin prepended, ``(..., n, d)`` → ``(..., n + 1, d)``.
+
+    Examples
+    --------
+    >>> import jax.numpy as jnp
+    >>> basepoint(jnp.array([[1.0, 2.0]]))
+    Array([[0., 0.],
+           [1., 2.]], dtype=float32)
+    """
+    x = _paths_array(paths)
+    return jnp.concatenate([jnp.zeros_like(x[..., :1, :]), x], axis=-2)
+
+
+def invisibility_reset(paths):
+    r"""Differentiable :func:`roughpaths.invisibility_reset`: ``(..., n, d)`` → ``(..., n + 2, d + 1)``.
+
+    Points ``(1, x_k)``, then ``(0, x_{n-1})``, then ``(0, 0)``.
+
+    Examples
+    --------
+    >>> import jax.numpy as jnp
+    >>> invisibility_reset(jnp.array([[1.0, 2.0], [3.0, 4.0]]))
+    Array([[1., 1., 2.],
+           [1., 3., 4.],
+           [0., 3., 4.],
+           [0., 0., 0.]], dtype=float32)
+    """
+    x = _paths_array(paths)
+    seen = jnp.concatenate([jnp.ones_like(x[..., :1]), x], axis=-1)
+    off = jnp.concatenate([jnp.zeros_like(x[..., -1:, :1]), x[..., -1:, :]], axis=-1)
+    return jnp.concatenate([seen, off, jnp.zeros_like(seen[..., :1, :])], axis=-2)

@@ -10,6 +10,11 @@ product; there is no second implementation:
 * :func:`signature_kernel`: ``roughpaths.signature_kernel``, ``roughpaths.signature_kernel_vjp``;
 * :func:`signature_kernel_gram`: ``roughpaths.signature_kernel_gram``, ``roughpaths.signature_kernel_gram_vjp``.
 
+The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
+:func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in torch operations
+(indexing and concatenation): they run on any device and in any floating dtype, and torch differentiates
+them itself (any order, ``torch.func`` included).
+
 Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`` paths, the
 ``iisignature`` layout, the Lyndon basis). What the wrappers add, and what they do not:
 
@@ -55,7 +60,8 @@ from torch.autograd.function import once_differentiable
 import roughpaths as _rp
 from roughpaths._frontends import batch_broadcast, sum_to
 
-__all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable"]
+__all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
+           "time_augment", "basepoint", "invisibility_reset"]
 
 _DTYPES = (torch.float32, torch.float64)
 
@@ -205,3 +211,93 @@ def signature_kernel_gram(X: torch.Tensor, Y: torch.Tensor, *, dyadic_order: int
     (computed in float64).
     """
     return _gram(X, Y, dyadic_order=dyadic_order, static_kernel=static_kernel)
+
+
+# ------------------------------------------------------------------------------ path transforms
+def _paths_tensor(paths, name: str = "paths") -> torch.Tensor:
+    """``paths`` as a floating tensor ``(..., n, d)`` with ``n, d >= 1``, or a clear error."""
+    if not isinstance(paths, torch.Tensor):
+        raise TypeError(f"{name} must be a torch.Tensor, got {type(paths).__name__}; wrap it with "
+                        f"torch.as_tensor({name}), or call roughpaths.{{lead_lag, ...}} on numpy arrays.")
+    if not paths.is_floating_point():
+        raise TypeError(f"{name} has dtype {paths.dtype}; the transforms take floating tensors: pass {name}.double().")
+    if paths.ndim < 2 or paths.shape[-2] < 1 or paths.shape[-1] < 1:
+        raise ValueError(f"{name} must have shape (..., n, d) with n >= 1 and d >= 1, got shape {tuple(paths.shape)}.")
+    return paths
+
+
+def lead_lag(paths: torch.Tensor) -> torch.Tensor:
+    r"""Differentiable :func:`roughpaths.lead_lag` in torch operations: ``(..., n, d)`` → ``(..., 2n - 1, 2d)``.
+
+    Point ``2k`` is ``(x_k, x_k)``, point ``2k + 1`` is ``(x_{k+1}, x_k)`` (lead channels first).
+
+    Examples
+    --------
+    >>> import torch
+    >>> lead_lag(torch.tensor([[0.0], [1.0], [3.0]])).T
+    tensor([[0., 1., 1., 3., 3.],
+            [0., 0., 1., 1., 3.]])
+    """
+    x = _paths_tensor(paths)
+    k = torch.arange(2 * x.shape[-2] - 1, device=x.device)
+    return torch.cat([x[..., (k + 1) // 2, :], x[..., k // 2, :]], dim=-1)
+
+
+def time_augment(paths: torch.Tensor, times=None) -> torch.Tensor:
+    r"""Differentiable :func:`roughpaths.time_augment`: time as the first channel, ``(..., n, d)`` → ``(..., n, d + 1)``.
+
+    ``times`` (shape ``(n,)`` or ``(..., n)``, strictly increasing) defaults to ``t_k = k / (n - 1)``.
+
+    Examples
+    --------
+    >>> import torch
+    >>> time_augment(torch.tensor([[5.0], [7.0], [6.0]]))
+    tensor([[0.0000, 5.0000],
+            [0.5000, 7.0000],
+            [1.0000, 6.0000]])
+    """
+    x = _paths_tensor(paths)
+    n = x.shape[-2]
+    if times is None:
+        t = torch.arange(n, dtype=x.dtype, device=x.device) / max(n - 1, 1)
+    else:
+        t = torch.as_tensor(times, dtype=x.dtype, device=x.device)
+        if t.ndim < 1 or t.shape[-1] != n:
+            raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {tuple(t.shape)}.")
+        if n > 1 and not bool(torch.all(t[..., 1:] > t[..., :-1])):
+            raise ValueError("times must be strictly increasing along its last axis; sort the points by time.")
+    return torch.cat([t.expand(x.shape[:-1]).unsqueeze(-1), x], dim=-1)
+
+
+def basepoint(paths: torch.Tensor) -> torch.Tensor:
+    r"""Differentiable :func:`roughpaths.basepoint`: the origin prepended, ``(..., n, d)`` → ``(..., n + 1, d)``.
+
+    Examples
+    --------
+    >>> import torch
+    >>> basepoint(torch.tensor([[1.0, 2.0]]))
+    tensor([[0., 0.],
+            [1., 2.]])
+    """
+    x = _paths_tensor(paths)
+    return torch.cat([torch.zeros_like(x[..., :1, :]), x], dim=-2)
+
+
+def invisibility_reset(paths: torch.Tensor) -> torch.Tensor:
+    r"""Differentiable :func:`roughpaths.invisibility_reset`: ``(..., n, d)`` → ``(..., n + 2, d + 1)``.
+
+    Points ``(1, x_k)``, then ``(0, x_{n-1})``, then ``(0, 0)``.
+
+    Examples
+    --------
+    >>> import torch
+    >>> invisibility_reset(torch.tensor([[1.0, 2.0], [3.0, 4.0]]))
+    tensor([[1., 1., 2.],
+            [1., 3., 4.],
+            [0., 3., 4.],
+            [0., 0., 0.]])
+    """
+    x = _paths_tensor(paths)
+    seen = torch.cat([torch.ones_like(x[..., :1]), x], dim=-1)
+    off = torch.cat([torch.zeros_like(x[..., -1:, :1]), x[..., -1:, :]], dim=-1)
+    return torch.cat([seen, off, torch.zeros_like(seen[..., :1, :])], dim=-2)

@@ -8,6 +8,9 @@ kernels (``_level2``, ``_lanes``, ``_simd``, ``_vjp``, ``_kernels``) are private
 Signature kernels (:mod:`~roughpaths.signatures.kernel`, the Goursat PDE in ``_goursat``), their static
 kernels (:mod:`~roughpaths.signatures.static_kernels`) and the two-sample test on them
 (:mod:`~roughpaths.signatures.mmd`) live here too.
+
+Path transforms applied before a signature (lead–lag, time, basepoint, invisibility reset) are in
+:mod:`~roughpaths.signatures.transforms`.
 """
 
 from .expected import brownian_expected_signature
@@ -16,9 +19,11 @@ from .kernel import signature_kernel, signature_kernel_gram, signature_kernel_gr
 from .mmd import MMDTestResult, sig_mmd_test
 from .signature import logsignature, rough_path_signature, signature
 from .static_kernels import LinearKernel, RBFKernel
+from .transforms import basepoint, invisibility_reset, lead_lag, time_augment
 
 __all__ = [
     "logsignature_vjp", "rough_path_signature_vjp", "signature_vjp", "logsignature", "rough_path_signature",
     "signature", "brownian_expected_signature", "signature_kernel", "signature_kernel_gram", "signature_kernel_vjp", "signature_kernel_gram_vjp",
     "LinearKernel", "RBFKernel", "sig_mmd_test", "MMDTestResult",
+    "lead_lag", "time_augment", "basepoint", "invisibility_reset",
 ]
