@@ -190,7 +190,7 @@ def _run_chunk(spec: _Spec, first: int, last: int):
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None, levy_area_error=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
                  chunk_size=1024, block_steps=None, executor=None, keep_final=False,
-                 checkpoint=None, keep_checkpoint=False) -> EnsembleResult:
+                 checkpoint=None, keep_checkpoint=False, code_version=None) -> EnsembleResult:
     r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
 
     Parameters
@@ -244,12 +244,30 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         (with a fingerprint of the run's arguments). If the file exists when the run starts, the
         finished chunks are taken from it and only the rest is simulated: a run killed at any moment
         and started again with the same arguments returns bitwise the result of an uninterrupted run.
-        A checkpoint of a different run is refused, and so is a checkpointed run whose ``system``,
-        ``method`` or ``observable`` cannot be identified across processes (a lambda or a closure: a
-        resume could not prove it is the same; define it at module level). The file is removed when
-        the run completes, unless ``keep_checkpoint``.
+        The file is removed when the run completes, unless ``keep_checkpoint``.
+
+        A checkpoint resumes only the run it belongs to, and it never takes identity on trust. Its
+        fingerprint holds the numerical arguments, the pickled ``system``, ``method`` and ``observable``
+        (their data, and the functions and classes they refer to, by name), the versions of
+        roughpaths-mechanics and numpy, and ``code_version``; a checkpoint of another run is refused.
+        A name identifies the library's own code (``roughpaths``, ``mechanics``, numpy: fixed by the
+        version) but not yours: a function of yours can compute something else under the same name
+        (an edited body, a global or a helper it reads). So with ``checkpoint``, a ``system``,
+        ``method`` or ``observable`` that refers to code outside the library (your own observable, a
+        Hamiltonian or force of yours, a solver subclass) is refused unless you pass
+        ``code_version``; a lambda or a closure, which does not pickle, is refused (define it at
+        module level). The file itself is untrusted input (:func:`roughpaths.io.open_npz`): a pipe,
+        a folder or a device is refused, every array's size is checked before it is read, and every
+        count, shape and statistic is checked against the run; a damaged or tampered file is
+        refused with a message that names it and says to delete it.
     keep_checkpoint : bool
         Leave the checkpoint file in place after a completed run (default False).
+    code_version : str, optional
+        With ``checkpoint``: the version of your own code that the run calls (see ``checkpoint``), any
+        non-empty string, e.g. ``"energy-observable-3"``. Change it whenever that code, or anything it
+        reads, changes: a checkpoint written under another ``code_version`` is refused, one written under
+        the same is resumed on your word. Required when the run refers to code outside the library,
+        refused without ``checkpoint`` (it would have no effect).
 
     Returns
     -------
@@ -320,10 +338,17 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
     snaps: list = []
     finals = []
     start = 0
+    if code_version is not None and checkpoint is None:
+        raise ValueError(f"code_version={code_version!r} identifies your code in a checkpoint, and there is no "
+                         f"checkpoint; pass checkpoint=... or leave code_version unset.")
     if checkpoint is not None:
         fingerprint = _fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, (levy_area, levy_area_error),
-                                   burn_in, average_every, record_every, chunk_size, keep_final, observable)
-        state = _load_checkpoint(checkpoint, fingerprint)
+                                   burn_in, average_every, record_every, chunk_size, keep_final, observable,
+                                   code_version)
+        n_avg = n_steps // average_every - min(burn_in, n_steps) // average_every     # steps in the time average
+        state = _load_checkpoint(checkpoint, fingerprint, bounds=bounds, dim=p, state_dim=n,
+                                 time_average=n_avg > 0, keep_final=bool(keep_final),
+                                 n_snapshots=0 if record_every is None else n_steps // record_every + 1)
         if state is not None:
             start, final, tavg, snaps, finals = state
     todo = bounds[start:]

@@ -6,7 +6,7 @@ matrix, the snapshots and the final states) is bitwise that of a run that was ne
 the first run was stopped by an exception or killed with SIGKILL. A checkpoint of another run is refused,
 including one of a run with another observable; an observable (or system) that cannot be identified
 across processes (a lambda) is refused with checkpoint=...; a completed run removes its checkpoint unless
-``keep_checkpoint=True``.
+``keep_checkpoint=True``. (Untrusted and tampered files, and user code: test_checkpoint_untrusted.py.)
 """
 
 import os
@@ -119,9 +119,11 @@ def _identity_obs(x):
 
 
 def test_another_observable_is_another_run_and_lambdas_are_refused(tmp_path):
+    """User observables need code_version (test_checkpoint_untrusted.py); under the same code_version, another
+    function is still another run, and a lambda, which does not pickle, is refused whatever the version."""
     ck = tmp_path / "ck.npz"
     body = mechanics.rigid_body(**BODY)
-    kw = dict(KW, n_paths=50)
+    kw = dict(KW, n_paths=50, code_version="1")
     mechanics.run_ensemble(body, [0.0, 0.6, 0.8], checkpoint=ck, keep_checkpoint=True, observable=_identity_obs,
                            **kw)
     with pytest.raises(ValueError, match="belongs to a run with other arguments"):
