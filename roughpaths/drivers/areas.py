@@ -2,7 +2,9 @@ r"""Lévy areas given Brownian increments: one vocabulary and one dispatch over 
 
 Every door that samples Brownian areas takes ``levy_area`` (one of :data:`LEVY_AREA_METHODS`, or
 ``None`` for no area) with the same default, ``"auto"``, and ``levy_area_error`` / ``substeps`` where
-they mean something: :class:`~roughpaths.BrownianDriver`, :func:`~roughpaths.brownian_rough_path`,
+they mean something, and refuses them where they would have no effect (``levy_area_error`` with any
+method but the Fourier ones and ``"auto"``, ``substeps`` with any but ``"davie"`` and ``"foster"``):
+:class:`~roughpaths.BrownianDriver`, :func:`~roughpaths.brownian_rough_path`,
 :func:`~roughpaths.brownian_increments_and_areas`, :func:`sample_levy_areas` (this module),
 :func:`mechanics.run_ensemble` and the main job's ``--levy-area``.
 
@@ -48,6 +50,11 @@ __all__ = ["sample_levy_areas", "DEFAULT_SUBSTEPS"]
 #: (Davie's own method: exact second moments at the lowest cost).
 DEFAULT_SUBSTEPS = 1
 
+#: The methods ``levy_area_error`` applies to: the Fourier methods, whose number of terms it sets, and
+#: ``"auto"``, which picks the cheapest method meeting it (``"exact"`` for ``d <= 2``, whose error is zero).
+#: Every other ``levy_area`` refuses it, whatever the dimension (it would have no effect).
+_ERROR_CONTROLLED = _FOURIER_METHODS + ("auto",)
+
 #: Series terms drawn exactly by the fallback of ``"exact"`` (the rest by a moment-matched Gamma tail).
 _EXACT_TERMS = 8
 # tail sums of the exact d = 2 series: Σ_{k>K} 1/c_k and Σ_{k>K} 1/c_k², c_k = 2π²k²
@@ -91,9 +98,12 @@ class _Sampler:
             raise ValueError(f"substeps={substeps!r} applies to levy_area='davie' or 'foster' only; "
                              f"levy_area={levy_area!r} sets its accuracy by levy_area_error (default h^1.5); "
                              f"leave substeps unset.")
-        if levy_area_error is not None and self.kind in (None, "bridge"):
-            raise ValueError(f"levy_area_error applies to the error-controlled methods {_FOURIER_METHODS + ('auto',)}, "
-                             f"not to levy_area={levy_area!r}; leave it unset or pick one of those.")
+        if levy_area_error is not None and levy_area not in _ERROR_CONTROLLED:
+            why = {None: "which draws no area", "exact": "which samples the exact law (no error to set)",
+                   "davie": "whose accuracy is set by substeps", "foster": "whose accuracy is set by substeps"}
+            raise ValueError(f"levy_area_error applies to the error-controlled methods {_ERROR_CONTROLLED} only; "
+                             f"levy_area={levy_area!r}, {why[levy_area]}, would ignore levy_area_error="
+                             f"{levy_area_error!r}. Leave levy_area_error unset, or pick one of those methods.")
 
     def block_width(self, fast: bool) -> int:
         """Area normals per path-step held in a block buffer: none when the kernels draw them (``fast``)."""
@@ -173,7 +183,8 @@ def sample_levy_areas(increments, h: float, rng, *, levy_area="auto", levy_area_
         Method (module table), default ``"auto"``: exact in law for ``d <= 2``, per-step L² error
         ``levy_area_error`` for ``d >= 3``.
     levy_area_error : float, optional
-        Per-component L² error per step of the error-controlled methods; default ``h^{3/2}``.
+        Per-component L² error per step of the error-controlled methods; default ``h^{3/2}``. Refused
+        with ``"exact"``, ``"davie"``, ``"foster"`` (and ``None``), where it would have no effect.
     substeps : int, optional
         Substeps of ``"davie"`` / ``"foster"`` (default 1).
 

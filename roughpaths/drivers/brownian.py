@@ -175,8 +175,9 @@ def brownian_increments_and_areas(rng, n_steps, dt, dim, *, batch_shape=(), levy
         Stratonovich areas :math:`A + \tfrac12 W\otimes W`, or Itô areas
         :math:`A + \tfrac12 W\otimes W - \tfrac12 h I`.
     levy_area_error : float, optional
-        Per-step L² error of the error-controlled methods (``"auto"`` at ``d >= 3``, the Fourier
-        methods; default ``h^{3/2}``), as for :class:`BrownianDriver`.
+        Per-step L² error of the error-controlled methods (default ``h^{3/2}``), as for
+        :class:`BrownianDriver`: accepted with the Fourier methods and ``"auto"``, refused with every
+        other ``levy_area``.
 
     Returns
     -------
@@ -311,7 +312,10 @@ class BrownianDriver(SeededDriver):
         Starting point (default 0).
     levy_area_error : float or callable h -> float, optional
         Per-component L² error per step for the Fourier samplers; default ``h^1.5`` (the accuracy at
-        which the order-1 schemes keep order 1 against Brownian motion).
+        which the order-1 schemes keep order 1 against Brownian motion). One rule at every door: it is
+        accepted where it sets the accuracy, with the Fourier methods and with ``"auto"`` (which meets
+        it with ``"exact"``, error zero, for ``d <= 2``), and refused (``ValueError``) with ``"exact"``,
+        ``"davie"``, ``"foster"`` and ``None``, where it would have no effect.
     block_bytes : int
         Target memory of one block (increments, areas and random buffers), default 16 MiB (at
         least one step per block); it sets the default of :meth:`blocks`, never the numbers.
