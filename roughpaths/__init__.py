@@ -7,7 +7,7 @@ Friz–Oberhauser drift of a perturbation ``s`` is ``½ Σ s^{ij} [V_i, V_j]``.
 The package is filed by concept, one subpackage each (imports point down this list, never up):
 :mod:`~roughpaths.algebra` (tensor algebra, level-2 group, Lyndon basis), :mod:`~roughpaths.paths`
 (rough paths, rough integral), :mod:`~roughpaths.signatures`, :mod:`~roughpaths.norms`,
-:mod:`~roughpaths.drivers` (Brownian with Lévy areas, coloured noise, fBM) and :mod:`~roughpaths.rde`
+:mod:`~roughpaths.drivers` (Brownian with Lévy areas, coloured noise, fBM, chaotic maps) and :mod:`~roughpaths.rde`
 (``solve``, the solvers, vector fields); :mod:`~roughpaths.io` saves and loads them. Every public name
 is importable from here.
 """
@@ -24,6 +24,8 @@ from .drivers import (DEFAULT_SUBSTEPS, LEVY_AREA_METHODS, BrownianDriver, Brown
                       levy_area_normals, levy_area_terms, levy_areas_from_normals, lift_area_rate, ou_step_law,
                       paper_coloured_noise_matrices, piecewise_linear_lift, refine, sample_coloured_noise,
                       sample_levy_areas)
+from .drivers import (ChaoticDriver, ChaoticLimit, ChaoticMap, GreenKuboEstimate, SineObservable, cat_map,
+                      chaotic_limit, chaotic_limit_path, green_kubo, lorenz63_map, observable_orbits)
 from .io import load, load_metadata, register_format, save
 from .norms import (area_holder_seminorm, area_p_variation, holder_distance, holder_seminorm, p_variation,
                     rough_path_holder_norm, rough_path_p_variation)
@@ -45,6 +47,9 @@ __all__ = [
     "coloured_noise_limit", "ColouredNoiseDriver", "ColouredNoiseLimit", "ColouredNoiseSample",
     "sample_coloured_noise", "iter_coloured_noise", "coloured_noise_limit_path", "paper_coloured_noise_matrices",
     "ou_step_law", "lift_area_rate", "expected_area_rate", "ResolutionWarning",
+    # deterministic chaos: drivers from chaotic maps, their limit with the Lévy-area drift Alt(E)
+    "ChaoticDriver", "ChaoticMap", "cat_map", "lorenz63_map", "observable_orbits", "green_kubo",
+    "GreenKuboEstimate", "chaotic_limit", "ChaoticLimit", "chaotic_limit_path", "SineObservable",
     # saving and loading (versioned .npz)
     "save", "load", "load_metadata", "register_format",
     # rough paths, the level-2 group

@@ -9,6 +9,9 @@
 * :mod:`~roughpaths.drivers.coloured_noise` (and its law, :mod:`~roughpaths.drivers.coloured_noise_law`):
   Ornstein–Uhlenbeck coloured noise and its Wong–Zakai limit.
 * :mod:`~roughpaths.drivers.fractional`: fractional Brownian motion and its rough-path lift.
+* :mod:`~roughpaths.drivers.chaotic`: sums of an observable along orbits of a chaotic map, lifted
+  (:class:`ChaoticDriver`), and :mod:`~roughpaths.drivers.chaotic_limit`: their Brownian limit with the
+  Lévy-area drift ``Alt(E)`` (Green–Kubo estimates, the perturbed limit path).
 
 The per-path streams (``_random``, ``_ziggurat``, ``_seeded``) and the compiled samplers are private.
 """
@@ -20,6 +23,9 @@ from .coloured_noise import (ColouredNoiseDriver, ColouredNoiseSample, Resolutio
                              coloured_noise_limit_path, iter_coloured_noise, sample_coloured_noise)
 from .coloured_noise_law import (ColouredNoiseLimit, coloured_noise_limit, expected_area_rate,
                                  lift_area_rate, ou_step_law, paper_coloured_noise_matrices)
+from .chaotic import ChaoticDriver, ChaoticMap, cat_map, lorenz63_map, observable_orbits
+from .chaotic_limit import (ChaoticLimit, GreenKuboEstimate, SineObservable, chaotic_limit, chaotic_limit_path,
+                            green_kubo)
 from .fractional import fbm, fbm_rough_path, fgn_autocovariance, piecewise_linear_lift
 from .levy_area import (LEVY_AREA_METHODS, choose_levy_area_method, levy_area_normals, levy_area_terms,
                         levy_areas_from_normals)
@@ -34,4 +40,6 @@ __all__ = [
     "fbm_rough_path", "fgn_autocovariance", "piecewise_linear_lift", "LEVY_AREA_METHODS",
     "choose_levy_area_method", "levy_area_normals", "levy_area_terms", "levy_areas_from_normals",
     "sample_levy_areas", "RefinedBrownianDriver", "refine", "BrownianTree",
+    "ChaoticDriver", "ChaoticMap", "cat_map", "lorenz63_map", "observable_orbits", "ChaoticLimit",
+    "GreenKuboEstimate", "SineObservable", "chaotic_limit", "chaotic_limit_path", "green_kubo",
 ]
