@@ -24,8 +24,16 @@ iisignature (single-threaded); the gradient at depth 4 on (b); ``logsignature`` 
 at depth 10 in a fresh process; level 2 on (a) beside a CPU-bound process; bitwise equality of
 results with 1 and 2 threads.
 
+Last section, streams and words (issue 41; alone with ``--only-streams``): on a Brownian path of 10^6
+points in d = 2 (step 1e-3) at depth 4, the error of S(s, t) for windows of 10, 1000 and 10^5 steps
+against the direct signature of the sub-path, per level and relative to the level's largest entry, for
+the prefixes-and-inverse answer S(0,s)^{-1} ⊗ S(0,t) and for ``SignatureStream`` (the tree of block
+signatures); the stream's build and query times for several block sizes against direct signatures of the
+sub-paths; ``windowed_signature`` against a batched direct computation; ``signature_coefficients``
+against the full signature and iisignature.
+
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
-[--depths 3,4]`` (the last three select peer-table cells and skip the rest).
+[--depths 3,4] [--only-streams]`` (the cells, kinds and depths select peer-table cells and skip the rest).
 """
 
 from __future__ import annotations
@@ -228,7 +236,11 @@ def main() -> None:
                         "implies --only-peer-table")
     parser.add_argument("--kinds", default="", help="peer-table kinds to run (e.g. 'sig,log vjp')")
     parser.add_argument("--depths", default="", help="peer-table depths to run (e.g. '3,4')")
+    parser.add_argument("--only-streams", action="store_true", help="print the streams-and-words section only")
     args = parser.parse_args()
+    if args.only_streams:
+        streams_section(args)
+        return
 
     import iisignature
     import numba
@@ -356,7 +368,98 @@ def main() -> None:
             same.append(one[0].tobytes() == many[0].tobytes() and one[1].tobytes() == many[1].tobytes())
     print(f"results with 1 thread and with {threads} threads bitwise identical (cases a-c, levels 2-3, "
           f"sig and logsig): {all(same)}")
-    print(f"load average at the end: {' '.join(f'{v:.1f}' for v in os.getloadavg())} (1, 5, 15 min)")
+    print(f"load average at the end: {' '.join(f'{v:.1f}' for v in os.getloadavg())} (1, 5, 15 min)\n")
+    streams_section(args)
+
+
+def streams_section(args) -> None:
+    """Issue 41: the rounding of sub-interval signatures (prefixes and inverse against the stream's tree),
+    the stream's costs, windowed signatures and chosen words."""
+    import math
+
+    import iisignature
+
+    import roughpaths as rp
+
+    rng = np.random.default_rng(41)
+    n, d, m = (10 ** 5 if args.quick else 10 ** 6), 2, 4
+    x = np.concatenate([np.zeros((1, d)), rng.normal(scale=1e-3, size=(n - 1, d)).cumsum(axis=0)])
+    off = np.cumsum([0] + [d ** k for k in range(1, m + 1)])
+    print(f"streams: Brownian path of {n} points, d = {d}, step 1e-3, depth {m}")
+    print("  error of S(s, t) against signature(x[s:t+1]), per level, relative to the level's largest entry "
+          "(max over 20 windows in the second half)")
+    print(f"  {'window':>8}{'level':>7}{'|S_k| (max)':>14}{'prefixes+inverse':>19}{'stream (tree)':>16}")
+    stream = rp.SignatureStream(x, m)
+    for w in (10, 1000, 10 ** 5 // (10 if args.quick else 1)):
+        s = rng.integers(n // 2, n - 1 - w, size=20)
+        t = s + w
+        direct = np.stack([rp.signature(x[a:b + 1], m) for a, b in zip(s, t)])
+        inverse = rp.tensor_product(rp.tensor_inverse(np.stack([rp.signature(x[:a + 1], m) for a in s]), d),
+                                    np.stack([rp.signature(x[:b + 1], m) for b in t]), d)
+        tree = stream.signature(s, t)
+        for k in range(m):
+            lv = slice(off[k], off[k + 1])
+            scale = np.max(np.abs(direct[:, lv]), axis=1)
+            e_inv = np.max(np.max(np.abs(inverse[:, lv] - direct[:, lv]), axis=1) / scale)
+            e_tree = np.max(np.max(np.abs(tree[:, lv] - direct[:, lv]), axis=1) / scale)
+            print(f"  {w:>8}{k + 1:>7}{float(np.max(scale)):>14.2e}{e_inv:>19.1e}{e_tree:>16.1e}")
+    print(f"  (the inverse loses about (|X_0s| / |X_st|)^k eps: here |X_0s| ~ {np.abs(x[n // 2:]).max():.1f})")
+
+    print("\n  SignatureStream costs (10^4 random queries [s, t], one call)")
+    s = rng.integers(0, n // 2, size=10_000)
+    t = s + rng.integers(0, n // 2, size=10_000)
+    for block in (8, 32, 128):
+        t0 = time.perf_counter()
+        st = rp.SignatureStream(x, m, block=block)
+        t_build = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        st.signature(s, t)
+        t_query = time.perf_counter() - t0
+        stored = sum(level.nbytes for level in st._levels)
+        print(f"  block {block:>4}: build {t_build:.2f} s, stored {stored / 2**20:.1f} MiB, "
+              f"{1e6 * t_query / s.size:.0f} us per query")
+    t0 = time.perf_counter()
+    for a, b in zip(s[:20], t[:20]):
+        rp.signature(x[a:b + 1], m)
+    print(f"  direct signature of the sub-path: {1e6 * (time.perf_counter() - t0) / 20:.0f} us per query "
+          f"(mean length {np.mean(t[:20] - s[:20]):.0f} steps)")
+
+    xs = rng.normal(size=(10 ** 5 // (10 if args.quick else 1), 3)).cumsum(axis=0) * 0.01
+    for length in (16, 256):
+        t0 = time.perf_counter()
+        got = rp.windowed_signature(xs, 3, length)
+        t_ours = time.perf_counter() - t0
+        idx = np.arange(got.shape[0])[:, None] + np.arange(length + 1)
+        t0 = time.perf_counter()
+        want = rp.signature(xs[idx], 3)
+        t_direct = time.perf_counter() - t0
+        err = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
+        print(f"\n  windowed_signature, sliding windows of {length} steps over {xs.shape[0]} points, d = 3, "
+              f"depth 3: {t_ours:.2f} s; gathered windows through signature: {t_direct:.2f} s; "
+              f"largest difference {err:.1e} of the largest entry")
+
+    xw = rng.normal(size=(n, 3)).cumsum(axis=0) * 1e-3
+    words = [tuple(rng.integers(0, 3, size=4)) for _ in range(10)]
+    rp.signature_coefficients(xw[:10], words)
+    t0 = time.perf_counter()
+    coef = rp.signature_coefficients(xw, words)
+    t_w = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    full = rp.signature(xw, 4)
+    t_full = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    iisignature.sig(xw, 4)
+    t_ii = time.perf_counter() - t0
+    pos = [sum(d3 for d3 in (3, 9, 27)) + sum(c * 3 ** (3 - j) for j, c in enumerate(w)) for w in words]
+    err = float(np.max(np.abs(coef - full[pos])) / np.max(np.abs(full[39:])))
+    print(f"\n  signature_coefficients: 10 words of length 4 along {n} points, d = 3: {1e3 * t_w:.0f} ms; "
+          f"full depth-4 signature {1e3 * t_full:.0f} ms (iisignature {1e3 * t_ii:.0f} ms); "
+          f"largest difference {err:.1e} of level 4's largest entry")
+    tr = rng.normal(size=(1000, 1000, 3))
+    t0 = time.perf_counter()
+    for f in (rp.lead_lag, rp.time_augment, rp.basepoint, rp.invisibility_reset):
+        f(tr)
+    print(f"\n  the four transforms on 1000 x 1000 x 3: {1e3 * (time.perf_counter() - t0):.0f} ms in all")
 
 
 if __name__ == "__main__":

@@ -32,11 +32,11 @@ from .norms import (area_holder_seminorm, area_p_variation, holder_distance, hol
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
 from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
                   NonFiniteStateError, PIController, Solution, Solver, VectorFields, central_jacobian, solve)
-from .signatures import (LinearKernel, MMDTestResult, RBFKernel, basepoint, brownian_expected_signature,
-                         invisibility_reset, lead_lag, logsignature,
+from .signatures import (LinearKernel, MMDTestResult, RBFKernel, SignatureStream, basepoint,
+                         brownian_expected_signature, invisibility_reset, lead_lag, logsignature,
                          logsignature_vjp, rough_path_signature, rough_path_signature_vjp, sig_mmd_test, signature,
                          signature_kernel, signature_kernel_gram, signature_kernel_gram_vjp, signature_kernel_vjp,
-                         signature_vjp, time_augment)
+                         signature_vjp, signature_coefficients, time_augment, windowed_signature)
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
@@ -71,6 +71,7 @@ __all__ = [
     # signature kernels and the two-sample test
     "signature_kernel", "signature_kernel_gram", "signature_kernel_vjp", "signature_kernel_gram_vjp",
     "LinearKernel", "RBFKernel", "sig_mmd_test", "MMDTestResult",
-    # path transforms
-    "lead_lag", "time_augment", "basepoint", "invisibility_reset",
+    # path transforms, streams (signatures of sub-intervals and windows), chosen words
+    "lead_lag", "time_augment", "basepoint", "invisibility_reset", "SignatureStream", "windowed_signature",
+    "signature_coefficients",
 ]

@@ -9,8 +9,10 @@ Signature kernels (:mod:`~roughpaths.signatures.kernel`, the Goursat PDE in ``_g
 kernels (:mod:`~roughpaths.signatures.static_kernels`) and the two-sample test on them
 (:mod:`~roughpaths.signatures.mmd`) live here too.
 
-Path transforms applied before a signature (lead–lag, time, basepoint, invisibility reset) are in
-:mod:`~roughpaths.signatures.transforms`.
+Path transforms applied before a signature (lead–lag, time, basepoint, invisibility reset:
+:mod:`~roughpaths.signatures.transforms`), signatures of any sub-interval and of sliding or expanding
+windows (:mod:`~roughpaths.signatures.stream`) and the coefficients of chosen words
+(:mod:`~roughpaths.signatures.words`) build on :func:`signature` and the tensor algebra.
 """
 
 from .expected import brownian_expected_signature
@@ -19,11 +21,14 @@ from .kernel import signature_kernel, signature_kernel_gram, signature_kernel_gr
 from .mmd import MMDTestResult, sig_mmd_test
 from .signature import logsignature, rough_path_signature, signature
 from .static_kernels import LinearKernel, RBFKernel
+from .stream import SignatureStream, windowed_signature
 from .transforms import basepoint, invisibility_reset, lead_lag, time_augment
+from .words import signature_coefficients
 
 __all__ = [
     "logsignature_vjp", "rough_path_signature_vjp", "signature_vjp", "logsignature", "rough_path_signature",
     "signature", "brownian_expected_signature", "signature_kernel", "signature_kernel_gram", "signature_kernel_vjp", "signature_kernel_gram_vjp",
     "LinearKernel", "RBFKernel", "sig_mmd_test", "MMDTestResult",
-    "lead_lag", "time_augment", "basepoint", "invisibility_reset",
+    "lead_lag", "time_augment", "basepoint", "invisibility_reset", "SignatureStream", "windowed_signature",
+    "signature_coefficients",
 ]

@@ -1,0 +1,287 @@
+r"""Signatures of any sub-interval of a sampled path, and windowed signatures in one call.
+
+A :class:`SignatureStream` holds a path's signatures in a form that answers :math:`S(X)_{s,t}` for
+any grid points ``s <= t`` without running over the sub-path again. The obvious form stores the
+prefixes :math:`S_{0,t}` and answers by Chen with the inverse,
+:math:`S_{s,t} = S_{0,s}^{-1} \otimes S_{0,t}`, in one product. Its rounding error, however, is
+that of the prefixes, not of the answer: level ``k`` of the product is a sum of terms of the size of
+:math:`|X_{0,s}|^k` that cancel down to the size of :math:`|X_{s,t}|^k`, so about
+:math:`(|X_{0,s}| / |X_{s,t}|)^k \varepsilon` of the answer is lost. Measured on a Brownian path of
+10⁶ points in ``d = 2`` (step ``10⁻³``, ``|X_{0,s}| ≈ 0.8``) at depth 4, relative to each level's
+largest entry, worst of 20 windows in the second half of the path:
+
+===========  ==============================================  ==========================
+window       prefixes and inverse, levels 1 / 2 / 3 / 4       this stream, all levels
+===========  ==============================================  ==========================
+10 steps     8e-13 / 2.5e-10 / 1.5e-7 / **8e-5**              below 3e-15
+1000 steps   1e-13 / 7e-12 / 2e-10 / 7e-9                     below 4e-15
+10⁵ steps    3e-14 / 8e-14 / 4e-13 / 1.4e-12                  below 3e-15
+===========  ==============================================  ==========================
+
+(``benchmarks/bench_signatures.py --only-streams`` prints this table.) The stream therefore stores a
+**segment tree of block signatures**: the grid is cut into blocks of ``block`` steps, each block's
+signature is computed directly (:func:`roughpaths.signature`), and level ``j`` of the tree holds the
+Chen products of ``2**j`` consecutive blocks. A query ``[s, t]`` is answered as
+
+.. math:: S_{s,t} = S_{s, b_1} \otimes (\text{at most } 2 \log_2(n / \text{block}) \text{ tree nodes})
+          \otimes S_{b_2, t},
+
+with the partial blocks ``[s, b_1]`` and ``[b_2, t]`` (fewer than ``block`` steps each) computed
+directly. Every factor is the signature of a piece of ``[s, t]`` itself, so nothing cancels against the
+rest of the path: the error is a few rounding units of the answer's own level sizes and grows only like
+the number of factors, ``log n`` (the table's right column; the tests assert ``1e-12`` of each level's
+largest entry, against the direct signature of the sub-path). Costs, same path, ``block = 32``: build
+0.34 s (the path read once, ``n / block`` tensor products), 14 MiB stored (``2 n / block``
+signatures); 72 µs a query in a call of 10⁴ random queries (at most ``2 block`` segments and
+``2 log2(n / block)`` tensor products each, vectorised over the queries), against 10 ms for the direct
+signature of a sub-path of 2·10⁵ steps. Blocks of 8 or 128 steps gave the same query time (the tree's
+products dominate), 57 or 3.6 MiB stored.
+
+:func:`windowed_signature` answers sliding and expanding windows in one call (short sliding windows
+directly, the others through a stream).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..algebra import lyndon_coordinates, sigdim, tensor_log, tensor_product
+from ..validation import as_float_array, check_memory, check_positive_int
+from .signature import signature
+
+__all__ = ["SignatureStream", "windowed_signature"]
+
+#: Target number of floats in one gathered chunk of queries (about 32 MiB).
+_CHUNK_FLOATS = 1 << 22
+#: Sliding windows of at most this many steps are signed directly (gathered), longer ones by a stream.
+_DIRECT_WINDOW = 64
+
+
+class SignatureStream:
+    r"""The signature of every sub-interval ``[s, t]`` of a sampled path's grid, by Chen from a tree.
+
+    Parameters
+    ----------
+    paths : array_like, shape ``(..., n, d)``
+        ``n >= 1`` points (linearly interpolated); leading axes are batch axes.
+    depth : int
+        Truncation level ``m >= 1``.
+    block : int, optional
+        Steps per stored block (default 32). Smaller blocks store more (``2 n / block`` signatures) and
+        make queries cheaper (at most ``2 block`` segments each); the answers are the same to rounding.
+
+    Attributes
+    ----------
+    depth, dim, n_points, block : int
+    batch_shape : tuple
+
+    Notes
+    -----
+    The module docstring states the design (a segment tree of block signatures instead of the prefixes
+    and their inverses) and the measured rounding error.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from roughpaths import signature
+    >>> x = np.random.default_rng(0).normal(size=(200, 2)).cumsum(axis=0)
+    >>> stream = SignatureStream(x, 3, block=8)
+    >>> stream.signature([5, 0], [150, 199]).shape            # two queries: [5, 150] and [0, 199]
+    (2, 14)
+    >>> bool(np.allclose(stream.signature(5, 150), signature(x[5:151], 3)))
+    True
+    """
+
+    def __init__(self, paths, depth: int, *, block: int = 32):
+        self.depth = check_positive_int(depth, "depth")
+        self.block = check_positive_int(block, "block")
+        x = as_float_array(paths, "paths", min_ndim=2)
+        self.batch_shape, (self.n_points, self.dim) = x.shape[:-2], x.shape[-2:]
+        if self.n_points < 1 or self.dim < 1:
+            raise ValueError(f"paths must have shape (..., n, d) with n >= 1 and d >= 1, got shape {x.shape}.")
+        self._sigdim = sigdim(self.dim, self.depth)
+        n_paths = float(np.prod(self.batch_shape, dtype=float))
+        n_blocks = max(1, -(-(self.n_points - 1) // self.block))
+        check_memory(n_paths * (2.0 * n_blocks * self._sigdim + n_blocks * (self.block + 1) * self.dim) * 8.0,
+                     f"the stream's tree ({self.batch_shape} paths x 2 x {n_blocks} blocks x {self._sigdim} "
+                     f"signature entries)", "pass a larger block or a smaller depth, or fewer paths at a time")
+        self._x = x
+        idx = np.minimum(np.arange(n_blocks)[:, None] * self.block + np.arange(self.block + 1), self.n_points - 1)
+        level = signature(x[..., idx, :], self.depth)                 # (..., n_blocks, D)
+        self._levels = [level]
+        while level.shape[-2] > 1:
+            if level.shape[-2] % 2:                                    # pad with the identity (zeros)
+                level = np.concatenate([level, np.zeros(level.shape[:-2] + (1, self._sigdim))], axis=-2)
+            level = tensor_product(level[..., 0::2, :], level[..., 1::2, :], self.dim)
+            self._levels.append(level)
+
+    def __repr__(self) -> str:
+        return (f"SignatureStream(batch_shape={self.batch_shape}, n_points={self.n_points}, dim={self.dim}, "
+                f"depth={self.depth}, block={self.block})")
+
+    # ------------------------------------------------------------------------------ queries
+    def _check_query(self, s, t) -> tuple:
+        out = []
+        for v, name in ((s, "s"), (t, "t")):
+            if isinstance(v, (str, bytes)) or v is None:
+                raise TypeError(f"{name} must be grid indices (integers), got {v!r}.")
+            a = np.asarray(v)
+            if a.dtype.kind not in "iu":
+                raise TypeError(f"{name} must be grid indices (integers 0..{self.n_points - 1}), got dtype "
+                                f"{a.dtype}; pass point indices, e.g. np.searchsorted(times, t_query).")
+            out.append(a.astype(np.int64))
+        try:
+            s, t = np.broadcast_arrays(*out)
+        except ValueError:
+            raise ValueError(f"s of shape {out[0].shape} and t of shape {out[1].shape} do not broadcast.") from None
+        for a, name in ((s, "s"), (t, "t")):
+            if a.size and (a.min() < 0 or a.max() > self.n_points - 1):
+                bad = int(a[(a < 0) | (a > self.n_points - 1)].ravel()[0])
+                raise ValueError(f"{name} holds the index {bad}, outside the grid 0..{self.n_points - 1}.")
+        if np.any(s > t):
+            k = tuple(int(i) for i in np.argwhere(s > t)[0])
+            raise ValueError(f"s must be <= t, but s{list(k)} = {int(s[k])} > t{list(k)} = {int(t[k])}; the "
+                             f"signature of the reversed piece is tensor_inverse(stream.signature(t, s), dim).")
+        n_paths = float(np.prod(self.batch_shape, dtype=float))
+        check_memory(n_paths * s.size * self._sigdim * 8.0, f"the answers ({self.batch_shape} paths x {s.size} "
+                     f"queries x {self._sigdim})", "ask fewer queries at a time")
+        return s, t
+
+    def _direct(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """``S(lo, hi)`` for ``hi - lo <= block``: the sub-path padded by repeating its last point."""
+        idx = np.minimum(lo[:, None] + np.arange(self.block + 1), hi[:, None])
+        return signature(self._x[..., idx, :], self.depth)
+
+    def _tree(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """The product of blocks ``a .. b-1`` (identity where ``a == b``): bottom-up segment-tree walk."""
+        shape = self.batch_shape + (a.shape[0], self._sigdim)
+        left, right = np.zeros(shape), np.zeros(shape)
+        lo, hi = a.copy(), b.copy()
+        for level in self._levels:
+            take = np.nonzero((lo < hi) & (lo % 2 == 1))[0]
+            if take.size:                                  # left <- left ⊗ node[lo], on those rows only
+                left[..., take, :] = tensor_product(left[..., take, :], level[..., lo[take], :], self.dim)
+                lo[take] += 1
+            take = np.nonzero((lo < hi) & (hi % 2 == 1))[0]
+            if take.size:                                  # right <- node[hi - 1] ⊗ right
+                hi[take] -= 1
+                right[..., take, :] = tensor_product(level[..., hi[take], :], right[..., take, :], self.dim)
+            lo, hi = lo // 2, hi // 2
+        return tensor_product(left, right, self.dim)
+
+    def _answer(self, s: np.ndarray, t: np.ndarray) -> np.ndarray:
+        B = self.block
+        first = np.minimum(-(-s // B) * B, t)            # first block boundary at or after s (or t)
+        last = np.maximum(t // B * B, first)             # last block boundary at or before t (or first)
+        middle = self._tree(first // B, last // B)
+        return tensor_product(tensor_product(self._direct(s, first), middle, self.dim),
+                              self._direct(last, t), self.dim)
+
+    def signature(self, s, t) -> np.ndarray:
+        r"""The signature :math:`S(X)_{s,t}` of the path between grid points ``s`` and ``t``.
+
+        Parameters
+        ----------
+        s, t : int or array_like of int
+            Point indices ``0 <= s <= t <= n - 1``, broadcast against each other to a query shape ``q``.
+
+        Returns
+        -------
+        ndarray, shape ``(*batch_shape, *q, sigdim(d, depth))``
+            In :func:`roughpaths.signature`'s layout: equal (to rounding, see the module docstring) to
+            ``signature(paths[..., s:t + 1, :], depth)``; zero where ``s == t``.
+        """
+        s, t = self._check_query(s, t)
+        q = s.shape
+        s, t = s.ravel(), t.ravel()
+        per_query = float(np.prod(self.batch_shape, dtype=float)) * max((self.block + 1) * self.dim,
+                                                                         4 * self._sigdim)
+        chunk = max(1, int(_CHUNK_FLOATS // max(per_query, 1.0)))
+        out = np.empty(self.batch_shape + (s.size, self._sigdim))
+        for lo in range(0, s.size, chunk):
+            out[..., lo:lo + chunk, :] = self._answer(s[lo:lo + chunk], t[lo:lo + chunk])
+        return out.reshape(self.batch_shape + q + (self._sigdim,))
+
+    def logsignature(self, s, t) -> np.ndarray:
+        r"""The log-signature of the path between grid points ``s`` and ``t``, in the Lyndon basis.
+
+        Parameters
+        ----------
+        s, t : int or array_like of int
+            As for :meth:`signature`.
+
+        Returns
+        -------
+        ndarray, shape ``(*batch_shape, *q, logsigdim(d, depth))``
+            ``lyndon_coordinates(tensor_log(self.signature(s, t), d), d)``: the coordinates of
+            :func:`roughpaths.logsignature` of the sub-path.
+        """
+        return lyndon_coordinates(tensor_log(self.signature(s, t), self.dim), self.dim)
+
+
+def windowed_signature(paths, depth: int, length: int, *, step: int = 1, expanding: bool = False,
+                       log: bool = False) -> np.ndarray:
+    r"""Signatures (or log-signatures) of sliding or expanding windows of sampled paths, in one call.
+
+    Parameters
+    ----------
+    paths : array_like, shape ``(..., n, d)``
+    depth : int
+        Truncation level ``m >= 1``.
+    length : int
+        Steps in a sliding window, or in the first expanding window (``1 <= length <= n - 1``).
+    step : int
+        Steps between consecutive windows (default 1).
+    expanding : bool
+        ``False`` (default): sliding windows ``[k step, k step + length]``; ``True``: expanding windows
+        ``[0, length + k step]``; ``k = 0, ..., W - 1`` with ``W = (n - 1 - length) // step + 1``.
+    log : bool
+        ``True``: log-signatures in the Lyndon basis instead of signatures.
+
+    Returns
+    -------
+    ndarray, shape ``(..., W, sigdim(d, m))`` (or ``logsigdim(d, m)`` with ``log=True``)
+        Window ``k`` in :func:`roughpaths.signature`'s (or :func:`roughpaths.logsignature`'s) layout.
+        Sliding windows of at most 64 steps are computed directly (each window's points gathered),
+        longer ones and expanding windows by a :class:`SignatureStream` (its rounding error).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> windowed_signature(x, 2, 2, log=True)                      # increments and Lévy areas
+    array([[ 1. ,  1. ,  0.5],
+           [-1. ,  1. ,  0.5]])
+    >>> windowed_signature(x, 1, 1, expanding=True)                # the path's value minus its start
+    array([[1., 0.],
+           [1., 1.],
+           [0., 1.]])
+    """
+    x = as_float_array(paths, "paths", min_ndim=2)
+    n = x.shape[-2]
+    length = check_positive_int(length, "length")
+    step = check_positive_int(step, "step")
+    if not isinstance(expanding, (bool, np.bool_)):
+        raise TypeError(f"expanding must be True or False, got {expanding!r}.")
+    if not isinstance(log, (bool, np.bool_)):
+        raise TypeError(f"log must be True or False, got {log!r}.")
+    if length > n - 1:
+        raise ValueError(f"length={length} is more than the {n - 1} steps of the paths (shape {x.shape}); pass "
+                         f"length <= {max(n - 1, 1)} or longer paths.")
+    depth = check_positive_int(depth, "depth")
+    k = np.arange((n - 1 - length) // step + 1)
+    s = np.zeros_like(k) if expanding else k * step
+    t = length + k * step
+    if not expanding and length <= _DIRECT_WINDOW:
+        # short sliding windows: each one's points gathered and signed directly (cheaper than the tree's
+        # partial blocks and products: 16 steps, 10^5 windows, d = 3, depth 3 took 0.3 s against 1.6 s)
+        n_paths = float(np.prod(x.shape[:-2], dtype=float))
+        check_memory(n_paths * k.size * sigdim(x.shape[-1], depth) * 8.0, f"the windows' signatures "
+                     f"({x.shape[:-2]} paths x {k.size} windows)", "pass a larger step or fewer paths at a time")
+        chunk = max(1, int(_CHUNK_FLOATS // max(1.0, n_paths * (length + 1) * x.shape[-1])))
+        parts = [signature(x[..., s[lo:lo + chunk, None] + np.arange(length + 1), :], depth)
+                 for lo in range(0, k.size, chunk)]
+        sig = np.concatenate(parts, axis=-2)
+        return lyndon_coordinates(tensor_log(sig, x.shape[-1]), x.shape[-1]) if log else sig
+    stream = SignatureStream(x, depth)
+    return stream.logsignature(s, t) if log else stream.signature(s, t)
