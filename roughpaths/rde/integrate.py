@@ -83,7 +83,9 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         Extra drift added to :math:`V_0`, e.g. ``fields.friz_oberhauser_drift(s)`` (vector fields only).
     save_at : "all", "end" or array_like of grid times
         Which states to keep (default all ``N + 1``; with adaptive steps every accepted step, or the
-        given times in ``[t0, t1]``, which the steps then hit).
+        given times in ``[t0, t1]``, which the steps then hit). Times are given in increasing order, as
+        ``Solution.times`` returns them: unsorted times are refused, never reordered (a repeated time
+        is saved once).
     on_failure : "raise" or "mask"
         What to do when batch members become non-finite: raise :class:`NonFiniteStateError` naming every
         failed member and its step (default), or finish the healthy members and return them, with
@@ -148,6 +150,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     """
     solver = _resolve_solver(solver)
     fields = solver.check_fields(fields)
+    _check_save_at(save_at)
     if block_steps is not None:
         block_steps = check_positive_int(block_steps, "block_steps")
     if isinstance(driver, BrownianTree):
@@ -246,6 +249,23 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     stats = {"solver": repr(solver), "n_steps": n, "n_blocks": n_blocks, "batch_shape": batch,
              "wall_time": _time.perf_counter() - t_start}
     return Solution(times=times[idx].copy(), states=out, failed_step=failed_step, stats=stats)
+
+
+def _check_save_at(save_at) -> None:
+    """Refuse an array ``save_at`` that is not 1-D (or a scalar) or not in increasing order (every route of
+    :func:`solve` keeps times in order; sorting them silently would pair the caller's times with other states)."""
+    if isinstance(save_at, str):
+        return
+    t = as_float_array(save_at, "save_at")
+    if t.ndim > 1:
+        raise ValueError(f"save_at must be a 1-D array of times, got shape {t.shape}; pass np.ravel(save_at) "
+                         f"if you meant its entries in that order.")
+    if t.ndim == 1 and np.any(t[1:] < t[:-1]):
+        k = int(np.argmax(t[1:] < t[:-1]))
+        shown = repr(save_at) if len(repr(save_at)) <= 80 else repr(save_at)[:77] + "..."
+        raise ValueError(f"save_at must be in increasing order (Solution.times and states follow it), but "
+                         f"save_at[{k}]={float(t[k])!r} > save_at[{k + 1}]={float(t[k + 1])!r} in save_at={shown}; sort it "
+                         f"(np.sort(save_at)) and read the states in that order.")
 
 
 def _higher_levels(block, increment_level):
