@@ -24,7 +24,7 @@ import mechanics
 import roughpaths
 
 from .model import INERTIA, PI0, SIGMA, THETA, hemisphere_mean, paper_body, s_matrix, standard_error
-from . import section2
+from . import chaos, section2
 from .report import CheckResult
 from .tasks import registry_decorator
 
@@ -488,3 +488,8 @@ def check_planar(ctx) -> CheckResult:
         "N12 = δγ/(2α(α² + γ²)) (the paper's constant is right).",
         predicted=pred, measured=meas, tolerance="relative difference ≤ 1e-10",
         passed=abs(meas - pred) <= 1e-10 * abs(pred), details=f"α = {alpha}, γ = {gamma}, δ = {delta}")
+
+
+# the conclusion's question (module chaos): fast chaotic dynamics homogenise to a limit with a Lévy-area drift
+register("chaos", "Deterministic chaos: the fast–slow limit carries the Lévy-area drift Alt(E), neither Itô nor "
+         "Stratonovich")(chaos.check_chaos)
