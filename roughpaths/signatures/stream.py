@@ -259,6 +259,8 @@ def windowed_signature(paths, depth: int, length: int, *, step: int = 1, expandi
     """
     x = as_float_array(paths, "paths", min_ndim=2)
     n = x.shape[-2]
+    if n < 1 or x.shape[-1] < 1:
+        raise ValueError(f"paths must have shape (..., n, d) with n >= 1 and d >= 1, got shape {x.shape}.")
     length = check_positive_int(length, "length")
     step = check_positive_int(step, "step")
     if not isinstance(expanding, (bool, np.bool_)):
