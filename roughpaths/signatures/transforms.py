@@ -7,15 +7,15 @@ augmentations of Chevyrev and Kormilitzin, *A primer on the signature method in 
 time series feature extraction* (2020); the conventions below (which copy leads, where the new channel
 goes) are those of ``sktime``'s signature transformer, so features line up with it:
 
-================================  ==================  ===========================================================
-transform                         shape out           points
-================================  ==================  ===========================================================
-:func:`lead_lag`                  ``(..., 2n-1, 2d)`` ``(x_k, x_k)`` at ``2k``, ``(x_{k+1}, x_k)`` at ``2k+1``:
-                                                      lead channels first, the lead moves first
-:func:`time_augment`              ``(..., n, d+1)``   ``(t_k, x_k)``, time first, ``t_k = k / (n - 1)`` or given
-:func:`basepoint`                 ``(..., n+1, d)``   ``0, x_0, ..., x_{n-1}``
-:func:`invisibility_reset`        ``(..., n+2, d+1)`` ``(1, x_k)``, then ``(0, x_{n-1})``, then ``(0, 0)``
-================================  ==================  ===========================================================
+================================  =====================  ===========================================================
+transform                         shape out              points
+================================  =====================  ===========================================================
+:func:`lead_lag`                  ``(..., 2n-1, 2d)``    ``(x_k, x_k)`` at ``2k``, ``(x_{k+1}, x_k)`` at ``2k+1``:
+                                                         lead channels first, the lead moves first
+:func:`time_augment`              ``(..., n, d+1)``      ``(t_k, x_k)``, time first, ``t_k = k / (n - 1)`` or given
+:func:`basepoint`                 ``(..., n+1, d)``      ``0, x_0, ..., x_{n-1}``
+:func:`invisibility_reset`        ``(..., n+2, d+1)``    ``(1, x_k)``, then ``(0, x_{n-1})``, then ``(0, 0)``
+================================  =====================  ===========================================================
 
 What they add to the signature:
 
