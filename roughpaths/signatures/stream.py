@@ -69,6 +69,7 @@ class SignatureStream:
     block : int, optional
         Steps per stored block (default 32). Smaller blocks store more (``2 n / block`` signatures) and
         make queries cheaper (at most ``2 block`` segments each); the answers are the same to rounding.
+        A block longer than the path is cut to the path's ``n - 1`` steps.
 
     Attributes
     ----------
@@ -94,11 +95,12 @@ class SignatureStream:
 
     def __init__(self, paths, depth: int, *, block: int = 32):
         self.depth = check_positive_int(depth, "depth")
-        self.block = check_positive_int(block, "block")
+        block = check_positive_int(block, "block")
         x = as_float_array(paths, "paths", min_ndim=2)
         self.batch_shape, (self.n_points, self.dim) = x.shape[:-2], x.shape[-2:]
         if self.n_points < 1 or self.dim < 1:
             raise ValueError(f"paths must have shape (..., n, d) with n >= 1 and d >= 1, got shape {x.shape}.")
+        self.block = min(block, max(1, self.n_points - 1))       # one block holds the whole path at most
         self._sigdim = sigdim(self.dim, self.depth)
         n_paths = float(np.prod(self.batch_shape, dtype=float))
         n_blocks = max(1, -(-(self.n_points - 1) // self.block))

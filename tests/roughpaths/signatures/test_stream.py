@@ -125,6 +125,13 @@ def test_windowed_signature_matches_loops(expanding, length, step):
     np.testing.assert_allclose(got_log, want_log, rtol=0, atol=1e-12 * np.abs(want_log).max())
 
 
+def test_a_block_longer_than_the_path_is_the_whole_path():
+    x = _brownian((), 30, 2, 1.0)
+    stream = rp.SignatureStream(x, 3, block=10 ** 12)
+    assert stream.block == 29
+    _assert_close_by_level(stream.signature(2, 27), rp.signature(x[2:28], 3), 2, 3, 1e-12)
+
+
 def test_one_point_and_one_channel():
     x = np.array([[2.0]])
     assert np.all(rp.SignatureStream(x, 3).signature(0, 0) == 0.0)
