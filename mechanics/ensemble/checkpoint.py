@@ -80,9 +80,12 @@ def fingerprint(system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn
 
     Parameters
     ----------
-    system, mu0, dt, n_steps, n_paths, seed, method, levy_area, burn_in, average_every, record_every, chunk_size, keep_final, observable
-        The run's arguments (as checked by :func:`~mechanics.run_ensemble`; ``levy_area`` the pair
-        ``(levy_area, levy_area_error)``).
+    system, mu0, dt, n_steps, n_paths, seed, method
+        The run's arguments, as checked by :func:`~mechanics.run_ensemble`.
+    levy_area : tuple
+        The pair ``(levy_area, levy_area_error)``.
+    burn_in, average_every, record_every, chunk_size, keep_final, observable
+        The run's arguments.
     code_version : str, optional
         Required when ``system``, ``method`` or ``observable`` refers to code outside
         :data:`LIBRARY_MODULES`; part of the digest.
@@ -190,7 +193,8 @@ def load_checkpoint(path, fingerprint, *, bounds, dim, state_dim, time_average, 
     """
     fix = "delete it to start the run afresh"
     try:
-        npz = open_npz(path, fix=f"it is not a readable checkpoint; {fix}", what="the checkpoint's arrays")
+        npz = open_npz(path, fix=f"it is not a checkpoint run_ensemble can resume; {fix}",
+                       what="the checkpoint's arrays")
     except FileNotFoundError:
         return None
     with npz:

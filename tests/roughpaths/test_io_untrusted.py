@@ -177,3 +177,48 @@ def test_a_writer_killed_mid_write_leaves_nothing_after_the_next_write(tmp_path,
     rp.save(X, tmp_path / "y.npz")
     assert not stale.exists() and live.exists()
     assert rp.load(tmp_path / "y.npz") == X
+
+
+def test_repeated_and_foreign_entries_are_refused(tmp_path, saved):
+    """A zip holding two ``x0.npy`` (the old reader silently used one of them) or a non-``.npy`` member is not a
+    file ``save`` writes: refused, naming the file and the entry."""
+    X, path = saved
+    twice = tmp_path / "twice.npz"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(twice, "w") as dst:
+        for info in src.infolist():
+            dst.writestr(info.filename, src.read(info))
+        with pytest.warns(UserWarning, match="Duplicate name"):
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, np.full(X.x0.shape, 7.0))
+            dst.writestr("x0.npy", buf.getvalue())
+    with pytest.raises(ValueError, match=r"twice.npz: entry 'x0.npy' is repeated"):
+        rp.load(twice)
+    foreign = tmp_path / "foreign.npz"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(foreign, "w") as dst:
+        for info in src.infolist():
+            dst.writestr(info.filename, src.read(info))
+        dst.writestr("notes.txt", b"hello")
+    with pytest.raises(ValueError, match=r"foreign.npz: entry 'notes.txt' is not an .npy array"):
+        rp.load_metadata(foreign)
+
+
+def test_open_npz_reads_what_the_headers_declare_and_refuses_other_expectations(tmp_path):
+    """The one reader: shapes and dtypes come from the checked headers, a C- or Fortran-ordered array reads back
+    equal, and an expectation the header does not meet is refused before the array is read."""
+    from roughpaths.io import atomic_savez, open_npz
+
+    a = np.arange(12.0).reshape(3, 4)
+    f = atomic_savez(tmp_path / "a.npz", {"c": a, "f": np.asfortranarray(a), "i": np.arange(5)})
+    with open_npz(f, fix="do something") as npz:
+        assert npz.entries == {"c": ((3, 4), np.dtype(np.float64)), "f": ((3, 4), np.dtype(np.float64)),
+                               "i": ((5,), np.dtype(np.int64))}
+        np.testing.assert_array_equal(npz.read("c"), a)
+        np.testing.assert_array_equal(npz.read("f"), a)
+        with pytest.raises(ValueError, match=r"a.npz: the array 'i' has dtype int64, expected float64; do something"):
+            npz.read("i", dtype=np.float64)
+        with pytest.raises(ValueError, match=r"the array 'c' has shape \(3, 4\), expected \(4, 3\); do something"):
+            npz.read("c", shape=(4, 3))
+        with pytest.raises(ValueError, match=r"the array 'x' is missing"):
+            npz.read("x")
+    with pytest.raises(ValueError, match="is not a regular file"):
+        open_npz("/dev/null")
