@@ -264,8 +264,8 @@ def _check_save_at(save_at) -> None:
         k = int(np.argmax(t[1:] < t[:-1]))
         shown = repr(save_at) if len(repr(save_at)) <= 80 else repr(save_at)[:77] + "..."
         raise ValueError(f"save_at must be in increasing order (Solution.times and states follow it), but "
-                         f"save_at[{k}]={float(t[k])!r} > save_at[{k + 1}]={float(t[k + 1])!r} in save_at={shown}; sort it "
-                         f"(np.sort(save_at)) and read the states in that order.")
+                         f"save_at[{k}]={float(t[k])!r} > save_at[{k + 1}]={float(t[k + 1])!r} in "
+                         f"save_at={shown}; sort it (np.sort(save_at)) and read the states in that order.")
 
 
 def _higher_levels(block, increment_level):
