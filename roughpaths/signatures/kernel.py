@@ -90,6 +90,57 @@ def _check_size(npairs: int, n: int, m: int, order: int, d: int, grad: bool) -> 
                  "lower dyadic_order or split the batch")
 
 
+def _feature_length(Z: np.ndarray, rbf: bool) -> float:
+    """Length of the piecewise-linear path ``Z (n, d)`` in the static kernel's feature space.
+
+    Linear: ``Σ |z_{t+1} - z_t|``; RBF (``Z`` already divided by σ): ``Σ sqrt(2 - 2 κ(z_t, z_{t+1}))``,
+    the distance of consecutive feature vectors. The signature's level ``k`` has norm at most
+    ``L**k / k!``, so ``|k(x, y)| <= Σ_k (Lx Ly)**k / (k!)**2 = I0(2 sqrt(Lx Ly)) <= exp(2 sqrt(Lx Ly))``.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        dz = np.diff(Z, axis=0)
+        top = np.max(np.abs(dz), axis=-1, initial=0.0)
+        safe = np.where((top > 0) & np.isfinite(top), top, 1.0)
+        step = np.where(np.isfinite(top), safe * np.sqrt(np.sum((dz / safe[:, None]) ** 2, axis=-1)), np.inf)
+        if rbf:
+            step = np.sqrt(2.0 - 2.0 * np.exp(-0.5 * step * step))
+        return float(np.sum(step))
+
+
+#: ``Lx * Ly`` below this keeps every kernel (and every value in its PDE grid) below ``exp(2 sqrt(C))``,
+#: about ``1e300``: the fix the overflow message proposes.
+_SAFE_LENGTH_PRODUCT = 1.2e5
+
+
+def _finite_or_raise(values: np.ndarray, X, Y, ia, ib, rbf: bool, what: str) -> None:
+    """Raise, naming the scale and the fix, if a pair's kernel (or gradient) overflowed float64.
+
+    The Goursat solution of two paths of feature-space lengths ``Lx``, ``Ly`` can be as large as
+    ``exp(2 sqrt(Lx Ly))``; beyond ``Lx Ly ~ 1.3e5`` it leaves float64 (``inf``, then ``inf - inf = nan``).
+    """
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size == 0:
+        return
+    k = int(bad[0])
+    i, j = int(ia[k]), int(ib[k])
+    lx, ly = _feature_length(X[i], rbf), _feature_length(Y[j], rbf)
+    root = np.sqrt(lx) * np.sqrt(ly)                   # sqrt(Lx Ly) without overflowing the product
+    log10 = 2.0 * root / np.log(10.0)
+    if rbf:
+        fix = ("use a larger sigma in RBFKernel(sigma) (fewer, shorter steps in feature space) or subsample "
+               "the paths")
+    else:
+        shrink = np.sqrt(_SAFE_LENGTH_PRODUCT) / root if 0 < root < np.inf else 0.0
+        fix = (f"scale the paths down: with static_kernel=LinearKernel(scale=s) the lengths are multiplied by s, "
+               f"and s <= {shrink:.3g} times the current scale keeps Lx*Ly <= {_SAFE_LENGTH_PRODUCT:.3g} "
+               f"(kernels below ~1e300); or normalise the paths (e.g. divide by their length)")
+    raise ValueError(f"the signature kernel{'' if what == 'kernel' else ' gradient'} of {bad.size} pair(s) "
+                     f"overflows float64 (inf or nan); the first is the pair of paths {i} and {j} (flattened batch "
+                     f"indices), whose lengths in the static kernel's feature space (after its scale) are "
+                     f"Lx={lx:.3g} and Ly={ly:.3g}: the kernel can grow like exp(2 sqrt(Lx Ly)) = 10^{log10:.3g}; "
+                     f"{fix}.")
+
+
 def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, rbf: bool, order: int) -> np.ndarray:
     """Kernels of the pairs ``(X[ia[k]], Y[ib[k]])`` of validated, scaled ``(A, n, d)``, ``(B, m, d)`` arrays."""
     npairs, n, m = ia.shape[0], X.shape[1], Y.shape[1]
@@ -102,6 +153,7 @@ def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, 
     per_group = _work(_goursat.LANES, n, m, order) * 4
     _threads.run(lambda lo, hi: _goursat.kernel_groups(X, Y, ia, ib, rbf, order, lo, hi, out),
                  _threads.ranges(ngroups, per_group))
+    _finite_or_raise(out, X, Y, ia, ib, rbf, "kernel")
     return out
 
 
@@ -118,6 +170,8 @@ def _pairs_vjp(X, Y, ia, ib, rbf: bool, order: int, gout: np.ndarray) -> tuple:
     per_group = _work(_goursat.LANES, n, m, order) * 16
     _threads.run(lambda lo, hi: _goursat.vjp_groups(X, Y, ia, ib, rbf, order, gout, lo, hi, gx, gy),
                  _threads.ranges(ngroups, per_group))
+    bad = ~(np.isfinite(gx).all(axis=(1, 2)) & np.isfinite(gy).all(axis=(1, 2)))
+    _finite_or_raise(np.where(bad, np.inf, 0.0), X, Y, ia, ib, rbf, "gradient")
     return gx, gy
 
 
@@ -142,7 +196,18 @@ def _setup(x, y, dyadic_order, static_kernel, names, axes):
         raise ValueError(f"dyadic_order={order} refines each step 2**{order} times; use dyadic_order <= "
                          f"{_MAX_ORDER} (the discretisation error falls like 4**-dyadic_order: 2 to 4 is typical).")
     rbf, factor = _resolve(static_kernel)
+    if not np.isfinite(factor):           # RBFKernel(sigma) with 1/sigma beyond float64 (sigma < ~5.6e-309)
+        raise ValueError(f"static_kernel={static_kernel!r}: the paths are divided by sigma, and 1/sigma overflows "
+                         f"float64; pass a sigma of at least 1e-300 (in the units of the paths' values), or "
+                         f"rescale the paths.")
     x, y = _check_pair(x, y, names, axes)
+    for arr, name in zip((x, y), names):
+        if factor != 1.0 and arr.size:
+            top = float(np.max(np.abs(arr)))
+            if not np.isfinite(top * factor):
+                raise ValueError(f"static_kernel={static_kernel!r} scales the paths by {factor:.3g}, and "
+                                 f"max |{name}| = {top:.3g} times that overflows float64; use a static kernel "
+                                 f"of smaller scale (larger sigma) or rescale the paths.")
     return x, y, order, rbf, factor
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from ..validation import check_positive_int
+from ..validation import check_memory, check_positive_int, check_work
 from .kernel import _pairs_kernel, _scaled, _setup
 
 __all__ = ["MMDTestResult", "sig_mmd_test"]
@@ -106,11 +106,30 @@ def _pooled_gram(X: np.ndarray, Y: np.ndarray, rbf: bool, order: int) -> np.ndar
         k = _pairs_kernel(Z, Z, i.astype(np.int64), j.astype(np.int64), rbf, order)
         K[off + i, off + j] = k
         K[off + j, off + i] = k
-    i, j = (g.ravel().astype(np.int64) for g in np.meshgrid(np.arange(a), np.arange(b), indexing="ij"))
+    i = np.repeat(np.arange(a, dtype=np.int64), b)
+    j = np.tile(np.arange(b, dtype=np.int64), a)
     k = _pairs_kernel(X, Y, i, j, rbf, order)
     K[i, a + j] = k
     K[a + j, i] = k
     return K
+
+
+#: Relabellings drawn and evaluated per block: the labels take ``_PERM_BLOCK * (a + b)`` bytes (twice,
+#: while a block is permuted) whatever ``n_permutations`` is.
+_PERM_BLOCK = 4096
+
+
+def _memory_estimate(a: int, b: int, n_permutations: int) -> float:
+    """Bytes :func:`sig_mmd_test` holds at its peak for samples of ``a`` and ``b`` paths (the estimate it checks).
+
+    The pooled Gram matrix ``8 (a + b)²``; while its largest block of ``P = max(ab, a(a-1)/2, b(b-1)/2)``
+    pairs is computed, about ``10`` arrays of ``P`` 8-byte entries (the pair indices, their padded copies,
+    the kernels and the scatter's index temporaries); the null statistics ``8 (n_permutations + 1)``; and
+    one block of labels (``2 * min(n_permutations, 4096) * (a + b)`` bytes).
+    """
+    pairs = max(float(a) * b, float(a) * (a - 1) / 2, float(b) * (b - 1) / 2)
+    block = min(float(n_permutations), float(_PERM_BLOCK)) + 1.0
+    return 8.0 * (a + b) ** 2 + 80.0 * pairs + 8.0 * (n_permutations + 1.0) + 2.0 * block * (a + b)
 
 
 def sig_mmd_test(X, Y, *, seed, n_permutations: int = 1000, dyadic_order: int = 0,
@@ -167,12 +186,28 @@ def sig_mmd_test(X, Y, *, seed, n_permutations: int = 1000, dyadic_order: int = 
                         f"(the test is reproducible from it).")
     rng = np.random.default_rng(seed)
     a, b = X.shape[0], Y.shape[0]
+    check_memory(_memory_estimate(a, b, n_perm), f"the permutation test of {a} against {b} paths with "
+                 f"n_permutations={n_perm} (the pooled Gram matrix of {a + b} x {a + b} kernels and "
+                 f"{n_perm + 1} statistics)", "use fewer permutations or smaller samples")
+    check_work(float(n_perm + 1) * (a + b) * (a + b - 1) / 2, f"the permutation test: {n_perm} relabelling(s) of "
+               f"{a + b} pooled paths, each summing the {(a + b) * (a + b - 1) // 2} pairs of the Gram matrix",
+               "use fewer permutations (n_permutations=999 resolves p-values down to 0.001) or smaller samples")
     K = _pooled_gram(_scaled(X, 2, factor), _scaled(Y, 2, factor), rbf, order)
-    labels = np.zeros((n_perm + 1, a + b), dtype=np.int8)
-    labels[0, :a] = 1
-    labels[1:, :a] = 1
-    labels[1:] = rng.permuted(labels[1:], axis=1)
-    stats = _mmd_stats(K, labels, float(a), float(b))
+    stats = np.empty(n_perm + 1)
+    first = np.zeros((1, a + b), dtype=np.int8)
+    first[0, :a] = 1
+    stats[:1] = _mmd_stats(K, first, float(a), float(b))
+    for lo in range(1, n_perm + 1, _PERM_BLOCK):          # one stream: the same draws whatever the block
+        labels = np.zeros((min(_PERM_BLOCK, n_perm + 1 - lo), a + b), dtype=np.int8)
+        labels[:, :a] = 1
+        labels = rng.permuted(labels, axis=1)
+        stats[lo:lo + labels.shape[0]] = _mmd_stats(K, labels, float(a), float(b))
+    if not np.all(np.isfinite(stats)):
+        top = float(np.max(np.abs(K)))
+        raise ValueError(f"the MMD statistics overflow float64: the kernels reach {top:.3g} and their sums over "
+                         f"the {(a + b) * (a + b - 1) // 2} pairs leave float64; scale the paths down (e.g. "
+                         f"static_kernel=LinearKernel(scale=0.5), or normalise the paths) so that the kernels stay "
+                         f"far below 1e300.")
     observed, null = float(stats[0]), stats[1:]
     p = (1.0 + np.count_nonzero(null >= observed)) / (1.0 + n_perm)
     return MMDTestResult(statistic=observed, p_value=float(p), n_permutations=n_perm, null_statistics=null)
