@@ -28,6 +28,7 @@ __all__ = [
     "check_same_batch",
     "check_memory",
     "memory_budget",
+    "recorded_memory_estimates",
     "check_work",
     "work_budget",
     "arrays_equal",
@@ -260,23 +261,98 @@ def _human(nbytes: float) -> str:
     return f"{nbytes:.0f} B"
 
 
+class _Recorders:
+    """The lists that :func:`recorded_memory_estimates` collects into (innermost last), per thread."""
+
+    def __init__(self):
+        import threading
+
+        self._local = threading.local()
+
+    @property
+    def stack(self) -> list:
+        st = getattr(self._local, "stack", None)
+        if st is None:
+            st = self._local.stack = []
+        return st
+
+
+_RECORDERS = _Recorders()
+
+
+class recorded_memory_estimates:  # noqa: N801 (a context manager used like a function)
+    """Collect every estimate that :func:`check_memory` receives inside a ``with`` block.
+
+    The estimates a call checks are the ones that would refuse it; collecting them lets a test compare
+    them with what the call really allocates (``tests/test_memory_estimates.py``), so that the number
+    that refuses a request is the number that is tested. Each entry is ``(nbytes, what)``; entries are
+    collected whether or not they fit the budget (a refused call raises after its entry is recorded).
+    Blocks nest (each collects what happens inside it) and are per thread.
+
+    Examples
+    --------
+    >>> with recorded_memory_estimates() as est:
+    ...     check_memory(8.0 * 1000, "a vector of 1000 floats", "use fewer")
+    >>> est.total, est.entries[0][1]
+    (8000.0, 'a vector of 1000 floats')
+    """
+
+    def __init__(self):
+        self.entries: list = []
+
+    @property
+    def total(self) -> float:
+        """The sum of the collected estimates, in bytes."""
+        return float(sum(nbytes for nbytes, _ in self.entries))
+
+    def __enter__(self):
+        _RECORDERS.stack.append(self)
+        return self
+
+    def __exit__(self, *exc):
+        _RECORDERS.stack.remove(self)
+        return False
+
+    def __repr__(self) -> str:
+        return f"recorded_memory_estimates(total={_human(self.total)}, entries={len(self.entries)})"
+
+
 def check_memory(nbytes, what: str, fix: str, *, max_bytes=None) -> None:
-    """Refuse, before allocating, an array of ``nbytes`` bytes above the budget.
+    """Refuse, before allocating, a request of ``nbytes`` bytes above the budget.
+
+    The one door for sizes: every constructor and call that allocates in proportion to its arguments
+    estimates the bytes it is about to hold and passes the estimate here before it allocates, so that a
+    request that cannot fit is refused at once with the estimate in the message (instead of swapping, an
+    out-of-memory kill, or a hang). The estimate covers the arrays the call holds at its peak (the result
+    and its working arrays); :func:`recorded_memory_estimates` collects the estimates a call makes, and
+    the test of the library compares them with the measured peak.
 
     Parameters
     ----------
     nbytes : int or float
-        The estimated size (compute it in floating point so it cannot overflow).
+        The estimated size (compute it in floating point so it cannot overflow); NaN is refused too.
     what : str
         What would be allocated, e.g. ``"the saved states (1000 paths x 10001 times x 3)"``.
     fix : str
         How to stay within the budget, e.g. ``"save fewer times (save_at='end')"``.
     max_bytes : int, optional
         The budget; default :func:`memory_budget`.
+
+    Examples
+    --------
+    >>> check_memory(8.0 * 10**6, "a vector of 10**6 floats", "use fewer", max_bytes=2**30)
+    >>> check_memory(8.0 * 10**12, "a vector of 10**12 floats", "use fewer", max_bytes=2**30)
+    Traceback (most recent call last):
+    ...
+    ValueError: a vector of 10**12 floats would take 7.28 TiB, more than the memory budget of 1 GiB (three \
+quarters of the available memory, or ROUGHPATHS_MAX_BYTES); use fewer.
     """
+    nbytes = float(nbytes)
+    for rec in _RECORDERS.stack:
+        rec.entries.append((nbytes, what))
     budget = memory_budget() if max_bytes is None else max_bytes
-    if float(nbytes) > budget:
-        raise ValueError(f"{what} would take {_human(float(nbytes))}, more than the memory budget of "
+    if not nbytes <= budget:
+        raise ValueError(f"{what} would take {_human(nbytes)}, more than the memory budget of "
                          f"{_human(budget)} (three quarters of the available memory, or "
                          f"ROUGHPATHS_MAX_BYTES); {fix}.")
 
