@@ -438,7 +438,7 @@ class ChaoticDriver(SeededDriver):
                 dl = scale * _observe(fm, self.observable, buf[:, :kk * m], d).reshape(P, kk, m, d)
                 g = np.cumsum(dl, axis=2) - 0.5 * dl          # Σ_{i<j} Δ_i + ½ Δ_j
                 inc[:, k0:k0 + kk] = dl.sum(axis=2)
-                area[:, k0:k0 + kk] = np.einsum("pkmi,pkmj->pkij", g, dl)
+                area[:, k0:k0 + kk] = np.swapaxes(g, -1, -2) @ dl     # Σ_j g_j ⊗ Δ_j
             return state, inc, area
         for k in range(n_steps_block):                        # each grid step in pieces, joined by Chen
             x, a = np.zeros((P, d)), np.zeros((P, d, d))
@@ -448,7 +448,7 @@ class ChaoticDriver(SeededDriver):
                 dl = scale * _observe(fm, self.observable, buf[:, :cc], d)
                 g = np.cumsum(dl, axis=1) - 0.5 * dl
                 xp = dl.sum(axis=1)
-                a += np.einsum("pmi,pmj->pij", g, dl) + x[:, :, None] * xp[:, None, :]
+                a += np.swapaxes(g, -1, -2) @ dl + x[:, :, None] * xp[:, None, :]
                 x += xp
             inc[:, k], area[:, k] = x, a
         return state, inc, area

@@ -18,14 +18,11 @@ so ``C^{ab}(m) = E[v^a_0 v^b_m]``: the **earlier** ``a``, the **later** ``b``.
    Korepanov, Melbourne and Zhang 2019): ``(W_n, Σ_{i<j} Δ_i⊗Δ_j) → (W, ∫ W ⊗ dW + E t)`` in law, ``W``
    Brownian with covariance ``Σ``, ``∫ W ⊗ dW`` the **Itô** area.
 3. *The piecewise-linear lift* that :class:`~roughpaths.drivers.chaotic.ChaoticDriver` gives adds
-   ``½ Σ_j Δ_j⊗Δ_j → ½ Σ_0 t`` (ergodic theorem). As ``XX^Strat = XX^Itô + ½ Σ t``, its limit is
-
-   .. math:: \mathbb{X}^{\text{Itô}} + (E + \tfrac12\Sigma_0) t = \mathbb{X}^{\text{Strat}} +
-             (E + \tfrac12\Sigma_0 - \tfrac12\Sigma) t = \mathbb{X}^{\text{Strat}} + \tfrac12 (E - E^T)\, t.
-
-   The symmetric parts cancel (the lift is geometric, so must its limit be): the limit is the
-   Stratonovich Brownian rough path **perturbed by** ``s = Alt(E) = ½(E − Eᵀ)``, the Lévy-area drift.
-   Its expected area rate is ``½ Σ + Alt(E)`` (:attr:`ChaoticLimit.area_rate`).
+   ``½ Σ_j Δ_j⊗Δ_j → ½ Σ_0 t`` (ergodic theorem). The Stratonovich area is the Itô area plus ``½ Σ t``, so
+   the lift tends to the Stratonovich area plus ``(E + ½Σ_0 − ½Σ) t = ½(E − Eᵀ) t``: the symmetric parts
+   cancel (the lift is geometric, so must its limit be), and the limit is the Stratonovich Brownian rough
+   path **perturbed by** ``s = Alt(E) = ½(E − Eᵀ)``, the Lévy-area drift. Its expected area rate is
+   ``½ Σ + Alt(E)`` (:attr:`ChaoticLimit.area_rate`).
 4. *Fast–slow systems* ``dx = a dt + b(x) dX`` (fields ``b_β``, Friz–Oberhauser: a perturbation ``K (t − s)``
    of the area is the drift ``Σ K^{βγ} Db_γ·b_β``):
 
@@ -344,12 +341,15 @@ class SineObservable:
         if c.shape != k.shape[:2]:
             raise ValueError(f"coefficients must have shape (d, R) = {k.shape[:2]}, got {c.shape}.")
         self.frequencies, self.coefficients = k.astype(np.int64), c
+        d, R = c.shape
+        self._freq = (2.0 * np.pi) * k.reshape(d * R, 2).T.astype(np.float64)     # (2, dR): phases by one matmul
+        self._weights = np.zeros((d * R, d))                                      # (dR, d): the sums over r
+        self._weights[np.arange(d * R), np.repeat(np.arange(d), R)] = c.ravel()
 
     def __call__(self, y) -> np.ndarray:
         """``v(y)``, ``y`` of shape ``(..., 2)`` to ``(..., d)``."""
         y = np.asarray(y, dtype=np.float64)
-        phase = np.einsum("...i,ari->...ar", y, self.frequencies.astype(np.float64))
-        return np.einsum("...ar,ar->...a", np.sin(2.0 * np.pi * phase), self.coefficients)
+        return np.sin(y @ self._freq) @ self._weights
 
     def correlations(self, max_lag: int, matrix=((2, 1), (1, 1))) -> np.ndarray:
         r"""``C(m) = ∫ v ⊗ v∘T^m dy`` for ``m = 0 … max_lag`` under ``y ↦ A y mod 1`` (exact, module docstring).
