@@ -88,9 +88,10 @@ def test_a_zip_bomb_is_refused_before_expanding(tmp_path, saved):
         rp.load(bomb)
 
 
-def test_declared_sizes_are_checked_against_the_budget(tmp_path, saved, monkeypatch):
-    _, path = saved
-    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", "100")
+def test_declared_sizes_are_checked_against_the_budget(tmp_path, monkeypatch):
+    X = rp.brownian_rough_path(np.linspace(0, 1, 200), 2, 0, batch_shape=(3,))   # ~30 kB of arrays
+    path = rp.save(X, tmp_path / "x.npz")
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", "10000")          # above the zip directory's ~5 kB estimate
     with pytest.raises(ValueError, match="the arrays of .*x.npz.*memory budget"):
         rp.load(path)
 
@@ -222,3 +223,36 @@ def test_open_npz_reads_what_the_headers_declare_and_refuses_other_expectations(
             npz.read("x")
     with pytest.raises(ValueError, match="is not a regular file"):
         open_npz("/dev/null")
+
+
+def test_the_zip_directory_is_held_to_the_budget_before_it_is_parsed(tmp_path, monkeypatch):
+    """``zipfile`` parses the whole directory into one object per entry before any entry can be checked, so its
+    size is estimated first (``_DIRECTORY_COST`` bytes per byte of directory) and held to the budget. The
+    estimate bounds what parsing a worst-case directory (10^4 entries with one-letter names) allocates."""
+    import tracemalloc
+
+    from roughpaths import _npz
+
+    many = tmp_path / "many.npz"
+    np.savez(many, **{f"a{i}": np.zeros(0) for i in range(2000)})
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))       # 2000 entries: ~0.1 MB of directory
+    with pytest.raises(ValueError, match=r"the zip directory of .*many.npz \(\d+ bytes.*memory budget"):
+        rp.load(many)
+    monkeypatch.delenv("ROUGHPATHS_MAX_BYTES")
+    with pytest.raises(ValueError, match="has no '__metadata__' entry"):
+        rp.load(many)                                             # within the budget: read, then refused as foreign
+
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        for i in range(10**4):
+            zf.writestr(f"{i:x}", b"")                           # names of 1 to 4 letters
+    zipfile.ZipFile(io.BytesIO(buf.getvalue()))                   # warm up zipfile's own structures
+    directory = _npz._directory_bytes(io.BytesIO(buf.getvalue()), len(buf.getvalue()))
+    assert 10**4 * 46 < directory < 10**4 * 60
+    tracemalloc.start()
+    try:
+        zipfile.ZipFile(io.BytesIO(buf.getvalue()))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < _npz._DIRECTORY_COST * directory, (peak, directory)
