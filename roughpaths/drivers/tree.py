@@ -68,7 +68,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..paths.rough_path import RoughPath
-from ..validation import as_float_array, check_batch_shape, check_positive_int, check_real
+from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_real
 from ._random import PathStreams
 from ._seeded import check_seed, selected_paths
 from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width
@@ -138,6 +138,10 @@ class BrownianTree:
         self.t0, self.t1 = check_real(t0, "t0"), check_real(t1, "t1")
         if not self.t1 > self.t0:
             raise ValueError(f"t1 must be greater than t0, got t0={t0!r}, t1={t1!r}.")
+        if not np.isfinite(self.t1 - self.t0):
+            raise ValueError(f"t1 - t0 overflows float64 (t0={t0!r}, t1={t1!r}): every node length and "
+                             f"increment would be inf or 0; use an interval of finite length (shift or rescale "
+                             f"time, e.g. t0=0).")
         self.batch_shape = check_batch_shape(batch_shape)
         if levy_area is None or levy_area == "none":
             raise ValueError("levy_area=None: the tree always carries Lévy areas (its splits are conditioned on "
@@ -152,16 +156,69 @@ class BrownianTree:
         self.resolution = check_positive_int(resolution, "resolution")
         if self.resolution > 62:
             raise ValueError(f"resolution must be at most 62 (grid indices are int64), got {resolution}.")
-        self.n_paths = int(np.prod(self.batch_shape, dtype=np.int64))
+        finest = (self.t1 - self.t0) / 2.0 ** (self.resolution + self.polygon_levels)
+        if not finest >= np.finfo(np.float64).tiny:
+            raise ValueError(f"the finest segment (t1 - t0) 2^-(resolution + polygon_levels) = {finest!r} underflows "
+                             f"float64 (t0={t0!r}, t1={t1!r}, resolution={self.resolution}); rescale time to a "
+                             f"longer interval or lower the resolution.")
+        self.n_paths = int(np.prod(self.batch_shape, dtype=object))
         n, d = 2 ** self.polygon_levels, self.dim
         self.node_bytes = max(1, self.n_paths) * 8 * (n * d + d * d)
+        user_cache = cache_size is not None
         if cache_size is None:
             cache_size = int(min(8192, _CACHE_BYTES // self.node_bytes))
         self.cache_size = check_positive_int(cache_size, "cache_size", minimum=0)
+        check_memory(self._setup_bytes(), f"the tree of {self.n_paths} path(s) in dim={d} (the path index, the "
+                     f"root's {n} segments and one split)", "use fewer paths (a smaller batch_shape) or split the "
+                     "batch into several trees (tree.select)")
+        if user_cache:
+            check_memory(float(self.cache_size) * self.node_bytes, f"cache_size={self.cache_size} nodes of "
+                         f"{self.node_bytes} bytes each (batch of {self.n_paths} path(s))",
+                         "pass a smaller cache_size, or leave it unset (64 MiB worth)")
         self._cache: OrderedDict = OrderedDict()
         self._root_node = None
         self._paths = np.arange(self.n_paths, dtype=np.int64)
         self._prefix = seed_prefix(self.seed_sequence)          # None: seed the splits' streams in numpy
+
+    # ------------------------------------------------------------------ sizes (checked before work)
+    def _setup_bytes(self) -> float:
+        """Bytes of the path index, the root's state and sampling, and one split: what any query needs first.
+
+        Per path (``n = 2^m`` segments, ``w`` normals per segment of the root's Lévy-area method): the index
+        and stream keys (48), the root's normals, polygon and areas (``8 (4 n d + 4 n d² + n w + 2 d²)``) and
+        a split's normals and outputs (``8 (split_width + 4 n d + 2 d²)`` plus its seeds, 100).
+        """
+        P, n, d = float(max(1, self.n_paths)), 2.0 ** self.polygon_levels, float(self.dim)
+        root = 8.0 * (4 * n * d + 4 * n * d * d + n * self._sampler.width + 2 * d * d)
+        split = 8.0 * (split_width(int(n), int(d)) + 4 * n * d + 2 * d * d) + 100.0
+        return P * (48.0 + root + split)
+
+    def _query_bytes(self, idx) -> float:
+        """Bytes a query on the grid indices ``idx`` allocates (the estimate :meth:`_cells` checks).
+
+        The outputs (``W``, ``A``, and three temporaries of ``A``'s size for :meth:`area` and
+        :meth:`rough_path`), the reduced canonical nodes of every cell (counted exactly: a cell ``[i, j)``
+        decomposes into ``popcount(k - i) + popcount(j - k)`` dyadic nodes, ``k`` the multiple of the highest
+        power of two in ``(i, j]``), and the splits it may keep: at most ``L`` per grid point, of which at most
+        ``cache_size / 2`` stay in the cache and ``L + 1`` more on the walk's stack, two nodes each. A grid
+        point ``g`` lies strictly inside ``L - tz(g)`` nodes (``tz``: its trailing zero bits), so a walk splits
+        at most the sum of those.
+        """
+        P, d, L = float(max(1, self.n_paths)), float(self.dim), self.resolution
+        cells = len(idx) - 1
+        nodes = 0
+        inside = 0
+        pts = idx.tolist()
+        for a, b in zip(pts[:-1], pts[1:]):
+            if b > a:
+                h = (a ^ b).bit_length() - 1
+                k = (b >> h) << h
+                nodes += (k - a).bit_count() + (b - k).bit_count()
+        for g in pts:
+            if 0 < g < 1 << L:
+                inside += L - ((g & -g).bit_length() - 1)
+        splits = min(float(inside), self.cache_size // 2 + L + 1.0)
+        return 8.0 * P * (d + d * d) * (4.0 * cells + nodes) + 2.0 * splits * self.node_bytes
 
     def __repr__(self) -> str:
         return (f"BrownianTree(dim={self.dim}, t0={self.t0}, t1={self.t1}, batch_shape={self.batch_shape}, "
@@ -315,6 +372,8 @@ class BrownianTree:
         """
         P, d, L = self.n_paths, self.dim, self.resolution
         n = idx.size - 1
+        check_memory(self._query_bytes(idx), f"a query of {n} interval(s) of the tree of {P} path(s) in dim={d}",
+                     "ask for fewer intervals at a time, or use fewer paths (tree.select)")
         if self._root_node is None:
             self._root_node = self._root()
         parts = [[] for _ in range(n)]
