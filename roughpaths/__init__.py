@@ -30,6 +30,7 @@ from .io import load, load_metadata, register_format, save
 from .norms import (area_holder_seminorm, area_p_variation, holder_distance, holder_seminorm, p_variation,
                     rough_path_holder_norm, rough_path_p_variation)
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
+from .progress import Progress, ProgressRecord, progress_reporter
 from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
                   NonFiniteStateError, PIController, Solution, Solver, VectorFields, central_jacobian, solve)
 from .signatures import (LinearKernel, MMDTestResult, RBFKernel, SignatureStream, basepoint,
@@ -43,6 +44,8 @@ __all__ = [
     "solve", "Solution", "NonFiniteStateError", "PIController", "Driver", "Solver", "Euler", "Heun", "Davie",
     "LogODE", "LogODE3", "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift",
     "central_jacobian", "rough_integral",
+    # progress and the time left of long work (the progress= option)
+    "ProgressRecord", "Progress", "progress_reporter",
     # coloured noise
     "coloured_noise_limit", "ColouredNoiseDriver", "ColouredNoiseLimit", "ColouredNoiseSample",
     "sample_coloured_noise", "iter_coloured_noise", "coloured_noise_limit_path", "paper_coloured_noise_matrices",

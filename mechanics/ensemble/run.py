@@ -43,7 +43,7 @@ from typing import Callable
 
 import numpy as np
 
-from roughpaths import BrownianDriver, solve
+from roughpaths import BrownianDriver, progress_reporter, solve
 from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_positive_real, check_work
 
 from ..integrators import CoadjointSolver, LieHeun
@@ -190,7 +190,7 @@ def _run_chunk(spec: _Spec, first: int, last: int):
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None, levy_area_error=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
                  chunk_size=1024, block_steps=None, executor=None, keep_final=False,
-                 checkpoint=None, keep_checkpoint=False, code_version=None) -> EnsembleResult:
+                 checkpoint=None, keep_checkpoint=False, code_version=None, progress=None) -> EnsembleResult:
     r"""Simulate ``n_paths`` independent Brownian-driven paths and return streaming statistics.
 
     Parameters
@@ -268,6 +268,13 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         reads, changes: a checkpoint written under another ``code_version`` is refused, one written under
         the same is resumed on your word. Required when the run refers to code outside the library,
         refused without ``checkpoint`` (it would have no effect).
+    progress : None, bool or callable
+        Report progress and the time left (:mod:`roughpaths.progress`): ``None``/``False`` silent (default),
+        ``True`` a bar on standard error (``tqdm`` if importable, else a plain line), a callable is called
+        with a :class:`roughpaths.ProgressRecord` ``(done, total, elapsed, eta)``. ``done`` counts paths of
+        ``total = n_paths`` and advances once per chunk, as the chunks are merged in path order (with an
+        executor, a slow first chunk holds back the report of later ones). A resumed run starts at the paths
+        of its checkpoint and estimates the time left from this run's rate. Never changes the numbers.
 
     Returns
     -------
@@ -352,26 +359,34 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         if state is not None:
             start, final, tavg, snaps, finals = state
     todo = bounds[start:]
+    report = progress_reporter(progress, n_paths, desc="run_ensemble", unit="paths",
+                               initial=bounds[start - 1][1] if start else 0)
     if executor is None:
         parts = (_run_chunk(spec, a, b) for a, b in todo)
     else:
         futures = [executor.submit(_run_chunk, spec, a, b) for a, b in todo]
         parts = (f.result() for f in futures)
-    for done, (fin, ta, sn, fs) in enumerate(parts, start + 1):   # in path order: fixed leaves, bitwise
-        if final is None:
-            p = fin.shape[-1]
-            final = LeafReducer(p)
-            tavg = LeafReducer(p) if ta is not None else None
-            snaps = [LeafReducer(p) for _ in sn]
-        final.add(fin)
-        if tavg is not None:
-            tavg.add(ta)
-        for red, values in zip(snaps, sn):
-            red.add(values)
-        if fs is not None:
-            finals.append(fs)
-        if checkpoint is not None:
-            _save_checkpoint(checkpoint, fingerprint, done, final, tavg, snaps, finals)
+    try:
+        for done, (fin, ta, sn, fs) in enumerate(parts, start + 1):   # in path order: fixed leaves, bitwise
+            if final is None:
+                p = fin.shape[-1]
+                final = LeafReducer(p)
+                tavg = LeafReducer(p) if ta is not None else None
+                snaps = [LeafReducer(p) for _ in sn]
+            final.add(fin)
+            if tavg is not None:
+                tavg.add(ta)
+            for red, values in zip(snaps, sn):
+                red.add(values)
+            if fs is not None:
+                finals.append(fs)
+            if checkpoint is not None:
+                _save_checkpoint(checkpoint, fingerprint, done, final, tavg, snaps, finals)
+            if report is not None:
+                report.update(bounds[done - 1][1])
+    finally:
+        if report is not None:
+            report.close()
     if checkpoint is not None and not keep_checkpoint:
         try:
             os.unlink(checkpoint)

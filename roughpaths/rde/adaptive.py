@@ -43,11 +43,13 @@ tree itself (see :mod:`roughpaths.drivers.tree`); the error estimate (of the rig
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time as _time
 
 import numpy as np
 
+from ..progress import progress_reporter
 from ..validation import check_memory, check_positive_int, check_positive_real
 from .base import Solver
 from .solution import NonFiniteStateError, Solution, _failure_message
@@ -146,8 +148,9 @@ def _whole_step(W, XX):
     return (W1 + W2)[..., None, :], XXw[..., None, :, :]
 
 
-def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_at, on_failure, batch):
-    """The adaptive loop of :func:`~roughpaths.solve` (arguments already checked there; ``y`` broadcast)."""
+def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_at, on_failure, batch, progress=None):
+    """The adaptive loop of :func:`~roughpaths.solve` (arguments already checked there; ``y`` broadcast).
+    ``progress`` reports the time reached, ``t - t0`` of ``t1 - t0``, after every accepted step."""
     if not isinstance(control, PIController):
         raise TypeError(f"step_control must be a roughpaths.PIController, got {type(control).__name__}; "
                         f"e.g. step_control=PIController(rtol=1e-3, atol=1e-6).")
@@ -195,7 +198,8 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
     r_prev, after_reject = 1.0, False
     t_start = _time.perf_counter()
     no_save = np.zeros(2, dtype=bool)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+    report = progress_reporter(progress, T, desc="solve (adaptive)", unit="time")
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"), (report or contextlib.nullcontext()):
         while i < end:
             if accepted + rejected >= control.max_steps:
                 raise ValueError(f"adaptive solve took {control.max_steps} attempts and reached t = "
@@ -246,6 +250,8 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
                                      f"so far, and growing)", "save fewer times (save_at='end' or an array of times)")
                 f = control._factor(r, r_prev, after_reject)
                 r_prev, after_reject = max(r, 1e-10), False
+                if report is not None:
+                    report.update(i * cell)        # exact: cell = T / 2^L, and end * cell == T
             else:
                 rejected += 1
                 f = control._factor(r, r_prev, True)

@@ -18,6 +18,7 @@ import numpy as np
 from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
 from ..drivers.base import Driver
 from ..drivers.tree import BrownianTree
+from ..progress import progress_reporter
 from ..paths.rough_path import RoughPath
 from ..paths.rough_path_n import RoughPathN
 from .adaptive import solve_adaptive
@@ -56,7 +57,7 @@ def _resolve_solver(solver) -> Solver:
 
 
 def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_failure="raise",
-          block_steps=None, executor=None, chunks=None, step_control=None) -> Solution:
+          block_steps=None, executor=None, chunks=None, step_control=None, progress=None) -> Solution:
     r"""Solve the RDE :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i`, :math:`Y_{t_0} = y_0`, on the driver's grid.
 
     Parameters
@@ -108,6 +109,14 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         batch (:mod:`roughpaths.rde.adaptive`; ``docs/adaptive-steps.md``). ``Solution.stats`` then holds
         ``accepted``, ``rejected`` and ``at_dt_min``. Fixed steps (``None``) need a grid: a
         ``RoughPath``, a ``Driver``, or ``tree.rough_path(times)``.
+    progress : None, bool or callable
+        Report progress and the time left (:mod:`roughpaths.progress`): ``None``/``False`` silent (default),
+        ``True`` a bar on standard error (``tqdm`` if importable, else a plain line), a callable is called
+        with a :class:`~roughpaths.ProgressRecord` ``(done, total, elapsed, eta)``. On a grid, ``done`` counts
+        steps of every member (``total = N × members``) and advances once per block of steps: per block of
+        a :class:`~roughpaths.Driver` (``block_steps``), per finished group with ``executor`` (in group
+        order), once at the end for a ``RoughPath`` (a single block). With adaptive steps, ``done`` is the
+        time reached, ``t - t0`` of ``total = t1 - t0``, once per accepted step. Never changes the numbers.
 
     Returns
     -------
@@ -165,7 +174,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
                          f"got a {type(driver).__name__}, whose grid is fixed. Build BrownianTree(dim, seed=...) "
                          f"or drop step_control.")
     if executor is not None:
-        return _solve_split(fields, driver, y0, solver, executor, chunks, drift=drift, save_at=save_at,
+        return _solve_split(fields, driver, y0, solver, executor, chunks, progress, drift=drift, save_at=save_at,
                             on_failure=on_failure, block_steps=block_steps)
     if not isinstance(driver, (RoughPath, RoughPathN, Driver, BrownianTree)):
         raise TypeError(f"driver must be a RoughPath, a RoughPathN, a Driver (e.g. roughpaths.BrownianDriver) or a "
@@ -193,7 +202,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
                             f"its own definition.")
         fields = fields.with_drift(drift)
     if step_control is not None:
-        return solve_adaptive(fields, driver, y, solver, step_control, save_at, on_failure, batch)
+        return solve_adaptive(fields, driver, y, solver, step_control, save_at, on_failure, batch, progress)
 
     times = np.asarray(driver.times)
     n = driver.n_steps
@@ -222,25 +231,32 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     blocks = driver.blocks(block_steps) if isinstance(driver, Driver) else (driver,)
     k0 = 0
     n_blocks = 0
+    report = progress_reporter(progress, n * members, desc="solve", unit="member-steps")
     t_start = _time.perf_counter()
-    for block in blocks:
-        kb = block.n_steps
-        save = save_mask[k0 + 1:k0 + kb + 1]
-        y, saved, first_bad = solver.integrate(fields, y, block.times, block.increments,
-                                               _higher_levels(block, level), save,
-                                               stop_on_failure=(on_failure == "raise"))
-        new_bad = (first_bad >= 0) & (failed_step < 0)
-        if new_bad.any():
-            failed_step[new_bad] = first_bad[new_bad] + k0
-            if on_failure == "raise":
-                msg, members, steps = _failure_message(failed_step, times, batch)
-                raise NonFiniteStateError(msg, members, steps)
-            y[failed_step >= 0] = np.nan
-        nsave = saved.shape[-2]
-        out[..., slot:slot + nsave, :] = saved
-        slot += nsave
-        k0 += kb
-        n_blocks += 1
+    try:
+        for block in blocks:
+            kb = block.n_steps
+            save = save_mask[k0 + 1:k0 + kb + 1]
+            y, saved, first_bad = solver.integrate(fields, y, block.times, block.increments,
+                                                   _higher_levels(block, level), save,
+                                                   stop_on_failure=(on_failure == "raise"))
+            new_bad = (first_bad >= 0) & (failed_step < 0)
+            if new_bad.any():
+                failed_step[new_bad] = first_bad[new_bad] + k0
+                if on_failure == "raise":
+                    msg, members, steps = _failure_message(failed_step, times, batch)
+                    raise NonFiniteStateError(msg, members, steps)
+                y[failed_step >= 0] = np.nan
+            nsave = saved.shape[-2]
+            out[..., slot:slot + nsave, :] = saved
+            slot += nsave
+            k0 += kb
+            n_blocks += 1
+            if report is not None:
+                report.update(k0 * members)
+    finally:
+        if report is not None:
+            report.close()
     if k0 != n:
         raise RuntimeError(f"the driver's blocks covered {k0} of its {n} steps; its blocks() is broken.")
     if on_failure == "mask" and (failed_step >= 0).any():
@@ -303,7 +319,7 @@ def _chunk_of(driver, batch, lo, hi):
     return driver.select(np.arange(lo, hi))
 
 
-def _solve_split(fields, driver, y0, solver, executor, chunks, **kw):
+def _solve_split(fields, driver, y0, solver, executor, chunks, progress, **kw):
     import os
 
     from ..validation import check_positive_int
@@ -320,14 +336,23 @@ def _solve_split(fields, driver, y0, solver, executor, chunks, **kw):
         fields = fields.with_drift(kw["drift"])
     kw["drift"] = None
     if members == 0:
-        return solve(fields, driver, y0, solver, **kw)
+        return solve(fields, driver, y0, solver, progress=progress, **kw)
     n_chunks = min(members, 4 * (os.cpu_count() or 1)) if chunks is None else check_positive_int(chunks, "chunks")
     bounds = np.linspace(0, members, min(n_chunks, members) + 1).round().astype(int)
     yflat = np.broadcast_to(y, batch + y.shape[-1:]).reshape((-1, y.shape[-1]))
     mode, kw["on_failure"] = kw["on_failure"], "mask"
+    report = progress_reporter(progress, driver.n_steps * members, desc="solve", unit="member-steps")
     futures = [executor.submit(solve, fields, _chunk_of(driver, batch, lo, hi), yflat[lo:hi], solver, **kw)
                for lo, hi in zip(bounds[:-1], bounds[1:])]
-    parts = [f.result() for f in futures]
+    parts = []
+    try:
+        for hi, f in zip(bounds[1:], futures):       # in group order: each finished group reports its members
+            parts.append(f.result())
+            if report is not None:
+                report.update(driver.n_steps * int(hi))
+    finally:
+        if report is not None:
+            report.close()
     states = np.concatenate([s.states for s in parts], axis=0).reshape(batch + parts[0].states.shape[-2:])
     failed = np.concatenate([s.failed_step for s in parts]).reshape(batch)
     if mode == "raise" and (failed >= 0).any():
