@@ -60,7 +60,7 @@ def check_chaos(ctx) -> CheckResult:
     v = roughpaths.SineObservable([[_K, _A @ _A @ _Q], [_A @ _K, _Q]], [[1.0, 0.5], [1.0, 1.0]])
     P = ctx.size("chaos.n_paths", tiny=300, default=6000, full=20000)
     n = ctx.size("chaos.n_steps", tiny=40, default=200, full=1000)
-    G, LG = max(16, min(256, P // 50)), max(16, min(512, P // 40))     # Green–Kubo orbits: cat map, Lorenz
+    G, LG = max(16, min(256, P // 50)), 8 * max(2, min(64, P // 320))  # Green–Kubo orbits: cat map, Lorenz (8 groups)
     LP, Ln = max(200, P // 3), 2 * n                                      # Lorenz fast–slow paths and steps
     C = v.correlations(8)
     E = C[1:].sum(axis=0)

@@ -267,8 +267,11 @@ def lorenz63_map(tau: float = 0.05, *, sigma: float = 10.0, rho: float = 28.0, b
         return u
 
     def sample(rng, P):
+        steps = int(math.ceil(spinup / tau))
+        check_work(float(P) * steps * substeps, f"the Lorenz-63 spin-up ({P} points x {steps} samples x {substeps} "
+                   f"RK4 steps)", "use a shorter spinup or a larger tau")
         u = 8.0 * rng.standard_normal((P, 3)) + np.array([0.0, 0.0, 25.0])
-        for _ in range(int(math.ceil(spinup / tau))):
+        for _ in range(steps):
             u = step(u)
         return u
 

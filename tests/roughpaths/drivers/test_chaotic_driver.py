@@ -214,5 +214,9 @@ def test_bad_input_is_refused_with_the_fix():
         ChaoticMap(3, lambda rng, P: None, dim=1)
     with pytest.raises(ValueError, match="diverged"):
         lorenz63_map(1.0, spinup=50.0).initial_states(np.random.default_rng(0), 2)
+    with pytest.raises(ValueError, match="spin-up"):
+        lorenz63_map(0.01, spinup=1e12).initial_states(np.random.default_rng(0), 2)
+    with pytest.raises(ValueError, match="memory budget"):
+        observable_orbits(cat_map(), _v, 10**7, seed=0, batch_shape=(10**6,))
     with pytest.raises(TypeError, match="seed must be an int"):
         ChaoticDriver(cat_map(), _v, 10, seed=np.random.default_rng(0), dt=0.1, n_steps=2)
