@@ -415,7 +415,13 @@ def streams_section(args) -> None:
         t0 = time.perf_counter()
         st.signature(s, t)
         t_query = time.perf_counter() - t0
-        stored = sum(level.nbytes for level in st._levels)
+        nodes, count = 0, -(-(n - 1) // block)          # the tree's nodes: ceil(n_blocks / 2**j) at level j
+        while True:
+            nodes += count
+            if count == 1:
+                break
+            count = -(-count // 2)
+        stored = nodes * rp.sigdim(d, m) * 8
         print(f"  block {block:>4}: build {t_build:.2f} s, stored {stored / 2**20:.1f} MiB, "
               f"{1e6 * t_query / s.size:.0f} us per query")
     t0 = time.perf_counter()
