@@ -113,7 +113,7 @@ def _lorenz_check(n, P, gk_orbits, gk_length, max_lag, seed):
 
 
 def test_lorenz_fast_slow_mean_matches_the_estimated_limit():
-    est, (z, wrong) = _lorenz_check(n=400, P=1000, gk_orbits=64, gk_length=6000, max_lag=200, seed=31)
+    est, (z, wrong) = _lorenz_check(n=400, P=1000, gk_orbits=64, gk_length=8000, max_lag=200, seed=31)
     assert z < 4, z
     assert wrong[1] > 6, wrong                      # Itô without E is far off
     assert abs(est.E[0, 1] - est.E[1, 0]) > 6 * max(est.E_se[0, 1], est.E_se[1, 0])   # Alt(E) ≠ 0, measured
@@ -121,6 +121,9 @@ def test_lorenz_fast_slow_mean_matches_the_estimated_limit():
 
 @pytest.mark.slow
 def test_lorenz_fast_slow_mean_matches_the_estimated_limit_long():
-    est, (z, wrong) = _lorenz_check(n=2000, P=8000, gk_orbits=512, gk_length=12000, max_lag=200, seed=32)
+    # sized so that the expected distance to "Stratonovich without the area" is ~10 combined SE (measured 6.8 at
+    # half these sizes): Lorenz orbits, unlike the cat map's, depend on the CPU's rounding, so the margin must hold
+    # for any draw
+    est, (z, wrong) = _lorenz_check(n=2000, P=16000, gk_orbits=1024, gk_length=12000, max_lag=200, seed=32)
     assert z < 4, z
     assert min(wrong) > 6, wrong                    # and Stratonovich without the area is rejected too
