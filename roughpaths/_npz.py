@@ -141,7 +141,11 @@ class NpzReader:
         declared_shape, declared_dtype = self.entries[name]
         try:
             with self._zip.open(self._infos[name]) as fh:
-                header = _read_npy_header(fh)
+                try:
+                    header = _read_npy_header(fh)
+                except (ValueError, SyntaxError) as exc:
+                    raise self.refuse(f"the header of {name!r} became unreadable while the file was read "
+                                      f"({exc})") from None
                 if header[:2] != (declared_shape, declared_dtype):
                     raise self.refuse(f"the header of {name!r} changed while the file was read")
                 fortran = header[2]
@@ -188,7 +192,8 @@ def _read_npy_header(fh):
 def open_npz(path, *, fix: str = _FIX, what: str = "the arrays") -> NpzReader:
     """Open an ``.npz`` file as untrusted input: the one reader of every file the library opens.
 
-    :func:`load`, :func:`load_metadata` and ``mechanics``' ensemble checkpoints read through it. Before
+    :func:`roughpaths.load`, :func:`roughpaths.load_metadata` and ``mechanics``' ensemble checkpoints
+    read through it. Before
     any array is read it checks that ``path`` is a regular file (opened without blocking, then
     ``fstat``: a named pipe, a device or a folder is refused, never waited on), that it is a zip
     archive of ``.npy`` entries (no pickled objects, no duplicate or foreign entries), that every
