@@ -7,6 +7,13 @@ turns them into ``report.md`` (figures linked), ``report.html`` (figures embedde
 external resources) and ``results.json`` (the same results, machine-readable), with the run's
 metadata (the command that reproduces it, seed, convention, Lévy-area sampler, sizes, versions).
 
+In ``report.html`` the formulas written in the claims, notes and captions (``XX_{s,t}``, ``σ²``,
+``Ad*_{exp σ_n}``) are found (:mod:`._html_math`) and typeset by KaTeX, embedded whole from the copy
+``tools/vendor_katex.sh`` puts in the source tree (:mod:`._html_katex`), so the page still opens
+offline as one file. Where that copy is missing (``./run.sh`` installs the Python dependencies only)
+the formulas are plain HTML with sub- and superscripts and the page says so; raw TeX is never shown.
+``report.md`` keeps the claims as the checks write them.
+
 The three files depend only on the results and the options, never on the clock or the output
 folder's name: the same run gives the same bytes (wall times and dates are in ``manifest.json``).
 """
@@ -16,6 +23,7 @@ from __future__ import annotations
 import base64
 import html
 import json
+import os
 import platform
 import sys
 from dataclasses import asdict, dataclass, field
@@ -26,6 +34,9 @@ import numpy as np
 
 import mechanics
 import roughpaths
+
+from ._html_katex import KATEX_DIR, KatexUnavailable, load_katex
+from ._html_math import markup
 
 __all__ = [
     "CheckResult", "FigureResult", "RunMetadata", "format_value", "write_report", "versions",
@@ -275,64 +286,114 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
 
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1150px;margin:2em auto;
-padding:0 1em;color:#222;line-height:1.45}
+padding:0 1em;color:#222;line-height:1.45;overflow-wrap:break-word}
 table{border-collapse:collapse;margin:1em 0;font-size:0.92em}th,td{border:1px solid #ccc;padding:4px 8px;
-vertical-align:top}th{background:#f2f2f2}td.pass{background:#e3f6e3;font-weight:bold}
+vertical-align:top}th{background:#f2f2f2}td.name,td.pass,td.FAIL,td.error{white-space:nowrap}
+td.pass{background:#e3f6e3;font-weight:bold}
 td.FAIL{background:#fbe0e0;font-weight:bold}td.error{background:#fbe0e0}
-figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}figcaption{font-size:0.92em;color:#444}
-code,pre{background:#f6f6f6;padding:1px 3px}pre{padding:6px;overflow-x:auto;font-size:0.85em}
-.summary{font-size:1.1em}
+figure{margin:1.5em 0}figure img{max-width:100%;box-sizing:border-box;border:1px solid #ddd}figcaption{font-size:0.92em;color:#444}
+code,pre{background:#f6f6f6;padding:1px 3px}pre{padding:6px;font-size:0.85em}
+pre,.details{white-space:pre-wrap;overflow-wrap:anywhere}.details{font-size:0.92em;margin:0.2em 0 0.8em}
+.katex{font-size:1.08em}.summary{font-size:1.1em}.note{color:#555;font-size:0.92em}
 """
 
+#: typesets every formula span (class ``arithmatex``, KaTeX source in ``data-tex``) once KaTeX is loaded; a
+#: formula KaTeX cannot parse keeps its plain-HTML form, is marked ``katex-failed`` and reported on the console
+_TYPESET_SCRIPT = """(function () {
+  "use strict";
+  document.querySelectorAll(".arithmatex[data-tex]").forEach(function (el) {
+    var tex = el.getAttribute("data-tex");
+    try {
+      katex.render(tex, el, { throwOnError: true, strict: "ignore" });
+    } catch (err) {
+      console.error("KaTeX could not typeset " + JSON.stringify(tex) + ": " + err.message);
+      el.classList.add("katex-failed");
+    }
+  });
+})();"""
 
-def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult], read_file) -> str:
-    """A self-contained HTML page (figures embedded as base64 PNG; ``read_file(name) -> bytes``)."""
+
+def _formula_note(katex, reason: str | None) -> str:
+    if katex is not None:
+        return (f"Formulas are typeset by KaTeX {katex.version} (embedded: the page needs no network); where "
+                f"JavaScript is off they are shown as plain text with sub- and superscripts.")
+    return (f"Formulas are shown as plain text with sub- and superscripts: {reason}. Run tools/vendor_katex.sh "
+            f"(or ./test.sh) in the source tree before the main job to have them typeset.")
+
+
+def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult], read_file,
+                katex_dir: str | os.PathLike | None = KATEX_DIR) -> str:
+    """A self-contained HTML page (figures embedded as base64 PNG; ``read_file(name) -> bytes``).
+
+    The formulas in the claims, notes and captions are found by :func:`~._html_math.markup` and
+    typeset by KaTeX, embedded whole (script, style sheet, fonts as ``data:`` URIs) from ``katex_dir``
+    (default: where ``tools/vendor_katex.sh`` vendors it in the source tree). Without KaTeX
+    (``katex_dir=None``, or a folder :func:`~._html_katex.load_katex` refuses) they are plain HTML with
+    ``<sub>``/``<sup>``, and the page says why. Either way no raw TeX (``_{``, ``^{``) is shown.
+    """
     e = html.escape
+    katex, reason = None, "the report was written without KaTeX"
+    if katex_dir is not None:
+        try:
+            katex = load_katex(katex_dir)
+        except KatexUnavailable as exc:
+            reason = str(exc)
+
+    def m(text) -> str:
+        return markup(str(text), typeset=katex is not None)
+
     counts = _summary(checks)
-    parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        "<title>Verification report: Lévy area correction</title>",
+    head = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+            "<meta name='viewport' content='width=device-width, initial-scale=1'>",
+            "<title>Verification report: Lévy area correction</title>"]
+    if katex is not None:
+        head.append(f"<style>/* KaTeX {katex.version}\n{katex.licence}\n*/\n{katex.css}</style>")
+    parts = head + [
         f"<style>{_CSS}</style></head><body>",
         "<h1>Verification report: <i>Variational Principles on Geometric Rough Paths and the Lévy Area "
         "Correction</i></h1>",
         f"<p>Convention: <b>{e(meta.convention)}</b> ({e(_CONVENTION_TEXT.get(meta.convention, ''))}) · seed "
         f"<b>{meta.seed}</b> · sizes <b>{e(meta.scale)}</b></p>",
-        f"<p>Lévy areas: <b>{e(meta.levy_area)}</b> ({e(_LEVY_AREA_TEXT.get(meta.levy_area, meta.levy_area))}). "
-        f"{e(_LEVY_AREA_NOTE)}</p>",
+        f"<p>Lévy areas: <b>{e(meta.levy_area)}</b> ({m(_LEVY_AREA_TEXT.get(meta.levy_area, meta.levy_area))}). "
+        f"{m(_LEVY_AREA_NOTE)}</p>",
         f"<p class='summary'>Checks: <b>{counts[PASS]} passed</b>, {counts[FAIL]} failed, "
         f"{counts[ERROR]} errors.</p>",
-        f"<p>{e(_CONVENTION_NOTE)}</p>",
+        f"<p>{m(_CONVENTION_NOTE)}</p>",
+        f"<p class='note'>{e(_formula_note(katex, reason))}</p>",
         "<h2>Theorem and proposition checks</h2>",
         "<table><tr><th>check</th><th>claim</th><th>predicted</th><th>measured</th><th>tolerance</th>"
         "<th>result</th></tr>",
     ]
     for c in checks:
         parts.append(
-            f"<tr><td><code>{e(c.name)}</code></td><td>{e(c.statement)}</td>"
-            f"<td>{e(format_value(c.predicted))}</td><td>{e(format_value(c.measured))}</td>"
-            f"<td>{e(c.tolerance)}</td><td class='{e(c.status)}'>{e(c.status)}</td></tr>"
+            f"<tr><td class='name'><code>{e(c.name)}</code></td><td>{m(c.statement)}</td>"
+            f"<td>{m(format_value(c.predicted))}</td><td>{m(format_value(c.measured))}</td>"
+            f"<td>{m(c.tolerance)}</td><td class='{e(c.status)}'>{e(c.status)}</td></tr>"
         )
     parts.append("</table>")
     notes = [c for c in checks if c.details]
     if notes:
         parts.append("<h3>Details</h3><ul>")
         for c in notes:
-            parts.append(f"<li><code>{e(c.name)}</code>: <pre>{e(c.details.strip())}</pre></li>")
+            # a traceback is shown as it is; notes are prose with formulas, wrapped (no horizontal scrolling)
+            body = (f"<pre>{e(c.details.strip())}</pre>" if c.status == ERROR
+                    else f"<div class='details'>{m(c.details.strip())}</div>")
+            parts.append(f"<li><code>{e(c.name)}</code>: {body}</li>")
         parts.append("</ul>")
     parts.append("<h2>Figures</h2>")
     for f in figures:
-        parts.append(f"<figure id='{e(f.name)}'><h3>{e(f.title)} (<code>{e(f.name)}</code>)</h3>")
+        parts.append(f"<figure id='{e(f.name)}'><h3>{m(f.title)} (<code>{e(f.name)}</code>)</h3>")
         if f.png is not None and f.status == PASS:
             data = base64.b64encode(read_file(f.png)).decode("ascii")
             parts.append(f"<img alt='{e(f.title)}' src='data:image/png;base64,{data}'>")
         else:
             parts.append(f"<p><b>{e(f.status)}</b></p><pre>{e(f.details.strip())}</pre>")
-        parts.append(f"<figcaption>{e(f.caption)}</figcaption></figure>")
+        parts.append(f"<figcaption>{m(f.caption)}</figcaption></figure>")
     parts += ["<h2>Run metadata</h2><table>",
               f"<tr><th>command</th><td><code>{e(meta.command)}</code></td></tr>",
               f"<tr><th>seed</th><td>{meta.seed}</td></tr>",
               f"<tr><th>convention</th><td>{e(meta.convention)}</td></tr>",
-              f"<tr><th>Lévy areas</th><td>{e(levy_area_text(meta.levy_area))}</td></tr>",
+              f"<tr><th>Lévy areas</th><td>{m(levy_area_text(meta.levy_area))}</td></tr>",
               f"<tr><th>sizes</th><td>{e(meta.scale)}</td></tr></table>",
               f"<p>{e(_TIMING_NOTE)}</p>"]
     if meta.sizes:
@@ -342,6 +403,9 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
     parts.append("<table><tr><th>package</th><th>version</th></tr>")
     parts += [f"<tr><td>{e(k)}</td><td>{e(str(v))}</td></tr>" for k, v in meta.versions.items()]
     parts.append("</table>")
+    if katex is not None:
+        parts.append(f"<script>/*! KaTeX {katex.version}\n{katex.licence}\n*/\n{katex.script}</script>")
+        parts.append(f"<script>{_TYPESET_SCRIPT}</script>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
 
