@@ -27,8 +27,8 @@ import roughpaths
 
 from .model import INERTIA, PI0, SIGMA, THETA, hemisphere_mean, paper_body, s_label, s_matrix
 from .plotting import (
-    AXIS_LABELS,
     new_figure,
+    plot_components,
     plot_density,
     plot_projected_trajectory,
     plot_sphere_portrait,
@@ -107,14 +107,21 @@ def fig1(ctx) -> FigureResult:
     xy = traj[keep][:, :2]
     mean_pred = hemisphere_mean(g, 1.0)
     fig = new_figure(figsize=(18, 5.8), layout="constrained")
-    ax3 = fig.add_subplot(1, 3, 1, projection="3d")
-    lc = plot_trajectory_3d(ax3, traj, start=PI0, times=times, title="trajectory on the sphere |Π| = 1")
-    cb = fig.colorbar(lc, ax=ax3, fraction=0.035, pad=0.12, orientation="horizontal")
-    cb.set_label("time t")
+    # the middle panel is as wide as its data are (equal scales on both axes): no empty half panel
+    span = np.ptp(traj[:, :2], axis=0) + 1e-12
+    gs = fig.add_gridspec(1, 3, width_ratios=(1.0, float(np.clip(span[0] / span[1], 0.45, 1.6)), 1.15))
+    ax3 = fig.add_subplot(gs[0], projection="3d")
+    lc3 = plot_trajectory_3d(ax3, traj, start=PI0, times=times, title="trajectory on the sphere |Π| = 1")
     ax3.view_init(elev=28, azim=-55)
-    plot_projected_trajectory(fig.add_subplot(1, 3, 2), traj, times, start=PI0,
-                              title="the same trajectory projected on (Π₁, Π₂)")
-    ax = fig.add_subplot(1, 3, 3)
+    ax2 = fig.add_subplot(gs[1])
+    lc2 = plot_projected_trajectory(ax2, traj, times, start=PI0, colorbar=False,
+                                    title="the same trajectory projected on (Π₁, Π₂)")
+    # one time scale for both trajectory panels; its colour bar right beside the sphere, between the two
+    for lc in (lc3, lc2):
+        lc.set_clim(times[0], times[-1])
+    cb = fig.colorbar(lc3, ax=ax3, location="right", fraction=0.04, pad=0.08, shrink=0.7)  # pad: clears the Π₃ axis
+    cb.set_label("time t (left and middle panels)")
+    ax = fig.add_subplot(gs[2])
     H, pred, edges = plot_density(
         ax, xy, bins=70, extent=_extent((0.0, 0.0)), density_fn=g.density, hemisphere=1.0, start=PI0[:2],
         marks=[((mean_pred[0], mean_pred[1]), dict(marker="x", color="cyan", ms=9, mew=2), "Gibbs mean"),
@@ -273,27 +280,26 @@ def _near_e2(traj, times, T):
     return float(np.mean(np.abs(traj[keep, 1]) > 0.9))
 
 
+#: the (Π₁, Π₃) density panels of Figures 4 and 5 reach a little beyond the unit disk, so that the marker of
+#: Π(0) = e₃, on its edge, is drawn whole
+_WZ_EXTENT = ((-1.1, 1.1), (-1.1, 1.1))
+
+
 def _wz_row(fig, gs_row, traj, times, T, label):
     ax3 = fig.add_subplot(gs_row[0], projection="3d")
     plot_trajectory_3d(ax3, traj, start=PI0, times=times, title=f"{label}: trajectory")
     ax3.view_init(elev=20, azim=-60)
-    ax = fig.add_subplot(gs_row[1])
-    step = max(len(times) // 20_000, 1)
-    for k, col in enumerate(("tab:blue", "tab:orange", "tab:green")):
-        ax.plot(times[::step], traj[::step, k], color=col, lw=0.6, label=AXIS_LABELS[k])
-    ax.set_xlabel("time t")
-    ax.set_ylabel("components of Π")
-    ax.set_ylim(-1.05, 1.05)
-    ax.legend(loc="lower right", fontsize=8, ncol=3)
     frac = _near_e2(traj, times, T)
-    ax.set_title(f"{label}: fraction of t ≥ T/2 with |Π₂| > 0.9: {frac:.2f}", fontsize=9)
+    plot_components(fig.add_subplot(gs_row[1]), times, traj,
+                    title=f"{label}: fraction of t ≥ T/2 with |Π₂| > 0.9: {frac:.2f}")
     axd = fig.add_subplot(gs_row[2])
     keep = times >= 0.1 * T
-    H, _, _ = plot_density(axd, traj[keep][:, [0, 2]], bins=60, extent=((-1, 1), (-1, 1)), axes=(0, 2),
-                           start=PI0[[0, 2]], marks=[((0.0, 0.0), dict(marker="D", mfc="none", mec="cyan", ms=8,
-                                                                         mew=1.5), "±e₂ (projected)")],
-                           title=f"{label}: density of (Π₁, Π₃), t ≥ T/10")
-    return H, frac
+    H, _, edges = plot_density(axd, traj[keep][:, [0, 2]], bins=66, extent=_WZ_EXTENT, axes=(0, 2),
+                               start=PI0[[0, 2]], legend="below",
+                               marks=[((0.0, 0.0), dict(marker="D", mfc="none", mec="cyan", ms=8, mew=1.5),
+                                       "±e₂ (projected)")],
+                               title=f"{label}: density of (Π₁, Π₃), t ≥ T/10")
+    return H, edges, frac
 
 
 @register("fig4", "Figure 4: the rigid body driven by coloured (OU) noise, no added drift",
@@ -307,12 +313,13 @@ def fig4(ctx) -> FigureResult:
     res, T = run["res"], run["T"]
     fig = new_figure(figsize=(18, 5.6), layout="constrained")
     gs = fig.add_gridspec(1, 3)
-    H, frac = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["coloured"].states[0], res["coloured"].times, T,
-                      f"coloured, ε = {run['eps']:g}")
+    H, edges, frac = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["coloured"].states[0], res["coloured"].times,
+                             T, f"coloured, ε = {run['eps']:g}")
     fig.suptitle(f"Figure 4: coloured noise, k = {K_PAPER:g}, ε = {run['eps']:g}, T = {T:g}, step h = {res['coloured'].stats['h']:.3g}",
                  fontsize=11)
     return _result(ctx, "fig4", fig, dict(times=res["coloured"].times, coloured=res["coloured"].states[0], eps=run["eps"], T=T,
                                             h=res["coloured"].stats["h"], A=run["A"], D=run["D"], density=H,
+                                            density_x_edges=edges[0], density_y_edges=edges[1],
                                             fraction_near_e2=frac))
 
 
@@ -329,11 +336,14 @@ def fig5(ctx) -> FigureResult:
     fig = new_figure(figsize=(18, 11), layout="constrained")
     gs = fig.add_gridspec(2, 3)
     c = run["wz"].torque
-    H1, f1 = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["limit"].states[0], res["limit"].times, T, "limit with torque")
-    H2, f2 = _wz_row(fig, [gs[1, 0], gs[1, 1], gs[1, 2]], res["no_torque"].states[0], res["no_torque"].times, T, "limit, no torque")
+    H1, edges, f1 = _wz_row(fig, [gs[0, 0], gs[0, 1], gs[0, 2]], res["limit"].states[0], res["limit"].times, T,
+                            "limit with torque")
+    H2, _, f2 = _wz_row(fig, [gs[1, 0], gs[1, 1], gs[1, 2]], res["no_torque"].states[0], res["no_torque"].times, T,
+                        "limit, no torque")
     fig.suptitle(f"Figure 5: white-noise limit, noise σA⁻¹D, torque c = ({', '.join(f'{v + 0.0:+.4g}' for v in c)}), "
                  f"N¹³ = {run['wz'].limit.N[0, 2]:.4g}, T = {T:g}", fontsize=11)
     return _result(ctx, "fig5", fig, dict(times=res["limit"].times, limit=res["limit"].states[0], no_torque=res["no_torque"].states[0],
                                             srblevy=res["srblevy"].states[0], torque=c, N=run["wz"].limit.N,
                                             limit_xi=run["wz"].limit_xi, density_limit=H1, density_no_torque=H2,
+                                            density_x_edges=edges[0], density_y_edges=edges[1],
                                             fraction_near_e2_limit=f1, fraction_near_e2_no_torque=f2))

@@ -7,7 +7,8 @@ works with any simulation, not only the library's. Figures are built with :func:
 :mod:`.figure`, :mod:`.sphere`, :mod:`.density`, :mod:`.trajectory`; every name is importable from here.
 
 * :func:`plot_trajectory_3d`, :func:`plot_projected_trajectory`: a trajectory on the sphere, in 3D
-  and projected on a coordinate plane, coloured by time;
+  and projected on a coordinate plane, coloured by time; :func:`plot_components`: its components
+  against time;
 * :func:`plot_density`: the time-density of a projected trajectory with the contours of a
   predicted density overlaid (the paper's Gibbs measure ``∝ exp(−2θh̃/σ²)``), binned the same way
   by :func:`projected_density`;
@@ -37,9 +38,9 @@ from __future__ import annotations
 from .density import plot_density, projected_density
 from .figure import AXIS_LABELS, new_figure
 from .sphere import orthographic_basis, plot_sphere_portrait, project, sphere_image
-from .trajectory import plot_projected_trajectory, plot_trajectory_3d
+from .trajectory import plot_components, plot_projected_trajectory, plot_trajectory_3d
 
 __all__ = [
     "AXIS_LABELS", "new_figure", "orthographic_basis", "sphere_image", "project", "projected_density",
-    "plot_sphere_portrait", "plot_density", "plot_trajectory_3d", "plot_projected_trajectory",
+    "plot_sphere_portrait", "plot_density", "plot_trajectory_3d", "plot_projected_trajectory", "plot_components",
 ]

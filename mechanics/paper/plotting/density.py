@@ -77,7 +77,7 @@ def _hemisphere_values(density_fn, X, Y, axes, other, hemisphere):
 
 
 def plot_density(ax, xy, *, bins, extent, density_fn=None, hemisphere=None, axes=(0, 1), start=None, marks=(),
-                 title="", cmap="magma", colorbar=True):
+                 title="", cmap="magma", colorbar=True, legend="upper left"):
     """Time-density of a projected trajectory, with a predicted density's contours overlaid.
 
     Parameters
@@ -105,6 +105,9 @@ def plot_density(ax, xy, *, bins, extent, density_fn=None, hemisphere=None, axes
     title, cmap : str
     colorbar : bool
         Add a colour bar to ``ax.figure``.
+    legend : str or None
+        Where the legend goes: a location inside the panel as matplotlib names them
+        (``"upper left"``, ...), ``"below"`` (under the panel, one row: it covers nothing), or None.
 
     Returns
     -------
@@ -146,6 +149,12 @@ def plot_density(ax, xy, *, bins, extent, density_fn=None, hemisphere=None, axes
     ax.set_ylabel(AXIS_LABELS[axes[1]])
     if title:
         ax.set_title(title, fontsize=10)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="upper left", fontsize=7, framealpha=0.7)
+    if legend is not None and not isinstance(legend, str):
+        raise TypeError(f"legend must be a location string, 'below' or None, got {type(legend).__name__}.")
+    handles = ax.get_legend_handles_labels()[0]
+    if handles and legend == "below":
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.11), fontsize=7, ncol=len(handles), frameon=False,
+                  borderaxespad=0.0, columnspacing=1.2, handletextpad=0.4)
+    elif handles and legend is not None:
+        ax.legend(loc=legend, fontsize=7, framealpha=0.7)
     return H, pred, (xe, ye)
