@@ -238,8 +238,8 @@ def green_kubo(values, max_lag: int) -> GreenKuboEstimate:
     over ``√P`` (orbits from independent initial points are independent). *Bias*: from a stationary start
     each product has mean ``C(m)``, so ``E[Ê] = Σ_{m≤M} C(m)`` exactly: the bias is the truncation
     ``−Σ_{m>M} C(m)`` alone (zero when the correlations vanish beyond ``M``, as in the cat-map example);
-    :attr:`GreenKuboEstimate.tail` shows whether it is negligible. A sample mean further than 6 standard
-    errors from 0 is refused: the observable must be centred.
+    :attr:`GreenKuboEstimate.tail` shows whether it is negligible. A sample mean that differs from 0 at the
+    two-sided level 10⁻⁶ (Student's t over the ``P`` orbit means) is refused: the observable must be centred.
 
     Examples
     --------
@@ -264,12 +264,16 @@ def green_kubo(values, max_lag: int) -> GreenKuboEstimate:
                          f"orbits or a smaller max_lag.")
     mean_p = v.mean(axis=1)
     mean, mean_se = mean_p.mean(axis=0), mean_p.std(axis=0, ddof=1) / np.sqrt(P)
-    off = np.abs(mean) > 6.0 * mean_se
+    from scipy.stats import t as student_t                        # (lazy: scipy.stats is slow to import)
+
+    crit = float(student_t.isf(0.5e-6, P - 1))                   # two-sided level 1e-6, P − 1 degrees of freedom
+    off = np.abs(mean) > crit * mean_se
     if np.any(off):
         a = int(np.argmax(off))
-        raise ValueError(f"values[..., {a}] has sample mean {mean[a]:.4g} ± {mean_se[a]:.2g} (standard error): not "
-                         f"centred. The Green–Kubo sums need ∫ v dμ = 0; subtract the observable's mean under the "
-                         f"invariant measure.")
+        raise ValueError(f"values[..., {a}] has sample mean {mean[a]:.4g} ± {mean_se[a]:.2g} (standard error over {P} "
+                         f"orbits): not centred (beyond {crit:.3g} standard errors, the two-sided 1e-6 level of "
+                         f"Student's t with {P - 1} degrees of freedom). The Green–Kubo sums need ∫ v dμ = 0; "
+                         f"subtract the observable's mean under the invariant measure.")
     nfft = _fast_len(L + M)
     per_orbit = 16.0 * (nfft // 2 + 1) * (d + d * d) + 8.0 * nfft * d * d
     check_memory(per_orbit, "the FFT workspace of one orbit", "use shorter orbits")

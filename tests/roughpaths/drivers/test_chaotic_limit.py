@@ -65,6 +65,20 @@ def test_green_kubo_moving_average_closed_form_and_calibrated_errors():
     assert 0.75 < z.std() < 1.3, z.std()
 
 
+def test_centring_check_is_calibrated_for_few_orbits():
+    """A centred observable is never refused, whatever the number of orbits: with 2 orbits the mean over its
+    standard error is Student-t with 1 degree of freedom (beyond 6 about 10 % of the time; a fixed 6-SE rule
+    refused the Lorenz groups of the main job's tiny run)."""
+    rng = np.random.default_rng(9)
+    ratios = []
+    for _ in range(300):
+        v = rng.standard_normal((2, 200, 1))
+        m = v.mean(axis=1)[:, 0]
+        ratios.append(abs(m.mean()) / (m.std(ddof=1) / math.sqrt(2)))
+        green_kubo(v, 3)                                              # never refused
+    assert np.mean(np.array(ratios) > 6) > 0.03                       # the old rule would have refused these
+
+
 def test_green_kubo_on_the_cat_map_matches_the_closed_form():
     C = EXAMPLE.correlations(8)
     E, S = C[1:].sum(axis=0), C[0] + 2 * 0.0 + C[1:].sum(axis=0) + C[1:].sum(axis=0).T
