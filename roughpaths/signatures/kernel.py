@@ -17,6 +17,18 @@ discretisation error falls like ``4**-dyadic_order`` (measured: ``docs/signature
 ``static_kernel`` is ``None`` (linear, ``<dx, dy>``), :class:`~roughpaths.LinearKernel` or
 :class:`~roughpaths.RBFKernel`. Each pair's value is computed by the same instructions whatever the
 batch and the thread count (bitwise: tested).
+
+Overflow. The signature's level ``k`` has norm at most ``L**k / k!`` (``L`` the path's length in the static
+kernel's feature space), so ``|k(x, y)| <= I0(2 sqrt(Lx Ly)) <= exp(2 sqrt(Lx Ly))``: paths of length
+about 20 already give kernels near ``1e100`` (the probe: Brownian paths scaled by 10 gave ``inf``, by 20
+``nan``). Every value of the PDE grid is the kernel of two sub-paths, and an ``inf`` anywhere reaches the
+result (``inf`` or ``inf - inf = nan``), so a non-finite kernel or gradient is detected after the sweep and
+refused with a ``ValueError`` naming the pair, ``Lx``, ``Ly`` and a ``LinearKernel`` scale that brings
+``Lx Ly`` below ``1.2e5`` (kernels below about ``1e300``). Every finite result is returned as before.
+Rescaling the grid would not gain a usable answer: a result beyond ``1.8e308`` has no float64 value, and
+a result far below an overflowing grid value would be a difference of such numbers with no correct
+digit. A static kernel whose scale itself overflows (``RBFKernel(1e-310)``: ``1/sigma = inf``) or scales
+the paths beyond float64 (``RBFKernel(1e-308)`` on ``|x| > 1.8``) is refused before the sweep.
 """
 
 from __future__ import annotations
