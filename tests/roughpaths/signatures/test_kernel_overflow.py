@@ -80,12 +80,13 @@ def test_static_kernel_scales_that_overflow_the_paths_are_refused():
 
 
 def test_mmd_statistics_that_overflow_are_refused():
-    # every kernel is finite (above 1e307) but the sum of the four cross kernels is not
-    X = 100.0 * np.stack([_monotone(0, 30)] * 4)
+    # every kernel is finite (5e307 to 1e308) but the sum of the nine cross kernels is not
+    X = 100.0 * np.stack([_monotone(0, 30)] * 6)
     s = 1.0
-    while rp.signature_kernel(s * X[0], s * X[1]) < 1e307:
-        s *= 1.01
+    for step, target in ((1.01, 1e306), (1.002, 5e307)):     # k grows ~9.5x per 1 %, ~1.6x per 0.2 %
+        while rp.signature_kernel(s * X[0], s * X[1]) < target:
+            s *= step
     K = rp.signature_kernel_gram(s * X, s * X)
-    assert np.all(np.isfinite(K)) and K.min() > 1e307
+    assert np.all(np.isfinite(K)) and 5e307 <= K.min() and K.max() < 1e308
     with pytest.raises(ValueError, match="MMD statistics overflow"):
-        rp.sig_mmd_test(s * X[:2], s * X[2:], seed=0, n_permutations=9)
+        rp.sig_mmd_test(s * X[:3], s * X[3:], seed=0, n_permutations=9)
