@@ -9,8 +9,13 @@ on pages served from 127.0.0.1:
   KaTeX fonts loaded, every image loaded (``naturalWidth > 0``), and no console error, uncaught
   exception or failed network load occurred (the site needs nothing outside it);
 * on ``report.html`` from a ``--tiny`` run of the main job: every embedded figure decodes
-  (``naturalWidth > 0``), one per figure that ran, no raw TeX or RST is in the text, and no console
-  error occurred.
+  (``naturalWidth > 0``), one per figure that ran, no raw TeX or RST is in the text, no console
+  error occurred, and the page asked for nothing but itself (no network, no file beside it);
+  every formula of the claims, notes and captions was typeset by the embedded KaTeX (each
+  ``.arithmatex`` holds a ``.katex``, the KaTeX fonts loaded, no ``_{``/``^{`` left in the visible
+  text: where KaTeX is not vendored, outside CI, the formulas are checked in their plain-HTML form
+  instead), and nothing needs horizontal scrolling (the page, the Details notes, the tables).
+  Screenshots of the page and of Figures 1, 4 and 5 as the reader sees them are kept.
 
 Screenshots are kept in ``test-artifacts/browser/`` (gitignored). Skipped when Chromium is missing,
 except under ``CI=true``, where that is a failure.
@@ -117,18 +122,51 @@ def test_docs_site_in_browser(docs_site, chromium):
     assert total >= 400
 
 
+REPORT_STATE = r"""
+(() => {
+  const text = document.body.innerText;
+  const raw = [];
+  for (const rx of [/_\{/g, /\^\{/g]) {
+    for (const m of text.matchAll(rx)) { raw.push(text.slice(Math.max(0, m.index - 40), m.index + 40)); }
+  }
+  const wide = Array.from(document.querySelectorAll('pre, .details, table, figure, p'))
+    .filter(el => el.scrollWidth > el.clientWidth + 1)
+    .map(el => el.tagName + '.' + el.className + ': ' + el.textContent.slice(0, 60));
+  return {
+    rawTex: raw.slice(0, 10),
+    katex: document.querySelectorAll('.arithmatex > .katex').length,
+    withTex: document.querySelectorAll('.arithmatex[data-tex]').length,
+    details: document.querySelectorAll('.details').length,
+    pageScrolls: document.documentElement.scrollWidth > document.documentElement.clientWidth,
+    wide: wide.slice(0, 10),
+    requests: performance.getEntriesByType('resource').map(r => r.name.slice(0, 100)),
+  };
+})()
+"""
+
+
 def test_report_html_in_browser(tiny_paper_run, chromium):
     out = tiny_paper_run.out
     assert tiny_paper_run.returncode in (0, 1), tiny_paper_run.stderr[-4000:]
     report = out / "report.html"
     assert report.exists()
-    figures_run = len(re.findall(r"<img alt=", report.read_text(encoding="utf-8")))
+    page_text = report.read_text(encoding="utf-8")
+    figures_run = len(re.findall(r"<img alt=", page_text))
+    # the report says whether it embeds KaTeX (it does wherever tools/vendor_katex.sh has run, as in CI)
+    katex_embedded = "Formulas are typeset by KaTeX" in page_text
     with StaticServer(out) as server:
         page = chromium.open(server.url + "report.html")
         s = page.evaluate(PAGE_STATE)
+        r = page.evaluate(REPORT_STATE)
         page.screenshot(ARTIFACTS / "report.png")
         page.screenshot(ARTIFACTS / "report-full.png", full_page=True)
+        # the figures as the reader sees them (look at them: the legends, markers and colour bars)
+        for name in ("fig1", "fig4", "fig5"):
+            if page.evaluate(f"(() => {{ const f = document.getElementById('{name}'); if (!f) return false;"
+                             f" f.scrollIntoView({{block: 'start'}}); return true; }})()"):
+                page.screenshot(ARTIFACTS / f"report-{name}.png")
         errors = page.errors()
+        page.close()
     errors = [e for e in errors if "favicon.ico" not in e]  # the browser asks for one; the report has none
     assert not errors, f"report.html: console/network errors: {errors}"
     assert figures_run >= 1 and len(s["images"]) == figures_run
@@ -136,3 +174,18 @@ def test_report_html_in_browser(tiny_paper_run, chromium):
     assert not bad, f"report.html: figures that did not decode: {bad}"
     assert not s["raw"], f"report.html: raw TeX/RST in the text: {s['raw']}"
     assert s["failed"] == 0
+    # self-contained: the page loaded nothing but itself (images are data: URIs, KaTeX is inline)
+    assert not [u for u in r["requests"] if not u.startswith("data:")], r["requests"]
+    # formulas: every claim has some; all typeset by KaTeX, or all plain HTML when KaTeX is missing here
+    assert s["formulas"] >= 100, f"only {s['formulas']} formulas found in report.html"
+    assert not r["rawTex"], f"report.html: raw TeX in the text: {r['rawTex']}"
+    if katex_embedded:
+        assert r["withTex"] == s["formulas"] == s["typeset"] == r["katex"], (r, s)
+        assert s["katexFont"], "report.html: the embedded KaTeX fonts did not load"
+    elif os.environ.get("CI"):
+        pytest.fail("report.html does not embed KaTeX in CI (./test.sh runs tools/vendor_katex.sh before the tests)")
+    else:
+        assert r["withTex"] == r["katex"] == 0 and "Formulas are shown as plain text" in page_text
+    # text wraps: no horizontal scrolling of the page or of a note, table or figure
+    assert r["details"] >= 5
+    assert not r["pageScrolls"] and not r["wide"], f"report.html needs horizontal scrolling: {r['wide']}"
