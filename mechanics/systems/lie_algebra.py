@@ -156,7 +156,7 @@ class LieAlgebra:
                 raise ValueError(f"structure_constants violate the Jacobi identity (defect {jac:.3g}, more than "
                                  f"atol * max|c|**2 = {atol * scale * scale:.3g}); they do not define a Lie "
                                  f"algebra.")
-        self._c = c
+        self._c = c.copy() if c is structure_constants else c       # frozen below: never the caller's array
         self._c.setflags(write=False)
         self.name = name
         self._basis = None if basis is None else np.asarray(basis)
@@ -222,9 +222,10 @@ class LieAlgebra:
 
     @property
     def is_semisimple(self) -> bool:
-        """Cartan's criterion: the Killing form is non-degenerate."""
-        k = self._killing
-        return bool(abs(np.linalg.det(k)) > 1e-9 * max(1.0, float(np.max(np.abs(k)))) ** self.dim)
+        """Cartan's criterion: the Killing form is non-degenerate (``|det K| > 1e-9 max(1, max|K|)^n``, in logs)."""
+        sign, logdet = np.linalg.slogdet(self._killing)       # det overflowed from n ~ 200 (so(25): 28^300)
+        return bool(sign != 0 and logdet > np.log(1e-9) + self.dim * np.log(max(1.0, float(np.max(np.abs(
+            self._killing))))))
 
     @property
     def casimir_names(self) -> tuple:
@@ -322,7 +323,7 @@ class LieAlgebra:
 def _constructor_bytes(n: int) -> float:
     """Bytes :class:`LieAlgebra` holds at its peak for dimension ``n`` (the estimate it checks).
 
-    The structure constants ``8 n³`` (a float64 copy of the argument when it is not one), one ``n³``
+    The structure constants ``8 n³`` (the float64 copy the algebra keeps and freezes), one ``n³``
     temporary at a time (the antisymmetry check; the transposed copy the Killing form's product reads),
     and ``O(n²)`` for the Jacobi check (at most four arrays of ``16 n²`` floats, a block of
     :func:`_jacobi_defect`) and the Killing form: ``8 (2 n³ + 72 n²)`` bytes.

@@ -84,3 +84,21 @@ def test_an_algebra_beyond_the_memory_budget_is_refused_first(monkeypatch):
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(2 ** 20))
     with pytest.raises(ValueError, match=r"Lie algebra of dimension n=60 .* would take \d.* MiB"):
         LieAlgebra(np.zeros((60, 60, 60)))
+
+
+def test_semisimplicity_of_a_killing_form_whose_determinant_overflows():
+    # so(3)^6 with constants scaled by 1e10: K = -2e20 I (18 x 18), det K = 2.6e365 overflows float64
+    # (so(25), n = 300, raised OverflowError in the constructor for the same reason)
+    eps = np.zeros((3, 3, 3))
+    for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+        eps[i, j, k], eps[j, i, k] = 1.0, -1.0
+    c = np.zeros((18, 18, 18))
+    for b in range(6):
+        c[3 * b:3 * b + 3, 3 * b:3 * b + 3, 3 * b:3 * b + 3] = 1e10 * eps
+    g = LieAlgebra(c)
+    assert c.flags.writeable                  # the caller's array is not frozen (a copy is kept)
+    np.testing.assert_allclose(g.killing_form(), -2e20 * np.eye(18), rtol=1e-15)
+    assert g.is_semisimple and g.has_casimirs
+    c[:3] = 0.0                               # an abelian summand: degenerate, not semisimple
+    c[:, :3] = 0.0
+    assert not LieAlgebra(c).is_semisimple
