@@ -16,7 +16,7 @@ How a formula is found (the rules, so that a claim can be written to be read rig
   ``--options``), math atoms (a single Latin or Greek letter, ``𝕀``, ``𝐗``, ``ℓ``, ``h̃``, ``XX``, a
   letter run that is not a word such as ``kI``, a differential ``dt``, anything carrying a script
   ``_``/``^``/``*``/Unicode super- or subscript; digits right after a single letter are its index:
-  ``s13`` is :math:`s_{13}`), numbers, operators, brackets, bars;
+  ``s13`` is s₁₃), numbers, operators, brackets, bars;
 * a formula is a maximal run of atoms, numbers, operators and brackets, with the spaces between
   them, that holds at least one atom and does not cross a line break; a bracket belongs to it only if
   nothing inside it is prose (nor a row of numbers such as a printed array); after a space, a
@@ -377,7 +377,7 @@ def _letter_run(text: str, i: int, end: int, out: list[_Token]) -> int:
 
 
 def _number(num: str) -> tuple[str, str]:
-    """(TeX, HTML) of a number; ``1e-10`` is written :math:`10^{-10}`, ``2.5e-3`` :math:`2.5\\cdot 10^{-3}`."""
+    """(TeX, HTML) of a number; ``1e-10`` is written 10⁻¹⁰, ``2.5e-3`` 2.5·10⁻³."""
     m = re.fullmatch(r"(\d+(?:\.\d+)?)[eE]([-+]?)(\d+)", num)
     if not m:
         return num, num

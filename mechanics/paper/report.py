@@ -8,8 +8,8 @@ external resources) and ``results.json`` (the same results, machine-readable), w
 metadata (the command that reproduces it, seed, convention, Lévy-area sampler, sizes, versions).
 
 In ``report.html`` the formulas written in the claims, notes and captions (``XX_{s,t}``, ``σ²``,
-``Ad*_{exp σ_n}``) are found (:mod:`._html_math`) and typeset by KaTeX, embedded whole from the copy
-``tools/vendor_katex.sh`` puts in the source tree (:mod:`._html_katex`), so the page still opens
+``Ad*_{exp σ_n}``) are found (module ``_html_math``) and typeset by KaTeX, embedded whole from the copy
+``tools/vendor_katex.sh`` puts in the source tree (module ``_html_katex``), so the page still opens
 offline as one file. Where that copy is missing (``./run.sh`` installs the Python dependencies only)
 the formulas are plain HTML with sub- and superscripts and the page says so; raw TeX is never shown.
 ``report.md`` keeps the claims as the checks write them.
@@ -325,11 +325,26 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
                 katex_dir: str | os.PathLike | None = KATEX_DIR) -> str:
     """A self-contained HTML page (figures embedded as base64 PNG; ``read_file(name) -> bytes``).
 
-    The formulas in the claims, notes and captions are found by :func:`~._html_math.markup` and
+    The formulas in the claims, notes and captions are found (``_html_math.markup``) and
     typeset by KaTeX, embedded whole (script, style sheet, fonts as ``data:`` URIs) from ``katex_dir``
     (default: where ``tools/vendor_katex.sh`` vendors it in the source tree). Without KaTeX
-    (``katex_dir=None``, or a folder :func:`~._html_katex.load_katex` refuses) they are plain HTML with
+    (``katex_dir=None``, or a folder ``_html_katex.load_katex`` refuses) they are plain HTML with
     ``<sub>``/``<sup>``, and the page says why. Either way no raw TeX (``_{``, ``^{``) is shown.
+
+    Parameters
+    ----------
+    meta : RunMetadata
+    checks : list of CheckResult
+    figures : list of FigureResult
+    read_file : callable
+        ``read_file(name) -> bytes``: a figure's PNG from the output folder.
+    katex_dir : path-like or None
+        The vendored KaTeX to embed, or None for plain-HTML formulas.
+
+    Returns
+    -------
+    str
+        The page; the same inputs (and the same KaTeX) give the same text.
     """
     e = html.escape
     katex, reason = None, "the report was written without KaTeX"
