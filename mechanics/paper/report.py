@@ -291,7 +291,8 @@ table{border-collapse:collapse;margin:1em 0;font-size:0.92em}th,td{border:1px so
 vertical-align:top}th{background:#f2f2f2}td.name,td.pass,td.FAIL,td.error{white-space:nowrap}
 td.pass{background:#e3f6e3;font-weight:bold}
 td.FAIL{background:#fbe0e0;font-weight:bold}td.error{background:#fbe0e0}
-figure{margin:1.5em 0}figure img{max-width:100%;box-sizing:border-box;border:1px solid #ddd}figcaption{font-size:0.92em;color:#444}
+figure{margin:1.5em 0}figure img{max-width:100%;box-sizing:border-box;border:1px solid #ddd}
+figcaption{font-size:0.92em;color:#444}
 code,pre{background:#f6f6f6;padding:1px 3px}pre{padding:6px;font-size:0.85em}
 pre,.details{white-space:pre-wrap;overflow-wrap:anywhere}.details{font-size:0.92em;margin:0.2em 0 0.8em}
 .katex{font-size:1.08em}.summary{font-size:1.1em}.note{color:#555;font-size:0.92em}

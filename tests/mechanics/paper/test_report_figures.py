@@ -53,7 +53,8 @@ def test_components_legend_would_be_caught_where_it_covers_data():
     covered = 0
     for line in ax.get_lines()[:3]:
         xy = ax.transData.transform(np.column_stack(line.get_data()))
-        covered += int(((xy[:, 0] >= box.x0) & (xy[:, 0] <= box.x1) & (xy[:, 1] >= box.y0) & (xy[:, 1] <= box.y1)).sum())
+        covered += int(((xy[:, 0] >= box.x0) & (xy[:, 0] <= box.x1)
+                        & (xy[:, 1] >= box.y0) & (xy[:, 1] <= box.y1)).sum())
     assert covered > 0
 
 

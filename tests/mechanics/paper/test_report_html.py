@@ -77,7 +77,8 @@ def test_multiplication_x_is_shown_as_times():
      "½(<i>XX</i> − <i>XX</i><sup>T</sup>)<sub>12</sub>"),
     ("E[XX_ii] = +0.0135 ± 0.0230", r"E[XX_{ii}] = +0.0135 \pm 0.0230",
      "<i>E</i>[<i>XX</i><sub><i>ii</i></sub>] = +0.0135 ± 0.0230"),
-    ("XX^Itô = XX^Strat", r"XX^{\text{Itô}} = XX^{\text{Strat}}", "<i>XX</i><sup>Itô</sup> = <i>XX</i><sup>Strat</sup>"),
+    ("XX^Itô = XX^Strat", r"XX^{\text{Itô}} = XX^{\text{Strat}}",
+     "<i>XX</i><sup>Itô</sup> = <i>XX</i><sup>Strat</sup>"),
     ("D = √δ I", r"D = \sqrt{\delta} I", "<i>D</i> = √<i>δ</i> <i>I</i>"),
     ("||Π| − 1| ≤ 1e-12", r"||\Pi| - 1| \le 10^{-12}", "||Π| − 1| ≤ 10<sup>−12</sup>"),
     ("h = 2^-4..2^-8", r"h = 2^{-4}..2^{-8}", "<i>h</i> = 2<sup>−4</sup>..2<sup>−8</sup>"),
@@ -91,8 +92,8 @@ def test_formula_tex_and_html_by_hand(formula, tex, shown):
 
 def test_markup_spans_and_escaping():
     out = markup("Chen's & <tag> t²/4; defect <= 1e-10")
-    assert out == ('Chen\'s &amp; &lt;tag&gt; <span class="arithmatex" data-tex="t^{2}/4"><i>t</i><sup>2</sup>/4</span>; '
-                   "defect ≤ 1e-10")
+    assert out == ("Chen's &amp; &lt;tag&gt; "
+                   '<span class="arithmatex" data-tex="t^{2}/4"><i>t</i><sup>2</sup>/4</span>; defect ≤ 1e-10')
     assert markup("t²/4", typeset=False) == '<span class="arithmatex"><i>t</i><sup>2</sup>/4</span>'
     with pytest.raises(TypeError, match="text must be a str"):
         split_formulas(b"bytes")
