@@ -34,6 +34,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._variants import variants
+
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True)
@@ -164,40 +166,51 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, tb, dl, delta):
         _top_sweep(s, ok, n, d, tb, dl, nk)
 
 
-@njit(**_NOGIL)
-def block_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
-    """Signatures (reversed layout) of units ``lo..hi-1`` into ``part`` (units, sigdim), depth ``m >= 2``.
+def block_key(d: int, m: int) -> tuple:
+    """``(D, M)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time).
+
+    Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
+    (d, m) = (8, 3), (8, 4), (6, 4), (20, 3), and d = 4 at any depth. Each variant is its own kernel,
+    compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
+    """
+    if (d, m) in ((8, 3), (8, 4), (6, 4), (20, 3)):
+        return d, m
+    return (4, 0) if d == 4 else (0, 0)
+
+
+@variants
+def _block_units_kernel(D: int, M: int):
+    """The compiled :func:`block_units` of variant ``(D, M)`` (:func:`block_key`)."""
+
+    @njit(**_NOGIL)
+    def block_units_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
+        d = D if D else x.shape[2]
+        mm = M if M else m
+        buf = np.empty((2 * mm + 2) * d ** max(mm - 2, 1))      # the chains C^l_j (_fused_d)
+        most = 1
+        for u in range(lo, hi):
+            most = max(most, uhi[u] - ulo[u])
+        tb = np.empty(min(KBLOCK, most) * d ** (mm - 1))        # a short path's block: its segments
+        dl = np.empty(KBLOCK * d)
+        delta = np.empty(d)
+        fac = np.empty(mm + 1)
+        for k in range(1, mm + 1):
+            fac[k] = 1.0 / k
+        for u in range(lo, hi):
+            _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, tb, dl, delta)
+
+    return block_units_variant
+
+
+def block_units(d: int, m: int):
+    """The one-unit kernel for alphabet size ``d`` and depth ``m >= 2`` (compiled on first use, without the
+    GIL): ``kernel(x, ub, ulo, uhi, m, offsets, lo, hi, part)`` writes the signatures (reversed layout) of
+    units ``lo..hi-1`` into ``part`` (units, sigdim).
 
     Unit ``u`` covers points ``ulo[u]..uhi[u]`` of path ``ub[u]``. The same bits as
     :func:`~roughpaths.signatures._lanes.scalar_units`.
     """
-    d = x.shape[2]
-    buf = np.empty((2 * m + 2) * d ** max(m - 2, 1))        # the chains C^l_j (_fused_d)
-    most = 1
-    for u in range(lo, hi):
-        most = max(most, uhi[u] - ulo[u])
-    tb = np.empty(min(KBLOCK, most) * d ** (m - 1))           # a short path's block: its segments
-    dl = np.empty(KBLOCK * d)
-    delta = np.empty(d)
-    fac = np.empty(m + 1)
-    for k in range(1, m + 1):
-        fac[k] = 1.0 / k
-    for u in range(lo, hi):
-        b, k0, k1, out = ub[u], ulo[u], uhi[u], part[u]
-        # compile-time widths (and depths): LLVM unrolls the loops over the letters and the levels.
-        # Each variant costs compile time once (the kernel: about 60 s on this machine, then cached)
-        if m == 3 and d == 8:
-            _unit_d(x, b, k0, k1, out, 8, 3, offsets, fac, buf, tb, dl, delta)
-        elif m == 4 and d == 8:
-            _unit_d(x, b, k0, k1, out, 8, 4, offsets, fac, buf, tb, dl, delta)
-        elif m == 4 and d == 6:
-            _unit_d(x, b, k0, k1, out, 6, 4, offsets, fac, buf, tb, dl, delta)
-        elif m == 3 and d == 20:
-            _unit_d(x, b, k0, k1, out, 20, 3, offsets, fac, buf, tb, dl, delta)
-        elif d == 4:
-            _unit_d(x, b, k0, k1, out, 4, m, offsets, fac, buf, tb, dl, delta)
-        else:
-            _unit_d(x, b, k0, k1, out, d, m, offsets, fac, buf, tb, dl, delta)
+    return _block_units_kernel(*block_key(d, m))
 
 
 #: Levels with more entries than this are permuted in tiles (:func:`to_rowmajor`).

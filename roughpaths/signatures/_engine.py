@@ -180,11 +180,12 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     per_unit = (n / nchunks) * 1.5 * d ** depth
     ngroups, first_alone = _split_units(nunits, d, depth)
     if ngroups:
-        _threads.run(lambda lo, hi: _lanes.lane_groups(x, *units, depth, off, lo, hi, part),
+        lanes = _lanes.lane_groups(d, depth)
+        _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES))
     if first_alone < nunits:
-        _threads.run(lambda lo, hi: _blocked.block_units(x, *units, depth, off, first_alone + lo,
-                                                         first_alone + hi, part),
+        alone = _blocked.block_units(d, depth)
+        _threads.run(lambda lo, hi: alone(x, *units, depth, off, first_alone + lo, first_alone + hi, part),
                      _threads.ranges(nunits - first_alone, per_unit))
     return part
 
@@ -201,7 +202,8 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
         _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
                      _threads.ranges(groups * nchunks, per_task * _lanes.LANES))
     first = groups * _lanes.LANES * nchunks
-    _threads.run(lambda lo, hi: _l2.sig2_tasks(x, nchunks, first + lo, first + hi, part),
+    tasks = _l2.sig2_tasks(d)
+    _threads.run(lambda lo, hi: tasks(x, nchunks, first + lo, first + hi, part),
                  _threads.ranges(nb * nchunks - first, per_task))
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 

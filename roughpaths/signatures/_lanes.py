@@ -40,6 +40,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._variants import variants
+
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True)
@@ -214,24 +216,25 @@ def _wide_step(s, delta, d, m, offsets, buf):
         s[i] += delta[i]
 
 
-@njit(cache=True)
-def _horner_step(s, delta, d, m, offsets, buf):
+def step_key(d: int) -> int:
+    """The compile-time variant of the one-unit step for alphabet size ``d`` (see :func:`_horner_step`):
+    ``d`` itself for d = 2..5, -1 for d = 6..15 (:func:`_wide_step`), 0 for a run-time ``d``."""
+    return d if 2 <= d <= 5 else (-1 if d < 16 else 0)
+
+
+@njit(cache=True, inline="always")
+def _horner_step(s, delta, K, d, m, offsets, buf):
     """``s <- s ⊗ exp(delta)`` in place (reversed layout), one unit; ``buf`` scratch of
-    ``2 d^(m-1) + d`` floats.
+    ``2 d^(m-1) + d`` floats; ``K = step_key(d)``, a compile-time constant of the calling kernel.
 
     Packed over the first letters (:func:`_outer`), so it runs at SIMD width for any ``d``; the
     same bits as a lane of :func:`_lane_step_d`. ``d = 2..5`` get a compile-time ``d``; ``d = 6..15``
-    run :func:`_wide_step` (the same bits, less loop overhead).
+    run :func:`_wide_step` (the same bits, less loop overhead). Inlined: each kernel compiles only the
+    variant of its ``K`` (the branches on the constant are pruned before typing).
     """
-    if d == 2:
-        _horner_step_d(s, delta, 2, m, offsets, buf)
-    elif d == 3:
-        _horner_step_d(s, delta, 3, m, offsets, buf)
-    elif d == 4:
-        _horner_step_d(s, delta, 4, m, offsets, buf)
-    elif d == 5:
-        _horner_step_d(s, delta, 5, m, offsets, buf)
-    elif d < 16:
+    if K > 0:
+        _horner_step_d(s, delta, K, m, offsets, buf)
+    elif K < 0:
         _wide_step(s, delta, d, m, offsets, buf)
     else:                           # measured: at d = 20, depth 3 _wide_step is 10% slower
         _horner_step_d(s, delta, d, m, offsets, buf)
@@ -303,27 +306,6 @@ def _block_d(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part):
                     part[u, r] = s[r * L + l]
 
 
-@njit(cache=True)
-def _block(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part):
-    # a compile-time d lets LLVM unroll the loops over the letters; depth 3 with d = 3 or 5 also
-    # gets a compile-time m, which unrolls the loops over the levels (about 10% faster). Each
-    # variant costs compile time on first use (about 20 s for this kernel, then cached)
-    if m == 3 and d == 3:
-        _block_d(s, blk, nt, t0, g, nsteps, 3, 3, offsets, buf, part)
-    elif m == 3 and d == 5:
-        _block_d(s, blk, nt, t0, g, nsteps, 5, 3, offsets, buf, part)
-    elif d == 2:
-        _block_d(s, blk, nt, t0, g, nsteps, 2, m, offsets, buf, part)
-    elif d == 3:
-        _block_d(s, blk, nt, t0, g, nsteps, 3, m, offsets, buf, part)
-    elif d == 4:
-        _block_d(s, blk, nt, t0, g, nsteps, 4, m, offsets, buf, part)
-    elif d == 5:
-        _block_d(s, blk, nt, t0, g, nsteps, 5, m, offsets, buf, part)
-    else:
-        _block_d(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part)
-
-
 @njit(cache=True, inline="always")
 def _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk):
     L = LANES
@@ -341,50 +323,59 @@ def _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk):
                 blk[(t * d + i) * L + l] = 0.0
 
 
-@njit(cache=True)
-def _gather(x, ub, ulo, nsteps, g, t0, nt, d, blk):
-    """Increments of segments ``t0 .. t0+nt-1`` of the units of group ``g``, as ``blk[t, i, lane]`` (0 past a unit's end)."""
-    if d == 2:
-        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 2, blk)
-    elif d == 3:
-        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 3, blk)
-    elif d == 4:
-        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 4, blk)
-    elif d == 5:
-        _gather_d(x, ub, ulo, nsteps, g, t0, nt, 5, blk)
-    else:
-        _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk)
+def lane_key(d: int, m: int) -> tuple:
+    """``(D, M)``: the compile-time alphabet size and depth of the lane kernel's variant (0: at run time).
+
+    A compile-time ``d`` lets LLVM unroll the loops over the letters (d = 2..5); depth 3 with d = 3 or 5
+    also gets a compile-time ``m``, which unrolls the loops over the levels (about 10 % faster). Each
+    variant is its own kernel, compiled on its first use (3-9 s of CPU here, then cached on disk), so a
+    call compiles only the variant it runs.
+    """
+    return (d if 2 <= d <= 5 else 0, 3 if m == 3 and d in (3, 5) else 0)
 
 
-@njit(**_NOGIL)
-def lane_groups(x, ub, ulo, uhi, m, offsets, lo, hi, part):
-    """Signatures (reversed layout) of the units of lane groups ``lo..hi-1`` into ``part`` (units, sigdim).
+@variants
+def _lane_groups_kernel(D: int, M: int):
+    """The compiled :func:`lane_groups` of variant ``(D, M)`` (:func:`lane_key`)."""
+
+    @njit(**_NOGIL)
+    def lane_groups_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
+        L = LANES
+        T = BLOCK
+        d = D if D else x.shape[2]
+        mm = M if M else m
+        dim = offsets[mm + 1]
+        nunits = ub.shape[0]
+        s = np.empty(dim * L)
+        buf = np.empty(2 * d ** max(mm - 2, 1) * L)
+        blk = np.empty(T * d * L)
+        nsteps = np.zeros(L, dtype=np.int64)
+        for g in range(lo, hi):
+            s[:] = 0.0
+            steps = 0
+            for l in range(L):
+                u = g * L + l
+                nsteps[l] = uhi[u] - ulo[u] if u < nunits else 0
+                steps = max(steps, nsteps[l])
+                if u < nunits and nsteps[l] == 0:
+                    part[u, :] = 0.0
+            for t0 in range(0, steps, T):
+                nt = min(T, steps - t0)
+                _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk)
+                _block_d(s, blk, nt, t0, g, nsteps, d, mm, offsets, buf, part)
+
+    return lane_groups_variant
+
+
+def lane_groups(d: int, m: int):
+    """The lane kernel for alphabet size ``d`` and depth ``m`` (compiled on first use, without the GIL):
+    ``kernel(x, ub, ulo, uhi, m, offsets, lo, hi, part)`` writes the signatures (reversed layout) of the
+    units of lane groups ``lo..hi-1`` into ``part`` (units, sigdim).
 
     Unit ``u`` covers points ``ulo[u]..uhi[u]`` of path ``ub[u]``; group ``g`` is units
-    ``g*LANES .. g*LANES + LANES - 1``.
+    ``g*LANES .. g*LANES + LANES - 1``. The variant is :func:`lane_key` of ``(d, m)``.
     """
-    L = LANES
-    T = BLOCK
-    d = x.shape[2]
-    dim = offsets[m + 1]
-    nunits = ub.shape[0]
-    s = np.empty(dim * L)
-    buf = np.empty(2 * d ** max(m - 2, 1) * L)
-    blk = np.empty(T * d * L)
-    nsteps = np.zeros(L, dtype=np.int64)
-    for g in range(lo, hi):
-        s[:] = 0.0
-        steps = 0
-        for l in range(L):
-            u = g * L + l
-            nsteps[l] = uhi[u] - ulo[u] if u < nunits else 0
-            steps = max(steps, nsteps[l])
-            if u < nunits and nsteps[l] == 0:
-                part[u, :] = 0.0
-        for t0 in range(0, steps, T):
-            nt = min(T, steps - t0)
-            _gather(x, ub, ulo, nsteps, g, t0, nt, d, blk)
-            _block(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part)
+    return _lane_groups_kernel(*lane_key(d, m))
 
 
 @njit(cache=True)
@@ -406,22 +397,32 @@ def lane_glue(part, nb, nchunks, m, offsets):
     return out
 
 
-@njit(**_NOGIL)
+@variants
+def _scalar_units_kernel(K: int):
+    """The compiled :func:`scalar_units` for the step variant ``K`` (:func:`step_key`)."""
+
+    @njit(**_NOGIL)
+    def scalar_units_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
+        d = x.shape[2]
+        buf = np.empty(2 * d ** max(m - 1, 1) + d)
+        delta = np.empty(d)
+        for u in range(lo, hi):
+            s = part[u]
+            for r in range(s.shape[0]):
+                s[r] = 0.0
+            b = ub[u]
+            for k in range(ulo[u] + 1, uhi[u] + 1):
+                for i in range(d):
+                    delta[i] = x[b, k, i] - x[b, k - 1, i]
+                _horner_step(s, delta, K, d, m, offsets, buf)
+
+    return scalar_units_variant
+
+
 def scalar_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
     """Signatures (reversed layout) of units ``lo..hi-1``, one at a time with :func:`_horner_step`.
 
     The same arithmetic, operation for operation, as :func:`lane_groups` (the same bits); the
-    kernel of wide paths (d >= 6) and of lane groups with few units.
+    reference of the blocked one-unit kernel (:mod:`roughpaths.signatures._blocked`) in the tests.
     """
-    d = x.shape[2]
-    buf = np.empty(2 * d ** max(m - 1, 1) + d)
-    delta = np.empty(d)
-    for u in range(lo, hi):
-        s = part[u]
-        for r in range(s.shape[0]):
-            s[r] = 0.0
-        b = ub[u]
-        for k in range(ulo[u] + 1, uhi[u] + 1):
-            for i in range(d):
-                delta[i] = x[b, k, i] - x[b, k - 1, i]
-            _horner_step(s, delta, d, m, offsets, buf)
+    _scalar_units_kernel(step_key(x.shape[2]))(x, ub, ulo, uhi, m, offsets, lo, hi, part)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._variants import variants
+
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True)
@@ -174,36 +176,49 @@ def _area_chunk_generic(x, b, lo, hi, out):
             q += 1
 
 
-@njit(cache=True)
-def _area_chunk(x, b, lo, hi, out):
-    """Write ``(X, twice the Lévy area over i<j)`` of points ``lo..hi`` of path ``b`` into ``out``."""
-    d = x.shape[2]
-    if d == 2:
+@njit(cache=True, inline="always")
+def _area_chunk(x, b, lo, hi, out, D):
+    """Write ``(X, twice the Lévy area over i<j)`` of points ``lo..hi`` of path ``b`` into ``out``; ``D`` is
+    the calling kernel's compile-time alphabet size (0: any), so only its chunk kernel is compiled."""
+    if D == 2:
         _area_chunk_d2(x, b, lo, hi, out)
-    elif d == 3:
+    elif D == 3:
         _area_chunk_d3(x, b, lo, hi, out)
-    elif d == 4:
+    elif D == 4:
         _area_chunk_d4(x, b, lo, hi, out)
-    elif d == 5:
+    elif D == 5:
         _area_chunk_d5(x, b, lo, hi, out)
     else:
         _area_chunk_generic(x, b, lo, hi, out)
 
 
-@njit(**_NOGIL)
-def sig2_tasks(x, nchunks, lo, hi, part):
-    """``(increment, twice the Lévy area)`` of chunks ``t = lo..hi-1`` (path ``t // nchunks``) into ``part``."""
-    n = x.shape[1]
-    seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
-    for t in range(lo, hi):
-        b = t // nchunks
-        c = t - b * nchunks
-        a = min(c * seg, n - 1)
-        e = min(a + seg, n - 1)
-        for r in range(part.shape[1]):
-            part[t, r] = 0.0
-        if e > a:
-            _area_chunk(x, b, a, e, part[t])
+@variants
+def _sig2_tasks_kernel(D: int):
+    """The compiled :func:`sig2_tasks` for the alphabet size ``D`` (2..5; 0 for any other)."""
+
+    @njit(**_NOGIL)
+    def sig2_tasks_variant(x, nchunks, lo, hi, part):
+        n = x.shape[1]
+        seg = (n - 1 + nchunks - 1) // nchunks if n > 1 else 0
+        for t in range(lo, hi):
+            b = t // nchunks
+            c = t - b * nchunks
+            a = min(c * seg, n - 1)
+            e = min(a + seg, n - 1)
+            for r in range(part.shape[1]):
+                part[t, r] = 0.0
+            if e > a:
+                _area_chunk(x, b, a, e, part[t], D)
+
+    return sig2_tasks_variant
+
+
+def sig2_tasks(d: int):
+    """The level-2 kernel for alphabet size ``d`` (compiled on first use, without the GIL):
+    ``kernel(x, nchunks, lo, hi, part)`` writes ``(increment, twice the Lévy area)`` of chunks
+    ``t = lo..hi-1`` (path ``t // nchunks``) into ``part``. d = 2..5 have unrolled chunk kernels of their
+    own (each compiled only when its d is first used)."""
+    return _sig2_tasks_kernel(d if 2 <= d <= 5 else 0)
 
 
 #: From this width on, groups of LANES paths run side by side (:func:`sig2_lane_tasks`).

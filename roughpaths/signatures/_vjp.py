@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._lanes import BLOCK, _addto, _axpy, _horner_step, _lane_step_d, mul_inplace
+from .._variants import variants
+from ._lanes import BLOCK, _addto, _axpy, _horner_step, _lane_step_d, mul_inplace, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True)
@@ -130,8 +131,13 @@ def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
             gdelta[q] += ga[q] * inv
 
 
-@njit(cache=True)
-def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+def vjp_key(d: int) -> int:
+    """The compile-time alphabet size of the backward step's variant (0: at run time)."""
+    return d if d in (2, 3) else 0
+
+
+@njit(cache=True, inline="always")
+def _step_vjp(s, g, delta, V, d, m, offsets, gprev, tb, ga, gb, gdelta):
     """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
 
     Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
@@ -143,16 +149,14 @@ def _step_vjp(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
     every lane of :func:`_lane_step_vjp_d`, the dot products in the four sums of :func:`_dot_wide`
     (one chain of dependent additions measured 3x slower on a lone 4^8 path).
     """
-    if d == 2:
-        _step_vjp_d(s, g, delta, 2, m, offsets, gprev, tb, ga, gb, gdelta)
-    elif d == 3:
-        _step_vjp_d(s, g, delta, 3, m, offsets, gprev, tb, ga, gb, gdelta)
+    if V:                               # V = vjp_key(d), a compile-time constant of the calling kernel
+        _step_vjp_d(s, g, delta, V, m, offsets, gprev, tb, ga, gb, gdelta)
     else:
         _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta)
 
 
-@njit(cache=True)
-def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
+@njit(cache=True, inline="always")
+def _unit_vjp(x, b, lo, hi, s, g, K, V, d, m, offsets, gd):
     """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
     dim = offsets[m + 1]
     buf = np.empty(2 * d ** max(m - 1, 1) + d)
@@ -167,8 +171,8 @@ def _unit_vjp(x, b, lo, hi, s, g, d, m, offsets, gd):
         for i in range(d):
             delta[i] = x[b, k, i] - x[b, k - 1, i]
             neg[i] = -delta[i]
-        _horner_step(s, neg, d, m - 1, offsets, buf)        # S_prev: its top level is never read
-        _step_vjp(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
+        _horner_step(s, neg, K, d, m - 1, offsets, buf)     # S_prev: its top level is never read
+        _step_vjp(s, g, delta, V, d, m, offsets, gn, tb, ga, gb, gdelta)
         for i in range(d):
             gd[b, k - 1, i] = gdelta[i]
         for r in range(offsets[m]):                         # the top level of g never changes
@@ -238,15 +242,27 @@ def _log_vjp_one(a, g, d, m, offsets, ga):
         ga[u] += cm * gc[u]
 
 
-@njit(**_NOGIL)
-def sig_vjp_units(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
-    """Cotangents of the segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d)."""
-    d = x.shape[2]
-    g = np.empty(offsets[m + 1])
-    for u in range(lo, hi):
-        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
-        s = part[u].copy()
-        _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd)
+@variants
+def _sig_vjp_units_kernel(K: int, V: int):
+    """The compiled one-unit backward pass for the step variants ``K`` (:func:`step_key`), ``V`` (:func:`vjp_key`)."""
+
+    @njit(**_NOGIL)
+    def sig_vjp_units_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+        d = x.shape[2]
+        g = np.empty(offsets[m + 1])
+        for u in range(lo, hi):
+            _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+            s = part[u].copy()
+            _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, K, V, d, m, offsets, gd)
+
+    return sig_vjp_units_variant
+
+
+def sig_vjp_units(d: int):
+    """The one-unit backward kernel for alphabet size ``d`` (compiled on first use, without the GIL):
+    ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)`` writes the cotangents of the
+    segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d)."""
+    return _sig_vjp_units_kernel(step_key(d), vjp_key(d))
 
 
 @njit(**_NOGIL)
@@ -362,57 +378,55 @@ def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk,
             g[r] = gn[r]
 
 
-@njit(cache=True)
-def _back_block(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
-                gdelta, gd):
-    if d == 2:
-        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, 2, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
-                      gdelta, gd)
-    elif d == 3:
-        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, 3, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
-                      gdelta, gd)
-    else:
-        _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
-                      gdelta, gd)
+@variants
+def _sig_vjp_groups_kernel(V: int):
+    """The compiled lane backward pass for the variant ``V`` (:func:`vjp_key`)."""
+
+    @njit(**_NOGIL)
+    def sig_vjp_groups_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+        L = LANES
+        T = BLOCK
+        d = x.shape[2]
+        dim = offsets[m + 1]
+        nunits = ub.shape[0]
+        s = np.empty(dim * L)
+        g = np.empty(dim * L)
+        gn = np.empty(dim * L)
+        tb = np.empty(dim * L)
+        ga = np.empty(d ** m * L)
+        gb = np.empty(d ** m * L)
+        gdelta = np.empty(d * L)
+        blk = np.empty(T * d * L)
+        neg = np.empty(T * d * L)
+        buf = np.empty(2 * d ** max(m - 2, 1) * L)
+        gu = np.empty(dim)
+        nsteps = np.zeros(L, dtype=np.int64)
+        for grp in range(lo, hi):
+            steps = 0
+            for l in range(L):
+                u = grp * L + l
+                if u < nunits:
+                    nsteps[l] = uhi[u] - ulo[u]
+                    _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, gu)
+                    for r in range(dim):
+                        s[r * L + l] = part[u, r]
+                        g[r * L + l] = gu[r]
+                else:
+                    nsteps[l] = 0
+                    for r in range(dim):
+                        s[r * L + l] = 0.0
+                        g[r * L + l] = 0.0
+                steps = max(steps, nsteps[l])
+            for t0 in range(0, steps, T):
+                nt = min(T, steps - t0)
+                _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, V if V else d, m, offsets, s, g, gn, blk, neg, buf,
+                              tb, ga, gb, gdelta, gd)
+
+    return sig_vjp_groups_variant
 
 
-@njit(**_NOGIL)
-def sig_vjp_groups(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
-    """:func:`sig_vjp_units` on lane groups ``lo..hi-1`` (units ``g*LANES ..``), the same bits."""
-    L = LANES
-    T = BLOCK
-    d = x.shape[2]
-    dim = offsets[m + 1]
-    nunits = ub.shape[0]
-    s = np.empty(dim * L)
-    g = np.empty(dim * L)
-    gn = np.empty(dim * L)
-    tb = np.empty(dim * L)
-    ga = np.empty(d ** m * L)
-    gb = np.empty(d ** m * L)
-    gdelta = np.empty(d * L)
-    blk = np.empty(T * d * L)
-    neg = np.empty(T * d * L)
-    buf = np.empty(2 * d ** max(m - 2, 1) * L)
-    gu = np.empty(dim)
-    nsteps = np.zeros(L, dtype=np.int64)
-    for grp in range(lo, hi):
-        steps = 0
-        for l in range(L):
-            u = grp * L + l
-            if u < nunits:
-                nsteps[l] = uhi[u] - ulo[u]
-                _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, gu)
-                for r in range(dim):
-                    s[r * L + l] = part[u, r]
-                    g[r * L + l] = gu[r]
-            else:
-                nsteps[l] = 0
-                for r in range(dim):
-                    s[r * L + l] = 0.0
-                    g[r * L + l] = 0.0
-            steps = max(steps, nsteps[l])
-        for t0 in range(0, steps, T):
-            nt = min(T, steps - t0)
-            _back_block(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
-                        gdelta, gd)
+def sig_vjp_groups(d: int):
+    """The lane backward kernel for alphabet size ``d`` (compiled on first use, without the GIL):
+    ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)``, :func:`sig_vjp_units` on lane
+    groups ``lo..hi-1`` (units ``g*LANES ..``), the same bits."""
+    return _sig_vjp_groups_kernel(vjp_key(d))

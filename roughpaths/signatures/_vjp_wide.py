@@ -25,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._lanes import _horner_step
+from .._variants import variants
+from ._lanes import _horner_step, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 from ._vjp import _dot_wide, _step_vjp_d, _tb_row, _unit_cotangent
 
@@ -159,7 +160,7 @@ def _top_back(s, g, delta, d, m, offsets, gbt, go, gprev, tb, ga, gb, gdelta):
 
 
 @njit(cache=True, inline="always")
-def _unit_back_d(x, b, lo, hi, s, g, d, m, offsets, gd, w):
+def _unit_back_d(x, b, lo, hi, s, g, K, d, m, offsets, gd, w):
     """Backward over the segments ``lo..hi`` of path ``b`` (``s`` its signature, ``g`` its cotangent)."""
     buf, tb, ga, gb, gn, delta, neg, gdelta, dl, gbt, tk, gdl, tmp = w
     ok = offsets[m]
@@ -174,7 +175,7 @@ def _unit_back_d(x, b, lo, hi, s, g, d, m, offsets, gd, w):
             for i in range(d):
                 delta[i] = dl[k * d + i]
                 neg[i] = -delta[i]
-            _horner_step(s, neg, d, m - 1, offsets, buf)      # S_prev, levels < m
+            _horner_step(s, neg, K, d, m - 1, offsets, buf)   # S_prev, levels < m
             _step_vjp_d(s, g, delta, d, m - 1, offsets, gn, tb, ga, gb, gdelta)
             _top_back(s, g, delta, d, m, offsets, gbt, k * n, gn, tb, ga, gb, gdelta)
             for p in range(n):                              # T_{m-1} of this segment
@@ -189,19 +190,31 @@ def _unit_back_d(x, b, lo, hi, s, g, d, m, offsets, gd, w):
                 gd[b, t0 - k - 1, i] = gdl[k * d + i]
 
 
-@njit(**_NOGIL)
-def sig_vjp_wide(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
-    """Cotangents of the segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d); d >= 6, m >= 3."""
-    d = x.shape[2]
-    dim = offsets[m + 1]
-    n = d ** (m - 1)
-    w = (np.empty(2 * n + d), np.empty(dim), np.empty(n), np.empty(n), np.empty(dim), np.empty(d),
-         np.empty(d), np.empty(d), np.empty(KB * d), np.empty(KB * n), np.empty(KB * n), np.empty(KB * d),
-         np.empty(LANES))
-    g = np.empty(dim)
-    for u in range(lo, hi):
-        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
-        s = part[u].copy()
-        # one run-time d: a compile-time d = 8 variant measured 20% faster at depth 3, but took 100 s
-        # more to compile
-        _unit_back_d(x, ub[u], ulo[u], uhi[u], s, g, d, m, offsets, gd, w)
+@variants
+def _sig_vjp_wide_kernel(K: int):
+    """The compiled wide backward pass for the step variant ``K`` (:func:`~._lanes.step_key`)."""
+
+    @njit(**_NOGIL)
+    def sig_vjp_wide_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+        d = x.shape[2]
+        dim = offsets[m + 1]
+        n = d ** (m - 1)
+        w = (np.empty(2 * n + d), np.empty(dim), np.empty(n), np.empty(n), np.empty(dim), np.empty(d),
+             np.empty(d), np.empty(d), np.empty(KB * d), np.empty(KB * n), np.empty(KB * n), np.empty(KB * d),
+             np.empty(LANES))
+        g = np.empty(dim)
+        for u in range(lo, hi):
+            _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+            s = part[u].copy()
+            # one run-time d: a compile-time d = 8 variant measured 20% faster at depth 3, but took 100 s
+            # more to compile
+            _unit_back_d(x, ub[u], ulo[u], uhi[u], s, g, K, d, m, offsets, gd, w)
+
+    return sig_vjp_wide_variant
+
+
+def sig_vjp_wide(d: int):
+    """The wide backward kernel (d >= 6, m >= 3; compiled on first use, without the GIL):
+    ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)`` writes the cotangents of the
+    segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d)."""
+    return _sig_vjp_wide_kernel(step_key(d))

@@ -76,14 +76,17 @@ def _signature_vjp_rev(x: np.ndarray, depth: int, g_rev: np.ndarray, part: np.nd
     per_unit = (n / nchunks) * 5 * d ** depth
     ngroups, first_alone = _split_units(nunits, d, depth)         # the same bits either way
     if ngroups:
-        _threads.run(lambda lo, hi: _vjp.sig_vjp_groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+        groups = _vjp.sig_vjp_groups(d)
+        _threads.run(lambda lo, hi: groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES))
     if d >= _WIDE:                                          # every unit alone, the top level in blocks
-        _threads.run(lambda lo, hi: _vjp_wide.sig_vjp_wide(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
+        wide = _vjp_wide.sig_vjp_wide(d)
+        _threads.run(lambda lo, hi: wide(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
                      _threads.ranges(nunits, per_unit))
     elif first_alone < nunits:
-        _threads.run(lambda lo, hi: _vjp.sig_vjp_units(x, *units, nchunks, depth, off, part, g_rev,
-                                                       first_alone + lo, first_alone + hi, gd),
+        alone = _vjp.sig_vjp_units(d)
+        _threads.run(lambda lo, hi: alone(x, *units, nchunks, depth, off, part, g_rev, first_alone + lo,
+                                          first_alone + hi, gd),
                      _threads.ranges(nunits - first_alone, per_unit))
     return _increments_to_points(gd, n)
 

@@ -41,7 +41,7 @@ def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     a = np.empty((6, off[m + 1]))
     b = np.empty_like(a)
     _lanes.scalar_units(x, *units, m, off, 0, 6, a)
-    _blocked.block_units(x, *units, m, off, 0, 6, b)
+    _blocked.block_units(x.shape[2], m)(x, *units, m, off, 0, 6, b)
     assert a.tobytes() == b.tobytes()
 
 

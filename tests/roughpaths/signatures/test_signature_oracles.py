@@ -153,7 +153,7 @@ def test_chunked_kernels_match_iisignature(rng, m, nchunks):
     xc = np.ascontiguousarray(x)
     if m == 2:
         part = np.empty((2 * nchunks, d + d * (d - 1) // 2))
-        _sig_level2.sig2_tasks(xc, nchunks, 0, 2 * nchunks, part)
+        _sig_level2.sig2_tasks(d)(xc, nchunks, 0, 2 * nchunks, part)
         got = _sig_level2.sig2_glue(part, 2, nchunks, d)
     else:
         off = np.zeros(m + 2, dtype=np.int64)
@@ -161,7 +161,7 @@ def test_chunked_kernels_match_iisignature(rng, m, nchunks):
             off[k + 1] = off[k] + d ** k
         ub, lo, hi = _units(x.shape[0], x.shape[1], nchunks)
         part = np.empty((2 * nchunks, off[m + 1]))
-        _sig_lanes.lane_groups(xc, ub, lo, hi, m, off, 0, 1, part)
+        _sig_lanes.lane_groups(d, m)(xc, ub, lo, hi, m, off, 0, 1, part)
         got = _sig_lanes.lane_glue(part, 2, nchunks, m, off)[:, _reversed_to_rowmajor(d, m)]
     np.testing.assert_allclose(got, ref, rtol=0, atol=TOL)
 

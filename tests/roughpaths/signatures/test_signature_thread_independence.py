@@ -56,7 +56,7 @@ def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m):
     lanes = np.empty_like(one)
     groups = -(-nu // kern.LANES)
     for g in range(groups):                       # one range per group, in reverse order
-        kern.lane_groups(x, *units, m, off, groups - 1 - g, groups - g, lanes)
+        kern.lane_groups(d, m)(x, *units, m, off, groups - 1 - g, groups - g, lanes)
     assert one.tobytes() == lanes.tobytes()
 
 
@@ -68,7 +68,7 @@ def test_lanes_with_empty_units():
     one = np.empty((12, off[4]))
     kern.scalar_units(x, *units, 3, off, 0, 12, one)
     lanes = np.full_like(one, np.nan)
-    kern.lane_groups(x, *units, 3, off, 0, 2, lanes)
+    kern.lane_groups(x.shape[2], 3)(x, *units, 3, off, 0, 2, lanes)
     assert one.tobytes() == lanes.tobytes()
 
 
@@ -101,9 +101,9 @@ def test_gradient_lanes_equal_one_unit_at_a_time(nchunks, d, m):
     off = _offsets(d, m)
     part = _reversed_parts(x, m, nchunks)
     one = np.zeros((9, 299, d))
-    _sig_vjp.sig_vjp_units(x, *units, nchunks, m, off, part, g, 0, nu, one)
+    _sig_vjp.sig_vjp_units(d)(x, *units, nchunks, m, off, part, g, 0, nu, one)
     lanes = np.full_like(one, np.nan)
     groups = -(-nu // kern.LANES)
     for grp in range(groups):                     # one range per group, in reverse order
-        _sig_vjp.sig_vjp_groups(x, *units, nchunks, m, off, part, g, groups - 1 - grp, groups - grp, lanes)
+        _sig_vjp.sig_vjp_groups(d)(x, *units, nchunks, m, off, part, g, groups - 1 - grp, groups - grp, lanes)
     assert one.tobytes() == lanes.tobytes()
