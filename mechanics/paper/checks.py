@@ -3,8 +3,10 @@
 Each check is a function ``check(ctx) -> CheckResult`` (see :class:`mechanics.paper.report.CheckResult`)
 that computes a *predicted* number from the theory (closed form, quadrature) and a *measured* one
 from a simulation or an independent computation with the library, compares them with a stated
-tolerance, and says pass or fail. Sizes come from ``ctx.size(...)`` (``tiny`` / ``default`` /
-``full``; their measured cost: ``docs/main-job.md``, section Cost).
+tolerance, and says pass or fail. Sizes come from ``ctx.size("TASK.WORD")``: their presets
+(``tiny`` / ``default`` / ``full``), kinds and meanings are declared in
+:data:`mechanics.paper.model.SIZES` (set on the command line with ``--set``; measured cost:
+``docs/main-job.md``, section Cost).
 
 The mathematics lives in :mod:`roughpaths` and :mod:`mechanics` (public names only); this module
 only calls it, through the same entry points as the tests (the Gibbs check of Theorem 3.1 through
@@ -67,8 +69,8 @@ _CHEN_CHUNK = 16        # paths per piece of the Chen check (memory ~ 16 x steps
 def check_chen(ctx) -> CheckResult:
     """Chen: XX_{0,T} = XX_{0,u} + XX_{u,T} + X_{0,u}⊗X_{u,T}, and = the naive sum over the steps."""
     rng = ctx.rng("chen")
-    n = ctx.size("chen.steps", tiny=200, default=10_000, full=100_000)
-    batch = ctx.size("chen.paths", tiny=4, default=64, full=256)
+    n = ctx.size("chen.n_steps")
+    batch = ctx.size("chen.n_paths")
     # the paths of _brownian(ctx, rng, batch, n, 3), generated CHUNK paths at a time (bitwise the same rows:
     # the driver's per-path streams), so that --full needs ~0.3 GB instead of ~9 GB
     seed = np.random.SeedSequence([int(v) for v in rng.integers(0, 2**63, size=2, dtype=np.int64)])
@@ -109,7 +111,7 @@ def check_chen(ctx) -> CheckResult:
 def check_levy_log(ctx) -> CheckResult:
     """log(X, XX) at level 2 is XX − ½ X⊗X = Alt(XX) for geometric paths (docs/conventions.md)."""
     rng = ctx.rng("levy_log")
-    n = ctx.size("levy_log.steps", tiny=100, default=2_000, full=20_000)
+    n = ctx.size("levy_log.n_steps")
     X = _brownian(ctx, rng, 32, n, 3)
     x, xx = X.increment(X.times[0], X.times[-1]), X.area(X.times[0], X.times[-1])
     out = roughpaths.level2_log(x, xx)
@@ -137,7 +139,7 @@ def check_brownian_levy_area(ctx) -> CheckResult:
     (by design, documented in the library), the predicted value is t²/4 minus that known per-step deficit
     (:func:`_area_variance_deficit`), and the check says so.
     """
-    P = ctx.size("brownian.paths", tiny=2_000, default=40_000, full=400_000)
+    P = ctx.size("brownian_levy_area.n_paths")
     t, n = 2.0, 4
     method = ctx.levy_area_for(2)
     grid = np.linspace(0.0, t, n + 1)
@@ -174,8 +176,8 @@ def check_brownian_levy_area(ctx) -> CheckResult:
 def check_friz_oberhauser(ctx) -> CheckResult:
     """Pathwise: solve on X.perturb(s) vs on X with the FO drift; difference -> 0 with the mesh."""
     rng = ctx.rng("friz_oberhauser")
-    P = ctx.size("fo.paths", tiny=8, default=64, full=256)
-    kmax = ctx.size("fo.log2_steps", tiny=8, default=11, full=13)
+    P = ctx.size("friz_oberhauser.n_paths")
+    kmax = ctx.size("friz_oberhauser.n_steps").bit_length() - 1   # a power of 2
     d, e = 3, 3
     M = rng.standard_normal((d, e, e)) * 0.5
     s = np.array([[0.0, 0.7, -0.4], [-0.7, 0.0, 0.3], [0.4, -0.3, 0.0]])
@@ -216,8 +218,8 @@ def check_friz_oberhauser(ctx) -> CheckResult:
 @register("prop21", "Proposition 2.1: perturbed driver = corrected rigid body, pathwise")
 def check_prop21(ctx) -> CheckResult:
     """The rigid body with s driven by X equals the one with s = 0 driven by X.perturb(s)."""
-    P = ctx.size("prop21.paths", tiny=4, default=32, full=128)
-    n = ctx.size("prop21.steps", tiny=200, default=4_000, full=20_000)
+    P = ctx.size("prop21.n_paths")
+    n = ctx.size("prop21.n_steps")
     s = s_matrix(s12=-50.0, s13=25.0, s23=25.0)
     X = roughpaths.brownian_rough_path(np.linspace(0.0, 10.0, n + 1), 3, ctx.rng("prop21"), batch_shape=(P,),
                                        levy_area=ctx.levy_area_for(3))
@@ -250,8 +252,8 @@ register("hamiltonian_reduction", "Section 2.3: Hamiltonian reduction of the lif
 
 @register("casimir", "Coadjoint integrators keep |Π| to round-off")
 def check_casimir(ctx) -> CheckResult:
-    n = ctx.size("casimir.steps", tiny=1_000, default=10_000, full=100_000)
-    P = ctx.size("casimir.paths", tiny=16, default=64, full=1_000)
+    n = ctx.size("casimir.n_steps")
+    P = ctx.size("casimir.n_paths")
     body = paper_body(s_matrix(s13=25.0), sigma=0.5)
     driver = roughpaths.BrownianDriver(3, seed=ctx.seed_for("casimir"), dt=0.01, n_steps=n, batch_shape=(P,),
                                        levy_area=ctx.levy_area_for(3))
@@ -305,11 +307,11 @@ def check_gibbs_mean(ctx) -> CheckResult:
     the printed torque sign; and the time averages of the uncorrected body and of the printed-sign
     body against the Gibbs mean of ``h̃``.
     """
-    P = ctx.size("gibbs.paths", tiny=8, default=64, full=512)
-    T = ctx.size("gibbs.T", tiny=40.0, default=300.0, full=1_000.0)
-    dt = ctx.size("gibbs.dt", tiny=0.01, default=0.005, full=0.002)
+    P = ctx.size("gibbs_mean.n_paths")
+    T = ctx.size("gibbs_mean.T")
+    dt = ctx.size("gibbs_mean.dt")
     # the wrong models miss by hundreds of standard errors: fewer paths suffice to reject them
-    P_wrong = ctx.size("gibbs.paths_wrong_models", tiny=8, default=16, full=32)
+    P_wrong = ctx.size("gibbs_mean.n_paths_wrong_models")
     burn = 30.0
     lines, ok_all, meas, preds = [], True, [], []
     for s in (s_matrix(s13=25.0), s_matrix(s23=25.0)):
@@ -351,7 +353,7 @@ def check_gibbs_mean(ctx) -> CheckResult:
 
 @register("uniform_no_dissipation", "Proposition 3.1: without dissipation the law tends to uniform on the sphere")
 def check_uniform(ctx) -> CheckResult:
-    P = ctx.size("uniform.paths", tiny=200, default=2_000, full=10_000)
+    P = ctx.size("uniform_no_dissipation.n_paths")
     T, dt = 30.0, 0.02
     body = paper_body(s_matrix(s12=-2.0, s13=1.0, s23=1.0), sigma=0.5, theta=0.0)
     n = int(T / dt)
@@ -426,7 +428,7 @@ def check_equilibria(ctx) -> CheckResult:
 def check_coloured_area_rate(ctx) -> CheckResult:
     A, D = roughpaths.paper_coloured_noise_matrices(1.0)   # k = 1: fast mixing, same structure as the paper's
     lim = roughpaths.coloured_noise_limit(A, D)
-    P = ctx.size("coloured.paths", tiny=50, default=400, full=2_000)
+    P = ctx.size("coloured_area_rate.n_paths")
     eps, T = 0.1, 5.0
     n = 500
     smp = roughpaths.sample_coloured_noise(A, D, eps, np.linspace(0.0, T, n + 1), rng=ctx.rng("coloured"), batch_shape=(P,))
@@ -451,8 +453,8 @@ def check_coloured_area_rate(ctx) -> CheckResult:
 @register("wong_zakai", "Wong–Zakai anomaly: coloured rigid body → limit with the Lévy torque, not without")
 def check_wong_zakai(ctx) -> CheckResult:
     A, D = roughpaths.paper_coloured_noise_matrices(0.05)
-    P = ctx.size("wz.paths", tiny=600, default=1_000, full=4_000)
-    eps = ctx.size("wz.eps", tiny=0.02, default=0.02, full=0.01)
+    P = ctx.size("wong_zakai.n_paths")
+    eps = ctx.size("wong_zakai.eps")
     T = 2.0
     r = mechanics.simulate_wong_zakai_rigid_body(A, D, eps, SIGMA, inertia=INERTIA, theta=THETA, Pi0=E3, T=T,
                                                  n_paths=P, rng=ctx.rng("wong_zakai"), save_every=10**9,

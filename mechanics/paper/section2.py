@@ -78,8 +78,8 @@ def _loop_ode(values, s):
 
 def check_forced_euler_poincare(ctx) -> CheckResult:
     """Forced rigid body (user F⁰ and Fⁱ) against the loop reference; double bracket as a force = theta."""
-    P = ctx.size("forced.paths", tiny=4, default=12, full=32)
-    kmax = ctx.size("forced.log2_steps", tiny=6, default=8, full=9)
+    P = ctx.size("forced_euler_poincare.n_paths")
+    kmax = ctx.size("forced_euler_poincare.n_steps").bit_length() - 1   # a power of 2
     rng = ctx.rng("forced_euler_poincare")
     so3 = mechanics.systems.so3()
     system = mechanics.LiePoissonSystem(so3, np.diag(_INERTIA), _XI, s=_S, force=_force, noise_forces=_noise_forces)
@@ -163,8 +163,8 @@ def _reduction_case(name):
 
 def check_hamiltonian_reduction(ctx) -> CheckResult:
     """Phase-space lift on X.perturb(s), mapped by J = the corrected Lie–Poisson solution on X."""
-    P = ctx.size("reduction.paths", tiny=2, default=4, full=8)
-    kmax = ctx.size("reduction.log2_steps", tiny=7, default=8, full=10)
+    P = ctx.size("hamiltonian_reduction.n_paths")
+    kmax = ctx.size("hamiltonian_reduction.n_steps").bit_length() - 1   # a power of 2
     ks = tuple(range(kmax - 4 if kmax < 10 else 4, kmax + 1, 2))
     rng = ctx.rng("hamiltonian_reduction")
     rows, ok, symp = [], True, 0.0

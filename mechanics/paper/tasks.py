@@ -3,7 +3,7 @@
 A :class:`Task` is a named function ``task(ctx) -> FigureResult | CheckResult``; the figures and the
 checks register themselves in :data:`mechanics.paper.figures.FIGURES` and
 :data:`mechanics.paper.checks.CHECKS` with :func:`registry_decorator`. Each task receives a
-:class:`Context`: the options of the run, sizes for the chosen scale, a random stream of its own
+:class:`Context`: the options of the run, its sizes (:data:`~.model.SIZES`), a random stream of its own
 (seeded by the run's seed and the task's name, so a task's numbers do not depend on which tasks ran
 before it, or whether the run was resumed), and a way to save its files into the output folder.
 """
@@ -19,6 +19,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .model import SIZES, size_spec
 from .output import npz_bytes
 
 __all__ = ["Task", "registry_decorator", "Context", "Progress", "DPI"]
@@ -37,6 +38,13 @@ class Task:
     caption: str = ""
 
     def run(self, ctx):
+        """Run the task on ``ctx``, which it names (:attr:`Context.task`) and which records all its sizes."""
+        if ctx.task is None:
+            ctx.task = self.name
+        if ctx.task != self.name:
+            raise ValueError(f"a context of task {ctx.task!r} was given to task {self.name!r}; make one per task")
+        for word in SIZES.get(self.name, {}):
+            ctx.sizes[f"{self.name}.{word}"] = ctx.size_value(self.name, word)
         return self.func(ctx)
 
 
@@ -126,27 +134,37 @@ class Context:
     ----------
     folder : RunFolder or None
         Where :meth:`save_figure` writes (None: nothing is saved, e.g. in tests of a single check).
+    task : str or None
+        The name of the figure or check being run (set by :meth:`Task.run` if not given).
     convention, seed, scale : str, int, str
         The run's options.
+    plan : dict or None
+        The run's sizes, ``{"TASK.WORD": value}`` (:func:`~.model.plan_sizes`: presets of ``scale``,
+        ``--paths-factor``, ``--steps-factor`` and ``--set``); None: the presets of ``scale``.
     levy_area : str
         The run's ``--levy-area``: the sampler of the Brownian Lévy areas (one of
         :data:`roughpaths.LEVY_AREA_METHODS`). Every Brownian driver a task creates with areas passes
         :meth:`levy_area_for` of its dimension (this value, but for ``"exact"`` at ``d > 2``).
     progress : Progress
     sizes : dict
-        The sizes the current task picked (``size``), recorded for the report.
+        The sizes of the current task, ``{"TASK.WORD": value}``, recorded for the report (all of the
+        task's sizes, whether or not it reads them on this run: a figure that reuses a cached run
+        reads none).
     files : dict
         ``{file name: {"size", "sha256"}}`` written by the current task.
     cache : dict
         Results shared between tasks (e.g. one coloured-noise run behind Figures 4 and 5); a cached
-        value must be a deterministic function of the seed and the sizes.
+        value must be a deterministic function of the seed and the task's sizes (the main job gives
+        tasks whose sizes differ different caches).
     """
 
     folder: Any = None
+    task: str | None = None
     convention: str = "rp"
     seed: int = 0
     levy_area: str = "auto"
     scale: str = "default"
+    plan: dict | None = None
     progress: Progress = field(default_factory=lambda: Progress(enabled=False))
     sizes: dict = field(default_factory=dict)
     files: dict = field(default_factory=dict)
@@ -168,10 +186,42 @@ class Context:
         """
         return "auto" if self.levy_area == "exact" and dim > 2 else self.levy_area
 
-    def size(self, key: str, *, tiny, default, full):
-        """Pick a size for the current scale and record it for the report's metadata."""
-        value = {"tiny": tiny, "default": default, "full": full}[self.scale]
-        self.sizes[key] = value
+    def size_value(self, task: str, word: str):
+        """The value of size ``word`` of ``task`` in this run: :attr:`plan`'s, else the preset's."""
+        key = f"{task}.{word}"
+        if self.plan is not None and key in self.plan:
+            return self.plan[key]
+        return size_spec(key).preset(self.scale)
+
+    def size(self, key: str, **presets):
+        """The value of the current task's size ``key`` in this run, recorded for the report.
+
+        Parameters
+        ----------
+        key : str
+            ``"TASK.WORD"`` of :data:`~.model.SIZES`; a key whose ``TASK`` is not the current task
+            (a helper shared by several tasks, e.g. ``"portrait.levels"``) means the current task's
+            ``WORD``.
+        **presets
+            ``tiny=``, ``default=``, ``full=``: optional, the presets the caller expects; they must be
+            those of :data:`~.model.SIZES` (``ValueError`` otherwise), so that they cannot drift apart.
+
+        Returns
+        -------
+        int or float
+        """
+        prefix, _, word = key.rpartition(".")
+        task = self.task if self.task is not None else prefix
+        if task not in SIZES or word not in SIZES[task]:
+            raise ValueError(f"size {key!r} of task {task!r} is not declared in mechanics.paper.model.SIZES; "
+                             "declare it there (its presets, kind and meaning)")
+        spec = SIZES[task][word]
+        wrong = {k: v for k, v in presets.items() if spec.preset(k) != v}
+        if wrong:
+            raise ValueError(f"size {key!r} of task {task!r}: the presets given ({wrong}) differ from those in "
+                             f"mechanics.paper.model.SIZES ({spec.tiny}, {spec.default}, {spec.full}); keep one")
+        value = self.size_value(task, word)
+        self.sizes[f"{task}.{word}"] = value
         return value
 
     def save_figure(self, name: str, fig, data: dict) -> tuple[str, str]:
