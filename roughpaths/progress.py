@@ -56,6 +56,11 @@ class ProgressRecord(NamedTuple):
     eta: float
 
 
+def _number(x: float) -> str:
+    """A count as an integer (12000, not 1.2e+04), anything else to 4 significant digits."""
+    return f"{x:.0f}" if x.is_integer() else f"{x:.4g}"
+
+
 def _clock(seconds: float) -> str:
     if not math.isfinite(seconds):
         return "?"
@@ -113,8 +118,8 @@ class Progress:
                 self._line()
             else:
                 self._bar = tqdm(total=total, initial=initial, desc=desc, unit=unit, file=sys.stderr,
-                                 bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} {unit} "
-                                            "[{elapsed}<{remaining}]")
+                                 unit_scale=True, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
+                                                             "{n_fmt}/{total_fmt} {unit} [{elapsed}<{remaining}]")
 
     def record(self) -> ProgressRecord:
         """The report of the work done so far."""
@@ -146,7 +151,7 @@ class Progress:
         self._drawn = now
         r = self.record()
         pct = 100.0 * r.done / r.total if r.total > 0 else 100.0
-        text = (f"{self.desc}: {pct:3.0f}% {r.done:.4g}/{r.total:.4g} {self.unit} "
+        text = (f"{self.desc}: {pct:3.0f}% {_number(r.done)}/{_number(r.total)} {self.unit} "
                 f"[{_clock(r.elapsed)} elapsed, {_clock(r.eta)} left]")
         pad = max(0, self._width - len(text))
         self._width = len(text)

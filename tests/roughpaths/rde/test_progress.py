@@ -172,7 +172,7 @@ def test_tqdm_gets_the_total_and_the_increments(monkeypatch):
     made = []
 
     class FakeBar:
-        def __init__(self, total, initial, desc, unit, file, bar_format):
+        def __init__(self, total, initial, desc, unit, **options):
             self.total, self.n, self.desc, self.unit, self.closed = total, initial, desc, unit, False
             self.updates = []
             made.append(self)
@@ -199,7 +199,7 @@ def test_real_tqdm_bar(capsys):
     pytest.importorskip("tqdm")
     rp.solve(rp.LinearVectorFields(M), _driver(), Y0, rp.Davie(), block_steps=BLOCK, progress=True)
     err = capsys.readouterr().err
-    assert "solve: 100%" in err and "300/300 member-steps" in err
+    assert "solve: 100%" in err and "300/300 member-steps" in err            # tqdm's unit_scale: 300 as is
 
 
 def test_resumed_work_estimates_from_this_runs_rate():
