@@ -8,7 +8,7 @@ every current browser reads), so that the report still opens offline as one file
 untrusted input: sizes are bounded, the font references must be plain KaTeX font names in the
 folder, and a script that could end its ``<script>`` element early is refused. Where anything is
 missing or wrong, :func:`load_katex` says why in a :class:`KatexUnavailable` and the report shows
-its formulas as plain HTML instead (:mod:`mechanics.paper._html_math`).
+its formulas as plain HTML instead (module ``_html_formula``).
 """
 
 from __future__ import annotations

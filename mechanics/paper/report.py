@@ -8,10 +8,11 @@ external resources) and ``results.json`` (the same results, machine-readable), w
 metadata (the command that reproduces it, seed, convention, Lévy-area sampler, sizes, versions).
 
 In ``report.html`` the formulas written in the claims, notes and captions (``XX_{s,t}``, ``σ²``,
-``Ad*_{exp σ_n}``) are found (module ``_html_math``) and typeset by KaTeX, embedded whole from the copy
-``tools/vendor_katex.sh`` puts in the source tree (module ``_html_katex``), so the page still opens
-offline as one file. Where that copy is missing (``./run.sh`` installs the Python dependencies only)
-the formulas are plain HTML with sub- and superscripts and the page says so; raw TeX is never shown.
+``Ad*_{exp σ_n}``) are found (modules ``_html_markup`` and ``_html_formula``) and typeset by KaTeX,
+embedded whole from the copy ``tools/vendor_katex.sh`` puts in the source tree (module ``_html_katex``),
+so the page still opens offline as one file. Where that copy is missing (``./run.sh`` installs the
+Python dependencies only) the formulas are plain HTML with sub- and superscripts and the page says so;
+raw TeX is never shown.
 ``report.md`` keeps the claims as the checks write them.
 
 The three files depend only on the results and the options, never on the clock or the output
@@ -36,7 +37,7 @@ import mechanics
 import roughpaths
 
 from ._html_katex import KATEX_DIR, KatexUnavailable, load_katex
-from ._html_math import markup
+from ._html_markup import markup
 
 __all__ = [
     "CheckResult", "FigureResult", "RunMetadata", "format_value", "write_report", "versions",
@@ -326,7 +327,7 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
                 katex_dir: str | os.PathLike | None = KATEX_DIR) -> str:
     """A self-contained HTML page (figures embedded as base64 PNG; ``read_file(name) -> bytes``).
 
-    The formulas in the claims, notes and captions are found (``_html_math.markup``) and
+    The formulas in the claims, notes and captions are found (``_html_markup.markup``) and
     typeset by KaTeX, embedded whole (script, style sheet, fonts as ``data:`` URIs) from ``katex_dir``
     (default: where ``tools/vendor_katex.sh`` vendors it in the source tree). Without KaTeX
     (``katex_dir=None``, or a folder ``_html_katex.load_katex`` refuses) they are plain HTML with

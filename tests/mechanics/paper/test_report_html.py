@@ -1,7 +1,7 @@
 """report.html: the formulas of the claims are found and typeset (KaTeX source, or plain HTML without KaTeX),
 KaTeX is embedded whole or refused with a reason, and no raw TeX reaches the reader.
 
-Oracles: TeX and HTML written by hand for the claims' notations (not produced by the module's helpers);
+Oracles: TeX and HTML written by hand for the claims' notations (not produced by the modules' helpers);
 the embedded fonts are compared with the bytes written into a fake KaTeX folder; the visible text of a
 page is collected by the standard library's HTML parser.
 """
@@ -19,7 +19,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from mechanics.paper._html_katex import KATEX_DIR, KatexUnavailable, load_katex
-from mechanics.paper._html_math import formula_html, formula_tex, markup, split_formulas
+from mechanics.paper._html_formula import formula_html, formula_tex
+from mechanics.paper._html_markup import markup, split_formulas
 from mechanics.paper.checks import CHECKS
 from mechanics.paper.figures import FIGURES
 from mechanics.paper.report import CheckResult, FigureResult, RunMetadata, render_html
