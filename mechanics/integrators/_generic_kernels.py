@@ -38,6 +38,7 @@ on its block, its neighbours or the thread. The implicit midpoint rule runs the 
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numba
 import numpy as np
@@ -198,144 +199,156 @@ def _eta_rows(dX, dXX, area, lo, bc, k0, kc, xi, brk, pi, pj, e):
 STEPS = 16
 
 
-@numba.njit(cache=True, nogil=True)
-def _run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
-               degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
-    """Members lo .. hi-1 over every step of the block; returns the number of members that failed."""
-    n = y.shape[1]
-    bc = hi - lo
-    nk = dX.shape[1]
-    area = dXX.shape[0] > 0
-    mu, w0, s = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
-    ebuf = np.empty((STEPS, n, bc))
-    a1, a2, pred, w1 = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
-    g, t1, t2, term, term2 = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
-    th = np.empty(bc)
-    big = np.empty(bc, dtype=np.bool_)
-    work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, 2 * n)),
-            np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
-    vs, vm, vo, ve = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    lim = degth[degth.shape[0] - 1]
-    for p in range(bc):
-        for i in range(n):
-            mu[i, p] = y[lo + p, i]
-    nfail = 0
-    slot = 0
-    for k in range(nk):
-        dt = dts[k]
-        kk = k % STEPS
-        if kk == 0:
-            _eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
-        e = ebuf[kk]
-        nbig = 0
-        if code == 2:
-            for p in range(bc):
-                big[p] = True
-            nbig = bc
-        else:
-            _velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, w0, ti, tk, tv, start, bc)
+@lru_cache(maxsize=None)
+def _block_kernel(C: int, N: int):
+    """The compiled block kernel for scheme ``C`` (0 LieEuler, 1 LieHeun, 2 implicit midpoint) and, for the
+    midpoint rule, the compile-time dimension ``N`` (3, 6; 0 reads it from the arrays).
+
+    Each variant is its own kernel, compiled on first use and cached: a LieHeun solve compiles neither
+    the chord iteration nor its three dimension variants (which cost most of the kernel's compile time).
+    """
+
+    @numba.njit(cache=True, nogil=True)
+    def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
+                  degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
+        """Members lo .. hi-1 over every step of the block; returns the number of members that failed
+        (``code`` is the scheme the variant was made for, ``C``)."""
+        n = y.shape[1]
+        bc = hi - lo
+        nk = dX.shape[1]
+        area = dXX.shape[0] > 0
+        mu, w0, s = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
+        ebuf = np.empty((STEPS, n, bc))
+        a1, a2, pred, w1 = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
+        g, t1, t2, term, term2 = np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc)), np.empty((n, bc))
+        th = np.empty(bc)
+        big = np.empty(bc, dtype=np.bool_)
+        work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, 2 * n)),
+                np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
+        vs, vm, vo, ve = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+        lim = degth[degth.shape[0] - 1]
+        for p in range(bc):
             for i in range(n):
-                si, wi, ei = s[i], w0[i], e[i]
+                mu[i, p] = y[lo + p, i]
+        nfail = 0
+        slot = 0
+        for k in range(nk):
+            dt = dts[k]
+            kk = k % STEPS
+            if kk == 0:
+                _eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
+            e = ebuf[kk]
+            nbig = 0
+            if C == 2:
                 for p in range(bc):
-                    si[p] = wi[p] * dt + ei[p]
-            if code == 1:
-                # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
-                _ad_star_rows(s, mu, a1, ti, tk, tv, start, bc)
-                _ad_star_rows(s, a1, a2, ti, tk, tv, start, bc)
+                    big[p] = True
+                nbig = bc
+            else:
+                _velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, w0, ti, tk, tv, start, bc)
                 for i in range(n):
-                    pr, mi, b1, b2 = pred[i], mu[i], a1[i], a2[i]
+                    si, wi, ei = s[i], w0[i], e[i]
                     for p in range(bc):
-                        pr[p] = mi[p] + b1[p] + 0.5 * b2[p]
-                _velocity_rows(pred, lin, f, has_f, theta, qs, mts, g, t1, t2, w1, ti, tk, tv, start, bc)
+                        si[p] = wi[p] * dt + ei[p]
+                if C == 1:
+                    # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
+                    _ad_star_rows(s, mu, a1, ti, tk, tv, start, bc)
+                    _ad_star_rows(s, a1, a2, ti, tk, tv, start, bc)
+                    for i in range(n):
+                        pr, mi, b1, b2 = pred[i], mu[i], a1[i], a2[i]
+                        for p in range(bc):
+                            pr[p] = mi[p] + b1[p] + 0.5 * b2[p]
+                    _velocity_rows(pred, lin, f, has_f, theta, qs, mts, g, t1, t2, w1, ti, tk, tv, start, bc)
+                    for i in range(n):
+                        si, wi, vi, ei = s[i], w0[i], w1[i], e[i]
+                        for p in range(bc):
+                            si[p] = 0.5 * (wi[p] + vi[p]) * dt + ei[p]
+                # exp(ad*_s) mu: Taylor on the vector, each member to its own degree (select, not multiply)
+                for p in range(bc):
+                    th[p] = 0.0
                 for i in range(n):
-                    si, wi, vi, ei = s[i], w0[i], w1[i], e[i]
+                    ci = cnorm[i]
+                    si = s[i]
                     for p in range(bc):
-                        si[p] = 0.5 * (wi[p] + vi[p]) * dt + ei[p]
-            # exp(ad*_s) mu: Taylor on the vector, each member to its own degree (select, not multiply)
-            for p in range(bc):
-                th[p] = 0.0
+                        th[p] += abs(si[p]) * ci
+                thmax = 0.0
+                for p in range(bc):
+                    b = not (th[p] <= lim)                 # NaN too: the scalar path diagnoses it
+                    big[p] = b
+                    nbig += b
+                    if not b:
+                        thmax = max(thmax, th[p])
+                r = 1
+                while thmax > degth[r - 1]:                # a1: the sum, term: the current term
+                    _ad_star_rows(s, mu if r == 1 else term, term2, ti, tk, tv, start, bc)
+                    inv = 1.0 / r
+                    lev = degth[r - 1]
+                    for i in range(n):
+                        tt, t2i, ai, mi = term[i], term2[i], a1[i], mu[i]
+                        if r == 1:
+                            for p in range(bc):
+                                x = t2i[p] * inv
+                                tt[p] = x
+                                ai[p] = mi[p] + x if th[p] > lev else mi[p]
+                        else:
+                            for p in range(bc):
+                                x = t2i[p] * inv
+                                tt[p] = x
+                                ai[p] = ai[p] + x if th[p] > lev else ai[p]
+                    r += 1
+                if r > 1:
+                    for i in range(n):
+                        mi, ai = mu[i], a1[i]
+                        for p in range(bc):
+                            mi[p] = ai[p] if not big[p] else mi[p]
+            if nbig > 0:
+                for p in range(bc):
+                    if not big[p]:
+                        continue
+                    finite_in = True
+                    for i in range(n):
+                        vm[i] = mu[i, p]
+                        ve[i] = e[i, p]
+                        vs[i] = s[i, p]
+                        if not (math.isfinite(vm[i]) and math.isfinite(ve[i])):
+                            finite_in = False
+                    ok = False
+                    chord_failed = False
+                    if finite_in and C == 2:                 # dimensions 3 and 6: compiled variants (DIMS3/6)
+                        if N == 6:
+                            ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                         ti, tj, tk, tv, cnorm, degth, work, DIMS6)
+                        elif N == 3:
+                            ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                         ti, tj, tk, tv, cnorm, degth, work, DIMS3)
+                        else:
+                            ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
+                                                         ti, tj, tk, tv, cnorm, degth, work)
+                    elif finite_in:
+                        ok = exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
+                                  cnorm, degth)
+                    if ok:
+                        for i in range(n):
+                            mu[i, p] = vo[i]
+                    else:
+                        for i in range(n):
+                            mu[i, p] = np.nan
+                        if first_bad[lo + p] < 0:
+                            first_bad[lo + p] = k
+                            reason[lo + p] = CHORD_FAILED if chord_failed else NON_FINITE
+                            nfail += 1
+            if save[k]:
+                for p in range(bc):
+                    for i in range(n):
+                        out[lo + p, slot, i] = mu[i, p]
+                slot += 1
+            if stop and nfail > 0:
+                break
+        for p in range(bc):
             for i in range(n):
-                ci = cnorm[i]
-                si = s[i]
-                for p in range(bc):
-                    th[p] += abs(si[p]) * ci
-            thmax = 0.0
-            for p in range(bc):
-                b = not (th[p] <= lim)                 # NaN too: the scalar path diagnoses it
-                big[p] = b
-                nbig += b
-                if not b:
-                    thmax = max(thmax, th[p])
-            r = 1
-            while thmax > degth[r - 1]:                # a1: the sum, term: the current term
-                _ad_star_rows(s, mu if r == 1 else term, term2, ti, tk, tv, start, bc)
-                inv = 1.0 / r
-                lev = degth[r - 1]
-                for i in range(n):
-                    tt, t2i, ai, mi = term[i], term2[i], a1[i], mu[i]
-                    if r == 1:
-                        for p in range(bc):
-                            x = t2i[p] * inv
-                            tt[p] = x
-                            ai[p] = mi[p] + x if th[p] > lev else mi[p]
-                    else:
-                        for p in range(bc):
-                            x = t2i[p] * inv
-                            tt[p] = x
-                            ai[p] = ai[p] + x if th[p] > lev else ai[p]
-                r += 1
-            if r > 1:
-                for i in range(n):
-                    mi, ai = mu[i], a1[i]
-                    for p in range(bc):
-                        mi[p] = ai[p] if not big[p] else mi[p]
-        if nbig > 0:
-            for p in range(bc):
-                if not big[p]:
-                    continue
-                finite_in = True
-                for i in range(n):
-                    vm[i] = mu[i, p]
-                    ve[i] = e[i, p]
-                    vs[i] = s[i, p]
-                    if not (math.isfinite(vm[i]) and math.isfinite(ve[i])):
-                        finite_in = False
-                ok = False
-                chord_failed = False
-                if finite_in and code == 2:              # dimensions 3 and 6: compiled variants (DIMS3/6)
-                    if n == 6:
-                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
-                                                     ti, tj, tk, tv, cnorm, degth, work, DIMS6)
-                    elif n == 3:
-                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
-                                                     ti, tj, tk, tv, cnorm, degth, work, DIMS3)
-                    else:
-                        ok, chord_failed = midpoint1(vm, ve, vs, vo, dt, q, qs, lin, f, mts, theta, tol, max_iter,
-                                                     ti, tj, tk, tv, cnorm, degth, work)
-                elif finite_in:
-                    ok = exp1(vs, vm, vo, work[5], work[6], work[7], work[8][6], work[8][7], ti, tj, tk, tv,
-                              cnorm, degth)
-                if ok:
-                    for i in range(n):
-                        mu[i, p] = vo[i]
-                else:
-                    for i in range(n):
-                        mu[i, p] = np.nan
-                    if first_bad[lo + p] < 0:
-                        first_bad[lo + p] = k
-                        reason[lo + p] = CHORD_FAILED if chord_failed else NON_FINITE
-                        nfail += 1
-        if save[k]:
-            for p in range(bc):
-                for i in range(n):
-                    out[lo + p, slot, i] = mu[i, p]
-            slot += 1
-        if stop and nfail > 0:
-            break
-    for p in range(bc):
-        for i in range(n):
-            y[lo + p, i] = mu[i, p]
-    return nfail
+                y[lo + p, i] = mu[i, p]
+        return nfail
+
+    return run_block
 
 
 def _readonly(a):
@@ -373,5 +386,6 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
             bool(stop_on_failure))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
-    parallel_ranges(lambda lo, hi: _run_block(*args, lo, hi, *tail), nb, BLOCK)
+    kernel = _block_kernel(int(code), n if code == 2 and n in (3, 6) else 0)
+    parallel_ranges(lambda lo, hi: kernel(*args, lo, hi, *tail), nb, BLOCK)
     return y, out, first_bad, reason

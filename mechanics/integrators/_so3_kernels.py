@@ -172,7 +172,7 @@ def coefficients(data):
     return coef
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k):
     """Advance every member of ``m`` (3, B) by one coadjoint step with stochastic velocities ``e`` (3, B).
 
@@ -354,7 +354,7 @@ def _velocities(dX, dXX, xi, brk, pi, pj, k0, tile):
             tile[p, t, 2] = e2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _so3_dx_block(m, dX, dXX, xi, brk, pi, pj, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta, save,
                   out, first_bad, reason, stop):
     """Advance m (3, B) over the increments ``dX`` (B, K, m) and areas ``dXX`` (:func:`_velocities`, formed
@@ -389,22 +389,30 @@ def _so3_dx_block(m, dX, dXX, xi, brk, pi, pj, dts, e, bad, coef, code, tol, max
 BLOCK = 256
 
 
-@numba.njit(cache=True, nogil=True)
-def _so3_range(y, dX, dXX, xi, brk, pi, pj, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
-               first_bad, reason, stop, lo, hi):
-    """Run :func:`_so3_dx_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
-    a member's result does not depend on its block)."""
-    bc = hi - lo
-    m = np.empty((3, bc))
-    for p in range(bc):
-        for i in range(3):
-            m[i, p] = y[lo + p, i]
-    _so3_dx_block(m, dX[lo:hi], dXX[lo:hi] if dXX.shape[0] > 0 else dXX, xi, brk, pi, pj, dts,
-                  np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, code, tol, max_iter, q, lin, minv, theta,
-                  save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
-    for p in range(bc):
-        for i in range(3):
-            y[lo + p, i] = m[i, p]
+@functools.lru_cache(maxsize=None)
+def _range_kernel(C: int):
+    """The compiled :func:`_so3_dx_block` over a range of members for scheme ``C`` (0 Lie–Euler, 1 Lie–Heun,
+    2 implicit midpoint), a compile-time constant: each scheme is its own kernel, compiled on first use and
+    cached, so a Lie–Heun solve does not compile the chord iteration of the midpoint rule."""
+
+    @numba.njit(cache=True, nogil=True)
+    def so3_range(y, dX, dXX, xi, brk, pi, pj, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
+                  first_bad, reason, stop, lo, hi):
+        """Run :func:`_so3_dx_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
+        a member's result does not depend on its block); ``code`` is the variant's ``C``."""
+        bc = hi - lo
+        m = np.empty((3, bc))
+        for p in range(bc):
+            for i in range(3):
+                m[i, p] = y[lo + p, i]
+        _so3_dx_block(m, dX[lo:hi], dXX[lo:hi] if dXX.shape[0] > 0 else dXX, xi, brk, pi, pj, dts,
+                      np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, C, tol, max_iter, q, lin, minv, theta,
+                      save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
+        for p in range(bc):
+            for i in range(3):
+                y[lo + p, i] = m[i, p]
+
+    return so3_range
 
 
 def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
@@ -428,7 +436,8 @@ def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
             brk, pi, pj, np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol), int(max_iter),
             data["q"], lin, data["metric_inv"], float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out,
             first_bad, reason, bool(stop_on_failure))
-    parallel_ranges(lambda lo, hi: _so3_range(*args, lo, hi), nb, BLOCK)
+    kernel = _range_kernel(int(code))
+    parallel_ranges(lambda lo, hi: kernel(*args, lo, hi), nb, BLOCK)
     return y, out, first_bad, reason
 
 
