@@ -203,7 +203,8 @@ def _pcg64_rounds(sh, sl, ih, il, out, buf, left, i):
         need = n - i
         if left + need > buf.size:
             nb = np.empty(left + need + 64, dtype=np.uint64)
-            nb[:left] = buf[:left]
+            for j in range(left):            # a loop, not nb[:left] = buf[:left]: the slice's shape check
+                nb[j] = buf[j]               # compiles numba's error formatting (~3 s of CPU)
             buf = nb
         for j in range(left, left + need):
             sh, sl = _lcg(sh, sl, ih, il)
@@ -307,9 +308,12 @@ def _fast_streams_ok() -> bool:
                     ss = np.random.SeedSequence(ent, spawn_key=base)
                     keys = [(0, 0), (1, 1), (2**33 + 5, 0)]
                     s = PathStreams(ss, keys, _force_numpy=False)
-                    got = np.empty((len(keys), 3000))
-                    s.fill(got[:, :1000])
-                    s.fill(got[:, 1000:])
+                    # two contiguous blocks (the layout every caller passes: a strided one would
+                    # compile a second specialisation of the kernels, ~15 s of CPU, for this check alone)
+                    first, rest = np.empty((len(keys), 1000)), np.empty((len(keys), 2000))
+                    s.fill(first)
+                    s.fill(rest)
+                    got = np.concatenate([first, rest], axis=1)
                     for j, k in enumerate(keys):
                         g = np.random.Generator(np.random.PCG64(
                             np.random.SeedSequence(ent, spawn_key=base + k)))
