@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ._inputs import _as_c, _check_radius, _check_theta
 from ._sphere import _tangent_basis
@@ -224,6 +223,8 @@ def rigid_body_equilibria(inertia, c=None, *, radius=1.0, theta=0.0):
             return max(beta / r * 1e-8, 8.0 * float(np.spacing(abs(p) + tol_a)))
 
         def root(f, x0, x1):
+            from scipy.optimize import brentq        # lazy: scipy.optimize costs ~0.2 s of import mechanics
+
             return brentq(f, x0, x1, xtol=1e-300, rtol=1e-15, maxiter=500)
 
         roots = []

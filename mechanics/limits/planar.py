@@ -29,7 +29,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from roughpaths import ColouredNoiseDriver, ColouredNoiseLimit, LinearVectorFields, coloured_noise_limit
 from roughpaths.validation import as_float_array, check_batch_shape, check_positive_real, check_real
@@ -183,6 +182,8 @@ def planar_limit_moments(ex: PlanarExample, x0, T, *, torque: bool = True):
     V = ex.limit_vector_fields(torque=torque)
     G = V.matrices
     B = V.drift_matrix + 0.5 * np.einsum("kab,kbc->ac", G, G)
+    import scipy.linalg as sla                                 # lazy: keeps import mechanics light
+
     mean = sla.expm(B * T) @ x0
     I2 = np.eye(2)
     L = np.kron(I2, B) + np.kron(B, I2) + sum(np.kron(g, g) for g in G)

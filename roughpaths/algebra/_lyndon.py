@@ -28,7 +28,6 @@ from collections import OrderedDict
 from functools import lru_cache
 
 import numpy as np
-import scipy.sparse as sp
 
 __all__ = ["lyndon_words", "standard_factorisation", "bracket_string", "level_expansion",
            "expansion_matrix",
@@ -50,7 +49,7 @@ class _ByteLRU:
     def _size(value) -> int:
         if isinstance(value, np.ndarray):
             return value.nbytes
-        if sp.issparse(value):
+        if _is_sparse(value):
             return value.data.nbytes + value.indices.nbytes + value.indptr.nbytes
         if isinstance(value, (tuple, list)):
             return sum(_ByteLRU._size(v) for v in value)
@@ -75,6 +74,18 @@ class _ByteLRU:
 
 
 _CACHE = _ByteLRU(CACHE_BYTES)
+
+
+
+def _sparse():
+    """scipy.sparse, imported on first use (it costs ~0.1 s of ``import roughpaths`` otherwise)."""
+    import scipy.sparse
+
+    return scipy.sparse
+
+
+def _is_sparse(value) -> bool:
+    return "scipy.sparse" in type(value).__module__ and _sparse().issparse(value)
 
 
 def cache_clear() -> None:
@@ -227,7 +238,7 @@ def level_expansion(dim: int, k: int) -> tuple:
                       lambda: _expand_rows(dim, k, np.arange(count_lyndon_words(dim, k), dtype=np.int64)))
 
 
-def expansion_matrix(dim: int, k: int) -> sp.csr_matrix:
+def expansion_matrix(dim: int, k: int):
     """Sparse ``(n_k, dim**k)`` matrix whose row ``j`` is the tensor expansion of ``P(w_j)``."""
     def build():
         n_k, width = count_lyndon_words(dim, k), 2 ** (k - 1)
@@ -235,14 +246,14 @@ def expansion_matrix(dim: int, k: int) -> sp.csr_matrix:
         for rows in _row_blocks(n_k, width):
             idx, sgn = _expand_rows(dim, k, rows)
             r = np.repeat(np.arange(rows.shape[0], dtype=np.int64), width)
-            blk = sp.csr_matrix((sgn.reshape(-1).astype(np.float64), (r, idx.reshape(-1))),
+            blk = _sparse().csr_matrix((sgn.reshape(-1).astype(np.float64), (r, idx.reshape(-1))),
                                 shape=(rows.shape[0], dim ** k))
             blk.sum_duplicates()
             blk.eliminate_zeros()
             blocks.append(blk)
         if not blocks:                                      # no Lyndon word of length k (dim = 1, k > 1)
-            return sp.csr_matrix((0, dim ** k))
-        return sp.vstack(blocks, format="csr")
+            return _sparse().csr_matrix((0, dim ** k))
+        return _sparse().vstack(blocks, format="csr")
     return _CACHE.get(("E", dim, k), build)
 
 
@@ -256,7 +267,7 @@ def lyndon_projection(dim: int, k: int) -> tuple:
         lidx = lyndon_indices(dim, k)
         n_k = lidx.shape[0]
         if k == 1 or n_k == 0:                               # n_k = 0: dim = 1, k > 1
-            m = sp.csr_matrix((n_k, n_k))
+            m = _sparse().csr_matrix((n_k, n_k))
         else:
             ri, ci, vi = [], [], []
             table = None
@@ -275,12 +286,12 @@ def lyndon_projection(dim: int, k: int) -> tuple:
                 ri.append(p[hit])
                 ci.append(np.broadcast_to(rows[:, None], terms.shape)[hit])
                 vi.append(sgn[hit].astype(np.float64))
-            m = sp.csr_matrix((np.concatenate(vi), (np.concatenate(ri), np.concatenate(ci))),
+            m = _sparse().csr_matrix((np.concatenate(vi), (np.concatenate(ri), np.concatenate(ci))),
                               shape=(n_k, n_k))
             m.sum_duplicates()
             if not np.array_equal(m.diagonal(), np.ones(n_k)):
                 raise AssertionError("Lyndon projection: M is not unit triangular")
-            m = sp.tril(m, k=-1, format="csr")
+            m = _sparse().tril(m, k=-1, format="csr")
             m.eliminate_zeros()
             if m.nnz and np.any(m.indices >= np.repeat(np.arange(n_k), np.diff(m.indptr))):
                 raise AssertionError("Lyndon projection: M is not lower triangular")

@@ -51,7 +51,6 @@ import numbers
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..validation import as_float_array, check_positive_real
 
@@ -69,6 +68,13 @@ _K_XU, _K_XV, _K_UV = -0.1, 0.1, -1.0 / 60.0
 
 
 # ---------------------------------------------------------------------------------------- checks
+
+def _sla():
+    """scipy.linalg, imported on first use (keeps ``import roughpaths`` light)."""
+    import scipy.linalg
+
+    return scipy.linalg
+
 def _check_eps(eps) -> float:
     if isinstance(eps, (bool, np.bool_)) or not isinstance(eps, numbers.Real):
         raise TypeError(f"eps must be a positive real number, got {eps!r}.")
@@ -102,7 +108,7 @@ def _check_AD(A, D):
 
 def _lyapunov(A, D):
     """Stationary covariance Σ with ``AΣ + ΣAᵀ = DDᵀ``; raise if singular."""
-    Sigma = sla.solve_continuous_lyapunov(A, D @ D.T)
+    Sigma = _sla().solve_continuous_lyapunov(A, D @ D.T)
     Sigma = 0.5 * (Sigma + Sigma.T)
     w = np.linalg.eigvalsh(Sigma)
     if w[0] <= 1e-10 * max(w[-1], 1e-300):
@@ -225,7 +231,7 @@ def _van_loan(F, GGt, delta):
     C[:k, :k] = -F
     C[:k, k:] = GGt
     C[k:, k:] = F.T
-    E = sla.expm(C * d0)
+    E = _sla().expm(C * d0)
     Phi = E[k:, k:].T
     Q = Phi @ E[:k, k:]
     for _ in range(j):
@@ -313,7 +319,7 @@ def expected_area_rate(A, D, eps, window):
     Sigma = _lyapunov(A, D)
     AiT = np.linalg.inv(A).T
     w = check_positive_real(window, "window")
-    return Sigma @ AiT - (eps ** 2 / w) * Sigma @ AiT @ AiT @ (np.eye(A.shape[0]) - sla.expm(-A.T * w / eps ** 2))
+    return Sigma @ AiT - (eps ** 2 / w) * Sigma @ AiT @ AiT @ (np.eye(A.shape[0]) - _sla().expm(-A.T * w / eps ** 2))
 
 
 def lift_area_rate(A, D, substep, *, hermite: bool = True):
@@ -341,14 +347,14 @@ def lift_area_rate(A, D, substep, *, hermite: bool = True):
     n = A.shape[0]
     Sigma = _lyapunov(A, D)
     AiT = np.linalg.inv(A).T
-    E = sla.expm(-A.T * delta)
+    E = _sla().expm(-A.T * delta)
     rate = Sigma @ AiT @ AiT @ (np.eye(n) - E) / delta
     Tm, Q = _fast_law(A, D, delta)                                       # each sub-step's ½ x⊗x
     TJ = Tm[n:2 * n]
     rate = rate + 0.5 * (TJ @ Sigma @ TJ.T + Q[n:2 * n, n:2 * n]) / delta
     if hermite:
         Ai = np.linalg.inv(A)
-        EJy0 = Ai @ (np.eye(n) - sla.expm(-A * delta)) @ Sigma          # E[J ỹ_0ᵀ]
+        EJy0 = Ai @ (np.eye(n) - _sla().expm(-A * delta)) @ Sigma          # E[J ỹ_0ᵀ]
         EJy1 = Sigma @ AiT @ (np.eye(n) - E)                             # E[J ỹ_δᵀ]
         Ey0y1 = Sigma @ E                                                # E[ỹ_0 ỹ_δᵀ]
 

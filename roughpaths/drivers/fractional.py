@@ -46,8 +46,6 @@ from __future__ import annotations
 import numbers
 
 import numpy as np
-import scipy.fft
-import scipy.linalg
 
 from ..paths.rough_path import RoughPath
 from ..paths.rough_path_n import RoughPathN
@@ -108,6 +106,8 @@ def _davies_harte(gamma_ext: np.ndarray, n_series: int, rng: np.random.Generator
     K = gamma_ext.shape[0] - 1
     row = np.concatenate([gamma_ext, gamma_ext[K - 1:0:-1]])
     M = row.shape[0]
+    import scipy.fft                                       # lazy: keeps import roughpaths light
+
     lam = scipy.fft.fft(row).real                          # circulant eigenvalues (row is symmetric)
     tol = 1e-10 * float(np.max(np.abs(lam)))
     if float(np.min(lam)) < -tol:
@@ -131,6 +131,8 @@ def _cholesky(gamma: np.ndarray, n_series: int, rng: np.random.Generator) -> np.
                          f"{_MAX_CHOLESKY} steps. Use method='davies-harte'.")
     idx = np.arange(K)
     C = gamma[np.abs(idx[:, None] - idx[None, :])]
+    import scipy.linalg                                    # lazy: keeps import roughpaths light
+
     L = scipy.linalg.cholesky(C, lower=True)
     z = rng.standard_normal((n_series, K))
     return z @ L.T
