@@ -238,8 +238,8 @@ def check_size(key: str, value) -> int | float:
         raise ValueError(f"{what} must be a number, got {value!r}") from None
     if spec.kind == "positive":
         if not (math.isfinite(x) and x > 0 and x >= spec.minimum):
-            raise ValueError(f"{what} must be a positive real number" + (f" >= {spec.minimum:g}" if spec.minimum else "")
-                             + f", got {value!r}")
+            floor = f" >= {spec.minimum:g}" if spec.minimum else ""
+            raise ValueError(f"{what} must be a positive real number{floor}, got {value!r}")
         return x
     whole = math.isfinite(x) and x == math.floor(x) and x >= spec.minimum
     if spec.kind == "power of 2":
@@ -258,10 +258,10 @@ def check_task_sizes(task: str, sizes: dict) -> None:
 
     Examples
     --------
-    >>> check_task_sizes("fig1", {"T": 1.0, "dt": 0.3})
+    >>> check_task_sizes("fig1", {"T": 1.0, "dt": 0.3})  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    mechanics.paper.model.SizeError: fig1: T/dt = 1/0.3 = 3.333 is not a whole number of steps; choose a dt that divides T = 1 (or a T that is a multiple of dt)
+    mechanics.paper.model.SizeError: fig1: T/dt = 1/0.3 = 3.333 is not a whole number of steps; choose a dt ...
     """
     if "T" in sizes and "dt" in sizes:
         T, dt = sizes["T"], sizes["dt"]
@@ -352,7 +352,8 @@ def plan_sizes(scale: str, tasks, *, settings: dict | None = None, paths_factor:
 
 # ------------------------------------------------------------------------------------------------ costs
 def _coloured_steps(T: float, eps: float) -> float:
-    """Steps of the paper's coloured-noise runs (k = 0.05): ``T / h``, ``h = ε²/(2‖A‖)``, ``‖A‖ = √(1 + k²)``."""
+    """Steps of the paper's coloured-noise runs (k = 0.05): ``T / h``, ``h = ε²/(2‖A‖)``,
+    ``‖A‖ = √(1 + k²)``."""
     return T * 2.0 * math.hypot(1.0, 0.05) / eps**2
 
 
