@@ -431,19 +431,26 @@ def _estimate_line(est: CostEstimate) -> str:
             + f"; {ESTIMATE_ACCURACY} (docs/main-job.md, Cost)")
 
 
-def _refuse_other_sizes(folder: RunFolder, opts: Options) -> None:
-    """``--resume``: refuse, naming the differences, an unfinished run whose sizes differ from this run's.
+def _refuse_other_sizes(folder: RunFolder, opts: Options, *, complete: bool = False) -> None:
+    """``--resume``: refuse, naming the differences, a run whose sizes differ from this run's.
 
-    (The folder's own check compares every option too; this one names only the sizes that differ.)
+    The unfinished run in ``OUT.incomplete`` (its record), or with ``complete=True`` the completed run in
+    ``OUT`` (its manifest), which ``--resume`` would otherwise report as done. (The folder's own check
+    compares every option of an unfinished run too; this one names only the sizes that differ.)
     """
+    where = folder.final if complete else folder.staging
     try:
-        old = json.loads((folder.staging / PROGRESS).read_text(encoding="utf-8"))["run"]["sizes"]
-        old = dict(old)
+        text = (where / ("manifest.json" if complete else PROGRESS)).read_text(encoding="utf-8")
+        old = dict(json.loads(text)["sizes"] if complete else json.loads(text)["run"]["sizes"])
     except (OSError, ValueError, KeyError, TypeError):
         return
     diffs = [f"{k}: {old[k]!r} then, {v!r} now" for k, v in opts.sizes.items() if k in old and old[k] != v]
+    if diffs and complete:
+        raise UsageError(f"--resume: the run in '{folder.show(where)}' is complete and used other sizes "
+                         f"({'; '.join(diffs)}); nothing was run: to run these sizes, pass --overwrite (replaces it) "
+                         "or another --output")
     if diffs:
-        raise UsageError(f"--resume: the unfinished run in '{folder.show(folder.staging)}' used other sizes "
+        raise UsageError(f"--resume: the unfinished run in '{folder.show(where)}' used other sizes "
                          f"({'; '.join(diffs)}); resume it with its sizes, or start over with --overwrite")
 
 
@@ -529,6 +536,7 @@ def run(opts: Options) -> int:
                 _refuse_other_sizes(folder, opts)
             folder.open(run_info, overwrite=opts.overwrite, resume=opts.resume, notify=prog.message)
             if folder.already_complete:
+                _refuse_other_sizes(folder, opts, complete=True)
                 prog.message(f"{PROG}: '{folder.shown}' is complete (manifest.json verified); nothing to resume")
                 return 0
             started = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")

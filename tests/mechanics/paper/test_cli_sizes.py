@@ -240,6 +240,13 @@ def test_resume_refuses_other_sizes_and_accepts_the_same(tmp_path, capsys, monke
     assert main(loud + ["--resume", "--paths-factor", repr(factor)]) == 0
     assert "2 finished pieces verified and reused" in capsys.readouterr().err
     assert json.loads((out / "manifest.json").read_text())["sizes"]["chen.n_paths"] == 6
+    # resuming the complete run with other sizes runs nothing and says so (not "complete, nothing to resume")
+    before = (out / "manifest.json").read_bytes()
+    assert main(base + ["--resume", "--set", "chen.n_paths=7"]) == 2
+    err = _one_line(capsys)
+    assert "is complete and used other sizes (chen.n_paths: 6 then, 7 now)" in err and "--overwrite" in err
+    assert (out / "manifest.json").read_bytes() == before
+    assert main(base + ["--resume", "--set", "chen.n_paths=6"]) == 0       # the same sizes: nothing to do
 
 
 # ------------------------------------------------------------------------------------------- the estimate
