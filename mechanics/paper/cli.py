@@ -410,6 +410,13 @@ def _check_estimate(opts: Options, est: CostEstimate) -> None:
     if est.peak_bytes > budget:
         task = max(est.tasks, key=lambda t: est.tasks[t][1])
         words = ", ".join(f"{task}.{w}" for w in SIZES.get(task, {}))
+        base = est.peak_bytes - est.tasks[task][1]
+        if base > budget or not words:       # not a matter of sizes
+            raise UsageError(
+                f"the main job needs about {_human_bytes(est.peak_bytes)} of memory, {_human_bytes(base)} before any "
+                f"figure or check, more than the memory budget of {_human_bytes(budget)} "
+                "(roughpaths.validation.memory_budget: three quarters of the available memory, or "
+                "ROUGHPATHS_MAX_BYTES); free some memory or raise ROUGHPATHS_MAX_BYTES")
         raise UsageError(
             f"{_origin(opts, task)}: the run would need about {_human_bytes(est.peak_bytes)} of memory at its peak "
             f"({task}: {_human_bytes(est.tasks[task][1])}), more than the memory budget of {_human_bytes(budget)} "

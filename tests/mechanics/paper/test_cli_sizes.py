@@ -263,9 +263,14 @@ def test_estimate_beyond_the_memory_budget_is_refused_before_any_folder(tmp_path
     assert err.startswith("levy-area-paper: error: --set chen.n_steps=100000000: ") and "memory budget" in err
     assert "ROUGHPATHS_MAX_BYTES" in err and "chen.n_steps, chen.n_paths" in err
     assert not out.exists() and not Path(str(out) + ".incomplete").exists()
-    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(int(0.5 * need)))           # even the preset: names --tiny
+    over = need - estimate_cost(plan, ["chen"]).tasks["chen"][1] / 2        # the preset of chen beyond the budget
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(int(over)))
     assert main(argv) == 2
     assert "error: --tiny: the run would need" in _one_line(capsys)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(int(0.5 * need)))           # not even the process fits
+    assert main(argv) == 2
+    err = _one_line(capsys)
+    assert "before any figure or check, more than the memory budget" in err and "ROUGHPATHS_MAX_BYTES" in err
 
 
 def test_estimate_beyond_the_work_budget_is_refused(tmp_path, capsys, monkeypatch):
