@@ -163,10 +163,35 @@ class SeededDriver(Driver):
         return new
 
     def rough_path(self):
-        """The whole driver as one ``RoughPath`` (refused, naming the size, if it would not fit in memory)."""
-        need = float(self.n_paths) * self.n_steps * 8 * (self.dim + (self.dim ** 2 if self.level == 2 else 0))
-        if need > 0.5 * phys_bytes():
-            raise ValueError(f"the whole path needs {need / 2**30:.1f} GiB, more than half the machine's "
-                             f"memory; pass the driver to solve(...) (it is consumed block by block) or "
-                             f"iterate driver.blocks(), or select(...) fewer paths.")
-        return super().rough_path()
+        """The whole driver as one ``RoughPath`` (refused, naming the size, if it would not fit in memory).
+
+        The blocks are copied into the whole path as they come, so the call holds the whole path and two
+        blocks (the generator releases a block when it has made the next): with ``P`` paths, ``N`` steps,
+        blocks of ``K`` steps and ``b`` bytes per path-step of a block (its increments, areas and sampling
+        scratch, :meth:`default_block_steps`), ``8 P N (d + d²) + 2 P K b`` bytes (``d²`` at level 2 only),
+        checked before the first block.
+        """
+        P, N, d = self.n_paths, self.n_steps, self.dim
+        per_step = d + (d * d if self.level == 2 else 0)
+        K = min(self.default_block_steps(), N)
+        blocks = 2 if K < N else 1
+        need = 8.0 * P * N * per_step + blocks * float(P) * K * self._bytes_per_path_step() + 4096.0
+        check_memory(need, f"the whole path ({P} paths x {N} steps x {per_step} numbers, and {blocks} "
+                           f"block(s) of {K} steps)",
+                     "pass the driver to solve(...) (it is consumed block by block) or iterate driver.blocks(), "
+                     "or select(...) fewer paths")
+        from ..paths.rough_path import RoughPath
+
+        inc = np.empty(self.batch_shape + (N, d))
+        areas = np.empty(self.batch_shape + (N, d, d)) if self.level == 2 else None
+        x0 = kind = None
+        k0 = 0
+        for block in self.blocks(K):
+            if k0 == 0:                                  # keep the start and kind, not the first block
+                x0, kind = block.x0, block.kind
+            k1 = k0 + block.increments.shape[-2]
+            inc[..., k0:k1, :] = block.increments
+            if areas is not None:
+                areas[..., k0:k1, :, :] = block.areas
+            k0 = k1
+        return RoughPath(inc, areas, times=self.times, x0=x0, kind=kind, check=False)

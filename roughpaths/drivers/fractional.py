@@ -138,6 +138,37 @@ def _cholesky(gamma: np.ndarray, n_series: int, rng: np.random.Generator) -> np.
     return z @ L.T
 
 
+def _fbm_bytes(method: str, n_series: int, K: int) -> float:
+    """Bytes :func:`fbm` holds at its peak for ``n_series`` series of ``K`` steps (float, cannot overflow).
+
+    Both methods: the autocovariance and its temporaries (6 (K + 2) floats) and the result
+    ``(n_series, K + 1)``. Davies–Harte (``M = 2K``, ``F = ceil(n_series / 2)`` complex series): the
+    circulant row, its eigenvalues and weights (6 M floats), the complex noise ``(F, M)`` and its FFT (a second
+    ``(F, M)`` if scipy does not transform in place), 16 bytes each, and the real samples ``(2F, K)``; so
+    ``8 (6 (K + 2) + 6 M) + 2 * 16 F M + 8 (2F K + n_series (K + 1))``. Cholesky: the covariance, its index
+    temporaries and the factor (4 K² floats), the normals and their product with the factor
+    (``2 n_series K``); so ``8 (6 (K + 2) + 4 K² + 2 n_series K + n_series (K + 1))``.
+    """
+    S, K = float(n_series), float(K)
+    common = 8.0 * (6 * (K + 2) + S * (K + 1))
+    if method == "cholesky":
+        return common + 8.0 * (4 * K * K + 2 * S * K)
+    F, M = float((n_series + 1) // 2), 2.0 * K
+    return common + 8.0 * 6 * M + 2 * 16.0 * F * M + 8.0 * 2 * F * K
+
+
+def _check_fbm_memory(method: str, n_series: int, K: int, d: int, batch_shape: tuple, max_bytes) -> None:
+    """Refuse, before sampling, working memory above ``max_bytes`` or above the memory budget."""
+    need = _fbm_bytes(method, n_series, K) + 4096.0         # + Python objects (array headers, FFT plan)
+    if need > max_bytes:
+        raise ValueError(f"fbm would need about {need / 2**20:.0f} MiB for {n_series} series (dim={d} x batch_shape={batch_shape}) of n_steps={K} steps "
+                         f"(method={method!r}) > max_bytes={max_bytes / 2**20:.0f} MiB; sample in smaller "
+                         f"batches (a loop over seeds) or pass a larger max_bytes.")
+    check_memory(need, f"fbm's working arrays ({n_series} series (dim={d} x batch_shape={batch_shape}) of "
+                       f"n_steps={K} steps, method={method!r})",
+                 "sample in smaller batches (a loop over seeds) or fewer steps")
+
+
 def fbm(n_steps: int, hurst, *, rng, T: float = 1.0, dim: int = 1, batch_shape=(), method: str = "auto",
         max_bytes: int = MAX_BYTES) -> np.ndarray:
     r"""Sample fractional Brownian motion exactly on the uniform grid ``linspace(0, T, n_steps + 1)``.
@@ -184,16 +215,14 @@ def fbm(n_steps: int, hurst, *, rng, T: float = 1.0, dim: int = 1, batch_shape=(
     n_series = int(np.prod(batch_shape, dtype=np.int64)) * d
     if method == "auto":
         method = "cholesky" if K <= _AUTO_CHOLESKY else "davies-harte"
-    need = 8 * n_series * (K + 1) + (8 * K * K if method == "cholesky" else 8 * (n_series + 1) * 2 * K * 3)
-    if need > max_bytes:
-        raise ValueError(f"fbm would need about {need / 2**20:.0f} MiB for {n_series} series (dim={d} x batch_shape={batch_shape}) of n_steps={K} steps "
-                         f"(method={method!r}) > max_bytes={max_bytes / 2**20:.0f} MiB; sample in smaller "
-                         f"batches (a loop over seeds) or pass a larger max_bytes.")
+    _check_fbm_memory(method, n_series, K, d, batch_shape, max_bytes)
     gamma = fgn_autocovariance(H, K + 1)
     x = None
     if method == "davies-harte":
         x = _davies_harte(gamma, n_series, rng, scale=(T / K) ** H)
     if x is None:
+        if method != "cholesky":                           # the embedding failed: Cholesky's own arrays
+            _check_fbm_memory("cholesky", n_series, K, d, batch_shape, max_bytes)
         x = _cholesky(gamma[:K], n_series, rng)
         x *= (T / K) ** H
     nb = n_series // d

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..paths.rough_path import RoughPath
+from ..validation import as_float_array, check_memory
 from . import _kernels as _k
 from ._common import (_DEFAULT_MAX_POINTS, _check_max_points, _check_p, _dilate, _level1_data,
                            _level2_data, _member_scale, _shape)
@@ -26,6 +28,30 @@ def _partition_mask(prev: np.ndarray) -> np.ndarray:
             j = int(prev[b, j])
             mask[b, j] = True
     return mask
+
+
+def _check_memory(X) -> None:
+    """Refuse a trace whose working arrays exceed the memory budget, before any is allocated.
+
+    With ``B`` members, ``n`` grid points and ``d`` dimensions, :func:`p_variation` holds at once, 8 bytes
+    per entry: two arrays of increments (B, n - 1, d) (the differences and their rescaled copy), the
+    cumulated paths (B, n, d) with the rescaled increments, the predecessor table (B, n) and the values (B);
+    the kernel's per-path scratch (values, block and prefix boxes: n + 4 n d + 2 d), and the partition mask
+    (B n bytes). Bound: ``8 (2 B n d + B n + B + n + 4 n d + 2 d) + B n``, plus 4 KiB of Python objects.
+    """
+    if isinstance(X, RoughPath):
+        shape = X.increments.shape
+        n, d = shape[-2] + 1, shape[-1]
+    else:
+        shape = X.shape
+        n, d = shape[-2], shape[-1]
+    B = float(np.prod(shape[:-2], dtype=float))
+    n, d = float(n), float(d)
+    need = 8.0 * (2 * B * n * d + B * n + B + n + 4 * n * d + 2 * d) + B * n + 4096.0
+    check_memory(need, f"the p-variation of {B:.0f} paths of {n:.0f} points in {d:.0f} dimensions "
+                       f"(increments, paths and predecessor tables)",
+                 "pass fewer paths at a time (slice the leading axes) or fewer points "
+                 "(X.restrict(coarser_times) for a RoughPath, X[..., ::k, :] for samples)")
 
 
 def p_variation(X, p, *, times=None, return_partition=False, prune=True,
@@ -77,6 +103,10 @@ def p_variation(X, p, *, times=None, return_partition=False, prune=True,
     3.0
     """
     pp = _check_p(p)
+    if not isinstance(X, RoughPath):
+        # float64 samples first (no copy for a float64 array; a list's float64 copy is smaller than the list)
+        X = as_float_array(X, "X", min_ndim=2)
+    _check_memory(X)
     inc, _, batch = _level1_data(X, times, "X", need_times=False)
     _check_max_points(inc.shape[-2] + 1, max_points, "X")
     nb, n, d = inc.shape

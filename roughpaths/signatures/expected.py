@@ -69,17 +69,28 @@ def brownian_expected_signature(dim: int, depth: int, t: float = 1.0) -> np.ndar
     m = check_positive_int(depth, "depth")
     t = check_positive_real(t, "t", allow_zero=True)
     size = float(sum(float(d) ** k for k in range(1, m + 1)))
-    check_memory(8.0 * size, f"the expected signature (dim={d}, depth={m}: {size:.3g} entries)",
-                 "use a lower depth or a smaller dim")
+    # held at the peak: the result (size entries), the tensor power of the top even level (d^(2k)
+    # entries, 2k = m rounded down to even) with the power it is built from (d^(2k-2)) and the pair (d^2),
+    # 8 bytes each, plus 4 KiB of Python objects (array headers and views, a few hundred bytes each)
+    top = 2 * (m // 2)
+    power_size = float(d) ** top + float(d) ** max(top - 2, 0) + float(d) ** 2 if top else 0.0
+    check_memory(8.0 * (size + power_size) + 4096.0,
+                 f"the expected signature (dim={d}, depth={m}: {size:.3g} entries and a working tensor power "
+                 f"of {power_size:.3g})", "use a lower depth or a smaller dim")
     out = np.zeros(sigdim(d, m))
     pair = np.eye(d).reshape(-1)                  # Σ_i e_i ⊗ e_i, flat (row-major words)
-    power = np.ones(1)                            # (Σ_i e_i ⊗ e_i)^{⊗k}, flat; kron is the flat ⊗
+    power = np.ones(1)                            # (Σ_i e_i ⊗ e_i)^{⊗k}, flat
     start, coeff = 0, 1.0
     for level in range(1, m + 1):
         if level % 2 == 0:
             k = level // 2
-            power = np.kron(power, pair)
+            new = np.empty(power.size * pair.size)   # the flat ⊗ power ⊗ pair, one column per letter pair
+            cols = new.reshape(power.size, pair.size)  # (a broadcast product would buffer up to 2x its size)
+            for j in range(pair.size):
+                np.multiply(power, pair[j], out=cols[:, j])
+            power = new
             coeff *= 0.5 * t / k
-            out[start:start + d ** level] = coeff * power
+            block = out[start:start + d ** level]
+            np.multiply(power, coeff, out=block)          # in place: no temporary
         start += d ** level
     return out
