@@ -82,3 +82,15 @@ def tiny_paper_run(tmp_path_factory):
                           capture_output=True, text=True, timeout=600)
     proc.out = out
     return proc
+
+
+# ------------------------------------------------------------------ two workers (pytest-xdist)
+#: Session fixtures that cost seconds to build: every test that uses one runs on the same worker
+#: (``--dist loadgroup``), so each is built once per run, not once per worker (a test may use both).
+_SHARED_BUILDS = ("docs_site", "tiny_paper_run")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if any(name in getattr(item, "fixturenames", ()) for name in _SHARED_BUILDS):
+            item.add_marker(pytest.mark.xdist_group("shared-builds"))

@@ -334,6 +334,10 @@ ALIASES = {("iter_coloured_noise", "h"): ("step",), ("solve", "driver"): ("drive
            ("save_load", "path"): ("path", "file", "such file"), ("save_load", "obj"): ("obj", "save")}
 
 TRIED = collections.Counter()         # (kind) -> inputs tried
+
+# The summary at the end counts what the tests before it tried in this process: with two workers
+# (./test.sh runs pytest-xdist, --dist loadgroup) the whole module runs on one of them, in order.
+pytestmark = pytest.mark.xdist_group("bad-input-fuzz")
 OUTCOME = collections.Counter()       # (refused | accepted) -> count
 
 

@@ -72,13 +72,21 @@ fi
 # Compile the numba kernels once (cached on disk by numba): the main job's, at tiny sizes, and the
 # library's other kernels (tools/warm_kernels.py: signatures and their gradients, signature kernels, the
 # Brownian tree, the coadjoint kernels); afterwards the first call of a user does not wait for the compiler.
-echo "Compiling the numba kernels once (a few minutes) ..." >&2
+echo "Compiling the numba kernels once (about a minute) ..." >&2
 WARM="$(mktemp -d)"
-rc=0
-"$PY" -m mechanics --tiny --quiet --output "$WARM/run" >>"$LOG" 2>&1 || rc=$?
-[ "$rc" -le 1 ] || echo "warning: the warm-up run failed (exit $rc, see $LOG)" >&2   # 1: a tiny-size check failed
-# every other kernel a public function can reach (signatures with gradients, signature kernels, tree, coadjoint)
-"$PY" tools/warm_kernels.py >>"$LOG" 2>&1 || echo "warning: compiling the kernels failed (see $LOG)" >&2
+# Two processes, one per core: the main job's kernels (a --tiny run) then the other coadjoint kernels, and
+# beside them the rough-path kernels (signatures with gradients, signature kernels, the tree).
+(
+    rc=0
+    "$PY" -m mechanics --tiny --quiet --output "$WARM/run" >"$WARM/main.log" 2>&1 || rc=$?
+    [ "$rc" -le 1 ] || echo "warning: the warm-up run failed (exit $rc, see $LOG)" >&2   # 1: a tiny-size check failed
+    "$PY" tools/warm_kernels.py --part mechanics >>"$WARM/main.log" 2>&1 \
+        || echo "warning: compiling the coadjoint kernels failed (see $LOG)" >&2
+) &
+"$PY" tools/warm_kernels.py --part roughpaths >"$WARM/rp.log" 2>&1 \
+    || echo "warning: compiling the rough-path kernels failed (see $LOG)" >&2
+wait
+cat "$WARM/main.log" "$WARM/rp.log" >>"$LOG"
 rm -rf "$WARM"
 
 { inputs_hash; norm_extras "$EXTRAS"; } > "$STAMP"

@@ -14,7 +14,15 @@ MMD statistics), the Brownian tree's split kernels (d = 2 and 3), and the generi
 :mod:`mechanics` (one compiled signature serves every algebra and all three coadjoint schemes; the
 so(3)/se(3) kernels are warmed too, with and without areas).
 
-Usage: ``python tools/warm_kernels.py`` (prints the time it took).
+Each kernel specialised on a size (the signature kernels' alphabet sizes and depths, the coadjoint
+kernels' schemes) is compiled per variant on its first use (``roughpaths._variants``): the calls below
+compile the variants of the shapes above (d = 2, 3 and 6); other sizes compile theirs, a few seconds
+each, on a user's first call.
+
+Usage: ``python tools/warm_kernels.py [--part roughpaths|mechanics]`` (prints the time each family took).
+``tools/setup_env.sh`` runs the two parts in two processes at once, one on each core. The few kernels both
+reach (the Brownian driver's random streams) may be compiled by both; numba replaces its cache files
+atomically, so the worst case is an entry compiled once more on a later first call.
 """
 
 from __future__ import annotations
@@ -93,12 +101,24 @@ def warm_coadjoint() -> None:
         run_ensemble(system, np.ones(system.dim), dt=0.01, n_steps=4, n_paths=2, seed=0)
 
 
+PARTS = {
+    "roughpaths": (("signatures", warm), ("signature kernels", warm_signature_kernels), ("Brownian tree", warm_tree)),
+    "mechanics": (("coadjoint kernels", warm_coadjoint),),
+}
+
+
 def main() -> None:
-    for what, fn in (("signatures", warm), ("signature kernels", warm_signature_kernels),
-                     ("Brownian tree", warm_tree), ("coadjoint kernels", warm_coadjoint)):
-        t0 = time.perf_counter()
-        fn()
-        print(f"{what}: compiled and cached in {time.perf_counter() - t0:.1f} s")
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--part", choices=sorted(PARTS), help="only this part (default: both, one after the other)")
+    part = parser.parse_args().part
+    for name in ([part] if part else sorted(PARTS, reverse=True)):
+        for what, fn in PARTS[name]:
+            t0, c0 = time.perf_counter(), time.process_time()
+            fn()
+            print(f"{what}: compiled and cached in {time.perf_counter() - t0:.1f} s "
+                  f"({time.process_time() - c0:.1f} s CPU)", flush=True)
 
 
 if __name__ == "__main__":
