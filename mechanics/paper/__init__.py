@@ -17,6 +17,9 @@ plotting
     overlay, phase portraits), usable on any simulation.
 model
     The paper's Section 4 set-up shared by figures and checks.
+sizes, cost
+    The sizes each figure and check runs at (presets, ``--set``, factors), and the estimated CPU
+    time and peak memory of a run at those sizes.
 tasks, output
     What a figure or check receives (seeded streams, sizes, progress), and the output folder
     (atomic writes, lock, manifest, ``--resume``).

@@ -5,7 +5,7 @@ that computes a *predicted* number from the theory (closed form, quadrature) and
 from a simulation or an independent computation with the library, compares them with a stated
 tolerance, and says pass or fail. Sizes come from ``ctx.size("TASK.WORD")``: their presets
 (``tiny`` / ``default`` / ``full``), kinds and meanings are declared in
-:data:`mechanics.paper.model.SIZES` (set on the command line with ``--set``; measured cost:
+:data:`mechanics.paper.sizes.SIZES` (set on the command line with ``--set``; measured cost:
 ``docs/main-job.md``, section Cost).
 
 The mathematics lives in :mod:`roughpaths` and :mod:`mechanics` (public names only); this module

@@ -11,9 +11,9 @@ an interrupted run (SIGTERM, SIGINT, a kill, a full disk) can be continued with 
 gives the same bytes as an uninterrupted run.
 
 The sizes of each figure and check (numbers of paths and steps, horizons, steps) are its presets
-(``--tiny``, default, ``--full``: :data:`mechanics.paper.model.SIZES`), scaled by ``--paths-factor``
+(``--tiny``, default, ``--full``: :data:`mechanics.paper.sizes.SIZES`), scaled by ``--paths-factor``
 and ``--steps-factor`` and set one by one with ``--set NAME.SIZE=VALUE``. Before it starts, the run
-prints its estimated CPU time and peak memory (:func:`mechanics.paper.model.estimate_cost`) and
+prints its estimated CPU time and peak memory (:func:`mechanics.paper.cost.estimate_cost`) and
 refuses a run beyond the library's memory or work budget.
 
 Every user error (bad option value or size, options that contradict each other, an estimate beyond
@@ -44,7 +44,7 @@ import roughpaths
 
 from roughpaths.validation import memory_budget, work_budget
 
-from .model import ESTIMATE_ACCURACY, SIZES, CostEstimate, SizeError, check_size, estimate_cost, plan_sizes
+from .cost import ESTIMATE_ACCURACY, CostEstimate, estimate_cost
 from .output import PROGRESS, OutputError, RunFolder
 from .report import (
     ERROR,
@@ -59,6 +59,7 @@ from .report import (
     versions,
     write_report,
 )
+from .sizes import SIZES, SizeError, check_size, plan_sizes
 from .tasks import Context, Progress
 
 __all__ = ["main", "build_parser", "parse_options", "Options", "UsageError", "run", "registries"]
@@ -159,7 +160,7 @@ class Options:
     """Validated command-line options.
 
     ``settings`` holds the ``--set`` values (``{"TASK.WORD": value}``); ``sizes`` every size of every
-    selected figure and check (:func:`~.model.plan_sizes`: presets of ``scale``, the two factors, then
+    selected figure and check (:func:`~.sizes.plan_sizes`: presets of ``scale``, the two factors, then
     ``settings``), which the run records and ``--resume`` compares.
     """
 
@@ -227,7 +228,7 @@ def _factor(text, flag: str) -> float:
 
 
 def _settings(chunks, selected: list[str]) -> dict:
-    """The ``--set`` values, ``{"TASK.WORD": number}``, checked against :data:`~.model.SIZES`."""
+    """The ``--set`` values, ``{"TASK.WORD": number}``, checked against :data:`~.sizes.SIZES`."""
     figs, chks = (list(r) for r in registries())
     settings: dict = {}
     for chunk in chunks or ():

@@ -3,7 +3,7 @@
 A :class:`Task` is a named function ``task(ctx) -> FigureResult | CheckResult``; the figures and the
 checks register themselves in :data:`mechanics.paper.figures.FIGURES` and
 :data:`mechanics.paper.checks.CHECKS` with :func:`registry_decorator`. Each task receives a
-:class:`Context`: the options of the run, its sizes (:data:`~.model.SIZES`), a random stream of its own
+:class:`Context`: the options of the run, its sizes (:data:`~.sizes.SIZES`), a random stream of its own
 (seeded by the run's seed and the task's name, so a task's numbers do not depend on which tasks ran
 before it, or whether the run was resumed), and a way to save its files into the output folder.
 """
@@ -19,7 +19,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .model import SIZES, size_spec
+from .sizes import SIZES, size_spec
 from .output import npz_bytes
 
 __all__ = ["Task", "registry_decorator", "Context", "Progress", "DPI"]
@@ -139,7 +139,7 @@ class Context:
     convention, seed, scale : str, int, str
         The run's options.
     plan : dict or None
-        The run's sizes, ``{"TASK.WORD": value}`` (:func:`~.model.plan_sizes`: presets of ``scale``,
+        The run's sizes, ``{"TASK.WORD": value}`` (:func:`~.sizes.plan_sizes`: presets of ``scale``,
         ``--paths-factor``, ``--steps-factor`` and ``--set``); None: the presets of ``scale``.
     levy_area : str
         The run's ``--levy-area``: the sampler of the Brownian Lévy areas (one of
@@ -199,12 +199,12 @@ class Context:
         Parameters
         ----------
         key : str
-            ``"TASK.WORD"`` of :data:`~.model.SIZES`; a key whose ``TASK`` is not the current task
+            ``"TASK.WORD"`` of :data:`~.sizes.SIZES`; a key whose ``TASK`` is not the current task
             (a helper shared by several tasks, e.g. ``"portrait.levels"``) means the current task's
             ``WORD``.
         **presets
             ``tiny=``, ``default=``, ``full=``: optional, the presets the caller expects; they must be
-            those of :data:`~.model.SIZES` (``ValueError`` otherwise), so that they cannot drift apart.
+            those of :data:`~.sizes.SIZES` (``ValueError`` otherwise), so that they cannot drift apart.
 
         Returns
         -------
@@ -213,13 +213,13 @@ class Context:
         prefix, _, word = key.rpartition(".")
         task = self.task if self.task is not None else prefix
         if task not in SIZES or word not in SIZES[task]:
-            raise ValueError(f"size {key!r} of task {task!r} is not declared in mechanics.paper.model.SIZES; "
+            raise ValueError(f"size {key!r} of task {task!r} is not declared in mechanics.paper.sizes.SIZES; "
                              "declare it there (its presets, kind and meaning)")
         spec = SIZES[task][word]
         wrong = {k: v for k, v in presets.items() if spec.preset(k) != v}
         if wrong:
             raise ValueError(f"size {key!r} of task {task!r}: the presets given ({wrong}) differ from those in "
-                             f"mechanics.paper.model.SIZES ({spec.tiny}, {spec.default}, {spec.full}); keep one")
+                             f"mechanics.paper.sizes.SIZES ({spec.tiny}, {spec.default}, {spec.full}); keep one")
         value = self.size_value(task, word)
         self.sizes[f"{task}.{word}"] = value
         return value

@@ -25,11 +25,12 @@ from pathlib import Path
 
 import pytest
 
-from mechanics.paper import cli, model, output
+from mechanics.paper import cli, cost, output
 from mechanics.paper.checks import CHECKS
 from mechanics.paper.cli import main, parse_options
+from mechanics.paper.cost import estimate_cost
 from mechanics.paper.figures import FIGURES
-from mechanics.paper.model import SIZES, estimate_cost, plan_sizes
+from mechanics.paper.sizes import SIZES, check_size, check_task_sizes, plan_sizes
 from mechanics.paper.tasks import Context, Task
 
 ALL = list(FIGURES) + list(CHECKS)
@@ -49,9 +50,9 @@ def test_every_task_is_in_the_size_table_and_presets_are_valid():
     for task, sizes in SIZES.items():
         for word, spec in sizes.items():
             for scale in ("tiny", "default", "full"):
-                assert model.check_size(f"{task}.{word}", spec.preset(scale)) == spec.preset(scale)
+                assert check_size(f"{task}.{word}", spec.preset(scale)) == spec.preset(scale)
             assert spec.kind in ("count", "power of 2", "positive") and spec.role in ("paths", "steps", "step", "other")
-        model.check_task_sizes(task, {w: s.default for w, s in sizes.items()})
+        check_task_sizes(task, {w: s.default for w, s in sizes.items()})
 
 
 # ------------------------------------------------------------------------------------------- parsing
@@ -161,7 +162,7 @@ def test_context_size_reads_the_plan_and_refuses_drift():
     # a helper shared by several tasks names its size by word: the current task's
     surf3 = Context(task="surf3", scale="full", plan={"surf3.levels": 5})
     assert surf3.size("portrait.levels", tiny=8, default=18, full=24) == 5
-    with pytest.raises(ValueError, match="differ from those in mechanics.paper.model.SIZES"):
+    with pytest.raises(ValueError, match="differ from those in mechanics.paper.sizes.SIZES"):
         Context(task="surf", scale="tiny").size("portrait.levels", tiny=9, default=18, full=24)
     with pytest.raises(ValueError, match="not declared"):
         Context(task="chen").size("chen.n_lanes")
@@ -285,12 +286,12 @@ def test_estimate_beyond_the_work_budget_is_refused(tmp_path, capsys, monkeypatc
 
 def test_estimate_grows_with_what_the_task_does():
     """Not the coefficients (machine speed) but the structure: linear in the work, fig5 reuses fig4's run."""
-    def cost(task, **sets):
+    def estimate(task, **sets):
         plan = plan_sizes("default", [task], settings={f"{task}.{k}": v for k, v in sets.items()})
         return estimate_cost(plan, [task])
 
-    a, b = cost("chen", n_paths=64), cost("chen", n_paths=128)
-    c = cost("chen", n_paths=192)
+    a, b = estimate("chen", n_paths=64), estimate("chen", n_paths=128)
+    c = estimate("chen", n_paths=192)
     assert b.work["chen"] == 2 * a.work["chen"] > 0
     assert math.isclose(c.tasks["chen"][0] - b.tasks["chen"][0], b.tasks["chen"][0] - a.tasks["chen"][0],
                         rel_tol=1e-9)
@@ -301,7 +302,7 @@ def test_estimate_grows_with_what_the_task_does():
     other = estimate_cost({**both, "fig5.T": 400.0}, ["fig4", "fig5"])
     assert shared.work["fig5"] == 0 < alone.work["fig5"] == other.work["fig5"] / 2
     assert shared.tasks["fig5"][0] < alone.tasks["fig5"][0] < other.tasks["fig5"][0]
-    assert shared.seconds == pytest.approx(sum(t for t, _ in shared.tasks.values()) + model._BASE_SECONDS)
+    assert shared.seconds == pytest.approx(sum(t for t, _ in shared.tasks.values()) + cost._BASE_SECONDS)
 
 
 # ------------------------------------------------------------------------------------------- every size is read
