@@ -7,7 +7,9 @@ the public API of :mod:`mechanics` and :mod:`roughpaths`; the library never impo
 Modules
 -------
 cli
-    The command line: options, the run, exit codes.
+    The command line: the run, its cost check, exit codes.
+options
+    The command-line options: the parser and the validation of every value.
 figures, checks
     The registries of the paper's figures and of its theorem / proposition checks.
 report

@@ -19,8 +19,9 @@ import pytest
 
 import roughpaths
 from mechanics.paper.checks import CHECKS
-from mechanics.paper.cli import SCALE_ENV, UsageError, main, parse_options
+from mechanics.paper.cli import main
 from mechanics.paper.figures import FIGURES
+from mechanics.paper.options import SCALE_ENV, UsageError, parse_options
 from mechanics.paper.tasks import Context, Progress
 
 

@@ -25,11 +25,12 @@ from pathlib import Path
 
 import pytest
 
-from mechanics.paper import cli, cost, output
+from mechanics.paper import cli, cost, options, output
 from mechanics.paper.checks import CHECKS
-from mechanics.paper.cli import main, parse_options
+from mechanics.paper.cli import main
 from mechanics.paper.cost import estimate_cost
 from mechanics.paper.figures import FIGURES
+from mechanics.paper.options import parse_options
 from mechanics.paper.sizes import SIZES, check_size, check_task_sizes, plan_sizes
 from mechanics.paper.tasks import Context, Task
 
@@ -57,7 +58,7 @@ def test_every_task_is_in_the_size_table_and_presets_are_valid():
 
 # ------------------------------------------------------------------------------------------- parsing
 def test_set_and_factors_give_the_documented_sizes(monkeypatch):
-    monkeypatch.delenv(cli.SCALE_ENV, raising=False)
+    monkeypatch.delenv(options.SCALE_ENV, raising=False)
     o = parse_options(["--only", "chen,fig1,friz_oberhauser,fig4", "--paths-factor", "2.5", "--steps-factor", "3",
                        "--set", "chen.n_steps=777", "--set", "fig4.T=50,fig4.eps=0.02"])
     d = {k: SIZES[k.partition(".")[0]][k.partition(".")[2]].default for k in o.sizes}
@@ -77,7 +78,7 @@ def test_set_and_factors_give_the_documented_sizes(monkeypatch):
 
 
 def test_factor_one_and_no_options_keep_the_presets_bitwise(monkeypatch):
-    monkeypatch.delenv(cli.SCALE_ENV, raising=False)
+    monkeypatch.delenv(options.SCALE_ENV, raising=False)
     for argv, scale in (([], "default"), (["--full"], "full"), (["--tiny", "--paths-factor", "1"], "tiny")):
         o = parse_options(argv)
         assert o.sizes == {f"{t}.{w}": s.preset(scale) for t in ALL for w, s in SIZES.get(t, {}).items()}
@@ -112,7 +113,7 @@ def test_factor_one_and_no_options_keep_the_presets_bitwise(monkeypatch):
     (["--paths-factor", "1e-9"], ["--paths-factor 1e-09", "below its minimum"]),
 ])
 def test_bad_sizes_one_line_exit_2_naming_option_and_fix(argv, fragments, capsys, tmp_path, monkeypatch):
-    monkeypatch.delenv(cli.SCALE_ENV, raising=False)
+    monkeypatch.delenv(options.SCALE_ENV, raising=False)
     out = tmp_path / "o"
     assert main(argv + ["--output", str(out)]) == 2
     err = _one_line(capsys)
@@ -136,7 +137,7 @@ def test_bad_sizes_one_line_exit_2_naming_option_and_fix(argv, fragments, capsys
     (["--only", "chen", "--set", "fig1.T=40"], ["--set fig1.T=40", "fig1 is not run", "--only"]),
 ])
 def test_contradicting_options_one_line_exit_2(argv, fragments, capsys, tmp_path):
-    with pytest.raises(cli.UsageError):
+    with pytest.raises(options.UsageError):
         parse_options(argv)
     assert main(argv) == 2
     err = _one_line(capsys)
@@ -145,7 +146,7 @@ def test_contradicting_options_one_line_exit_2(argv, fragments, capsys, tmp_path
 
 
 def test_same_value_twice_and_list_with_sizes_are_accepted(capsys, monkeypatch):
-    monkeypatch.delenv(cli.SCALE_ENV, raising=False)
+    monkeypatch.delenv(options.SCALE_ENV, raising=False)
     assert parse_options(["--set", "chen.n_paths=3", "--set", "chen.n_paths=3.0"]).sizes["chen.n_paths"] == 3
     assert main(["--list", "--full", "--only", "chen,fig1", "--set", "chen.n_paths=300", "--steps-factor", "2"]) == 0
     out = capsys.readouterr().out
@@ -187,7 +188,9 @@ def test_tasks_with_different_sizes_get_different_caches(monkeypatch, tmp_path):
             return cli.FigureResult(name, name, "")
         return Task(name, name, run)
 
-    monkeypatch.setattr(cli, "registries", lambda: ({"fig4": fake("fig4"), "fig5": fake("fig5")}, {}))
+    fake_registries = {"fig4": fake("fig4"), "fig5": fake("fig5")}, {}
+    for module in (options, cli):             # the options read the registries, the run loop runs them
+        monkeypatch.setattr(module, "registries", lambda: fake_registries)
     for extra, shared in (([], True), (["--set", "fig5.T=20"], False)):
         seen.clear()
         out = tmp_path / f"o{len(extra)}"
