@@ -52,9 +52,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ._npz import NpzReader, _fspath, atomic_savez, open_npz
+from ._npz import _CHUNK, NpzReader, _fspath, atomic_savez, open_npz
 from .paths.rough_path import RoughPath
 from .rde.solution import Solution
+from .validation import check_memory
 
 __all__ = ["save", "load", "load_metadata", "register_format", "atomic_savez", "open_npz", "NpzReader", "FORMAT",
            "FORMAT_VERSION"]
@@ -303,6 +304,21 @@ def load_metadata(path) -> dict:
     return _from_json(meta)
 
 
+def _check_reading_memory(npz: NpzReader, names, kind) -> None:
+    """Refuse, before reading, what :func:`load` holds beyond the arrays (which :func:`open_npz` checked).
+
+    With ``T`` bytes of arrays and ``A`` bytes of areas: zipfile's read buffer and its copy (``2 x 1 MiB``),
+    the finiteness mask of the largest array (one byte per entry, ``T / 8``) and the check that the areas are
+    geometric (three area-sized temporaries: the symmetric part, ½ x⊗x and their difference; four for Itô
+    areas, whose Stratonovich form is made first), so ``2 MiB + T / 8 + 3 A`` (``4 A`` for Itô).
+    """
+    nbytes = {n: float(np.prod(npz.entries[n][0], dtype=float)) * npz.entries[n][1].itemsize for n in names}
+    areas = nbytes.get("areas", 0.0)
+    need = 2.0 * _CHUNK + max(nbytes.values(), default=0.0) / 8 + (4.0 if kind == "ito" else 3.0) * areas
+    check_memory(need, f"the buffers and consistency checks of reading {npz.path} ({len(names)} arrays)",
+                 "read it on a machine with more memory, or set ROUGHPATHS_MAX_BYTES if you trust it")
+
+
 def load(path):
     """Read a :class:`~roughpaths.RoughPath` or :class:`~roughpaths.Solution` written by :func:`save`.
 
@@ -353,6 +369,7 @@ def load(path):
         has_failed = kind == "Solution" and "failed_step" in npz.entries
         if has_failed:
             npz.expect("failed_step", dtype=np.int64)
+        _check_reading_memory(npz, names, meta.get("kind"))
         arrays = {n: npz.read(n) for n in names}
         failed_arr = npz.read("failed_step") if has_failed else None
     if failed_arr is not None and failed_arr.shape != arrays["states"].shape[:-2]:

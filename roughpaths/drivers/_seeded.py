@@ -128,6 +128,22 @@ class SeededDriver(Driver):
         per_step = max(1, self.n_paths) * self._bytes_per_path_step()
         return max(1, min(self.n_steps, self.block_bytes // per_step))
 
+    def block_nbytes(self, max_steps=None) -> float:
+        """Bytes one block of :meth:`blocks` (``max_steps``, default :meth:`default_block_steps`) holds while it
+        is made: its increments, areas and sampling scratch, ``P × min(K, N) × b`` for ``P`` paths, blocks of
+        ``K`` steps and ``b`` bytes per path-step. A consumer that keeps a block while the next is made holds
+        two. Callers add it to the estimate they pass to :func:`roughpaths.validation.check_memory`.
+
+        Examples
+        --------
+        >>> from roughpaths import BrownianDriver
+        >>> drv = BrownianDriver(2, seed=0, dt=0.01, n_steps=100, batch_shape=(10,), levy_area=None)
+        >>> drv.block_nbytes(max_steps=50)      # 10 paths x 50 steps x (increments and normals, 2 x 2 floats)
+        16000.0
+        """
+        K = self.default_block_steps() if max_steps is None else check_positive_int(max_steps, "max_steps")
+        return float(self.n_paths) * min(K, self.n_steps) * self._bytes_per_path_step()
+
     def _block_size(self, max_steps) -> int:
         K = self.default_block_steps() if max_steps is None else check_positive_int(max_steps, "max_steps")
         need = float(self.n_paths) * min(K, self.n_steps) * self._bytes_per_path_step()
@@ -175,7 +191,7 @@ class SeededDriver(Driver):
         per_step = d + (d * d if self.level == 2 else 0)
         K = min(self.default_block_steps(), N)
         blocks = 2 if K < N else 1
-        need = 8.0 * P * N * per_step + blocks * float(P) * K * self._bytes_per_path_step() + 4096.0
+        need = 8.0 * P * N * per_step + blocks * self.block_nbytes(K) + 4096.0
         check_memory(need, f"the whole path ({P} paths x {N} steps x {per_step} numbers, and {blocks} "
                            f"block(s) of {K} steps)",
                      "pass the driver to solve(...) (it is consumed block by block) or iterate driver.blocks(), "

@@ -152,7 +152,11 @@ class RoughPathN:
         if v.shape[-2] < 2:
             raise ValueError(f"values needs at least 2 samples along axis -2, got shape {v.shape}.")
         d = v.shape[-1]
-        check_memory(8.0 * 3 * float(np.prod(v.shape[:-1], dtype=float)) * float(sigdim(d, level)),
+        # held at the peak, for M = prod(v.shape[:-1]) samples and S = sigdim(d, level) entries each: the
+        # exponent z, the running sum of exp's series and its update, the tensor power and its successor
+        # (5 M S), one level-sized product temporary (M d^level) and the increments (M d), 8 bytes each
+        M = float(np.prod(v.shape[:-1], dtype=float))
+        check_memory(8.0 * M * (5.0 * float(sigdim(d, level)) + float(d) ** level + d) + 4096.0,
                      f"the level-{level} lift of {v.shape[:-1]} samples in d={d}", "lower level or lift fewer samples")
         inc = np.diff(v, axis=-2)
         z = np.zeros(inc.shape[:-1] + (sigdim(d, level),))

@@ -221,6 +221,10 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     check_memory(8.0 * members * idx.size * e, f"the saved states ({members:.0f} member(s) x {idx.size} "
                  f"time(s) x {e})", "save fewer times (save_at='end' or a coarser array of grid times) or "
                  "solve the batch in parts")
+    work, blocks_what = _working_bytes(driver, block_steps, members, e, level, int(idx.size))
+    check_memory(work, f"the solver's working arrays ({members:.0f} member(s): {blocks_what}, the states saved "
+                       f"per block and one step's temporaries)",
+                 "pass a smaller block_steps, or solve the batch in parts (driver.select(...), or executor=...)")
     out = np.empty(batch + (idx.size, e))
     slot = 0
     if save_mask[0]:
@@ -265,6 +269,35 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     stats = {"solver": repr(solver), "n_steps": n, "n_blocks": n_blocks, "batch_shape": batch,
              "wall_time": _time.perf_counter() - t_start}
     return Solution(times=times[idx].copy(), states=out, failed_step=failed_step, stats=stats)
+
+
+def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_saved: int):
+    """Bytes a fixed-step :func:`solve` holds besides its saved states, and what holds them (for the message).
+
+    With ``M`` members, ``N`` steps, blocks of ``K`` steps, ``d`` noise and ``e`` state dimensions:
+
+    * a lazy driver's blocks: two of ``driver.block_nbytes(K)`` (the generator makes the next block while
+      the loop still holds the last; one if a block covers the grid); a ``RoughPath`` is read in place;
+    * the states a block saves before they are copied out, ``8 M min(K, saved) e``;
+    * the state, its copy and the failure indices, ``8 M (2 e + 1)``;
+    * one step's temporaries, per member: the slice of the area (d²) and of level 3 (d³) the step is given,
+      the fields' values and their product with the area (2 e d), their Jacobians (d e²), the linear
+      generators (2 e²) with a log-ODE step's matrix exponential (up to 14 e², scaling and squaring) and up to
+      eight state-sized sums (8 e), 8 bytes each.
+    """
+    N, d = driver.n_steps, driver.dim
+    if isinstance(driver, Driver):
+        K = block_steps if block_steps is not None else getattr(driver, "default_block_steps", lambda: N)()
+        K = min(K, N)
+        nb = 2 if K < N else 1
+        # a driver without block_nbytes (one of the caller's own) states nothing of its blocks
+        per_block = driver.block_nbytes(K) if hasattr(driver, "block_nbytes") else 0.0
+        blocks, what = nb * per_block, f"{nb} driver block(s) of {K} steps"
+    else:
+        K, blocks, what = N, 0.0, "the path read in place"
+    d3 = float(d) ** 3 if level >= 3 else 0.0
+    step = float(d) ** 2 + d3 + 2.0 * e * d + float(d) * e * e + 16.0 * e * e + 8.0 * e
+    return (blocks + 8.0 * members * (min(K, n_saved) * e + 2 * e + 1 + step) + 4096.0), what
 
 
 def _check_save_at(save_at) -> None:
