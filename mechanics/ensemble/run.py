@@ -187,6 +187,34 @@ def _run_chunk(spec: _Spec, first: int, last: int):
     return final, (acc / n_avg if n_avg else None), snaps, (mu if spec.keep_final else None)
 
 
+def _check_working_memory(driver, system, block_steps, chunk_size, n_paths, n_steps, p, keep_final) -> None:
+    """Refuse, before any path is solved, a chunk's working arrays above the memory budget.
+
+    A chunk of ``c = min(chunk_size, n_paths)`` paths, in blocks of ``K`` steps (``block_steps``, else the
+    chunk driver's default but at least ``MIN_BLOCK_STEPS``, at most ``n_steps``), with ``n`` state, ``m``
+    noise and ``p`` observed dimensions, holds: two driver blocks (one if a block covers the run,
+    ``driver.block_nbytes``); the states a block saves (``c K n``) and the observable on them with its
+    contiguous copy (``2 c K p``); the state, its update, the time-average accumulator and the final values
+    (``3 c n + 2 c p``); one step's temporaries per path (the noise's square, its products with the state,
+    the Jacobian-sized ``m n²`` and up to ``16 n² + 8 n`` for the coadjoint maps), 8 bytes each. With
+    ``keep_final`` the finals are concatenated at the end (a second ``n_paths x n``). With ``executor``,
+    each concurrent chunk holds as much again.
+    """
+    n, m = system.dim, system.n_noise
+    c = min(chunk_size, n_paths)
+    chunk = driver.select(range(c))
+    K = block_steps if block_steps is not None else max(chunk.default_block_steps(), MIN_BLOCK_STEPS)
+    K = min(K, n_steps)
+    blocks = (2 if K < n_steps else 1) * chunk.block_nbytes(K)
+    step = float(m) ** 2 + 2.0 * n * m + float(m) * n * n + 16.0 * n * n + 8.0 * n
+    need = blocks + 8.0 * c * (K * (n + 2 * p) + 3 * n + 2 * p + step) + 4096.0
+    if keep_final:
+        need += 8.0 * n_paths * n
+    check_memory(need, f"the working arrays of a chunk of {c} paths ({K}-step blocks of the driver, the saved "
+                       f"states and observables, one step's temporaries)",
+                 "pass a smaller chunk_size or block_steps")
+
+
 def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_area=None, levy_area_error=None,
                  observable=moment_observable, burn_in=0, average_every=1, record_every=None,
                  chunk_size=1024, block_steps=None, executor=None, keep_final=False,
@@ -359,6 +387,8 @@ def run_ensemble(system, mu0, *, dt, n_steps, n_paths, seed, method=None, levy_a
         if state is not None:
             start, final, tavg, snaps, finals = state
     todo = bounds[start:]
+    # after the checkpoint (its own sizes are checked as it is read), before any path is solved
+    _check_working_memory(driver, system, block_steps, chunk_size, n_paths, n_steps, p, keep_final)
     report = progress_reporter(progress, n_paths, desc="run_ensemble", unit="paths",
                                initial=bounds[start - 1][1] if start else 0)
     if executor is None:
