@@ -346,6 +346,27 @@ class RefinedBrownianDriver(Driver):
         """Fine steps per block when :meth:`blocks` gets no ``max_steps`` (whole coarse steps)."""
         return self.factor * max(1, self.coarse.default_block_steps() // self.factor)
 
+    def block_nbytes(self, max_steps=None) -> float:
+        """Bytes one block of :meth:`blocks` (``max_steps`` fine steps, default :meth:`default_block_steps`) holds
+        while it is made, 8 bytes each: the coarse block of ``k = max(1, K // factor)`` steps
+        (``coarse.block_nbytes(k)``); the area and refinement normals of its ``P`` paths and their per-step-length
+        gathered copies (``2 P k (a + r)``, ``a`` and ``r`` the widest per-step widths); the fine increments and
+        areas and their per-step-length copies (``2 P k F (d + d²)``), the assembly's two ``P k F d²``
+        temporaries, and the temporaries of a chunk of at most 1024 rows being refined (four arrays of a
+        row's normals and fine values). A consumer that keeps a block while the next is made holds two.
+        """
+        F, d, c = self.factor, self.dim, self.coarse
+        K = self.default_block_steps() if max_steps is None else check_positive_int(max_steps, "max_steps")
+        if F == 1:
+            return c.block_nbytes(K)
+        kc = min(max(1, K // F), c.n_steps)
+        widths = [self._area_width(float(x)) + self._refine_width(float(x)) for x in np.unique(c._h)]
+        P = float(self.n_paths)
+        rows = min(P * kc, float(_ROWS))
+        return (c.block_nbytes(kc)
+                + 8.0 * P * kc * (2.0 * max(widths) + 2.0 * F * (d + d * d) + 2.0 * F * d * d)
+                + 8.0 * rows * 4.0 * (max(widths) + F * (d + d * d)))
+
     # ------------------------------------------------------------------ per step length
     def _plan(self, h: float):
         plan = self._plans.get(h)
