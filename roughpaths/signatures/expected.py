@@ -71,10 +71,11 @@ def brownian_expected_signature(dim: int, depth: int, t: float = 1.0) -> np.ndar
     size = float(sum(float(d) ** k for k in range(1, m + 1)))
     # held at the peak: the result (size entries), the tensor power of the top even level (d^(2k)
     # entries, 2k = m rounded down to even) with the power it is built from (d^(2k-2)) and the pair (d^2),
-    # 8 bytes each, plus 4 KiB of Python objects (array headers and views, a few hundred bytes each)
+    # 8 bytes each, plus 8 KiB of Python objects (some twenty array headers and views, a few hundred bytes
+    # each: 2-3 KiB measured, the rest a margin for other numpy versions)
     top = 2 * (m // 2)
     power_size = float(d) ** top + float(d) ** max(top - 2, 0) + float(d) ** 2 if top else 0.0
-    check_memory(8.0 * (size + power_size) + 4096.0,
+    check_memory(8.0 * (size + power_size) + 8192.0,
                  f"the expected signature (dim={d}, depth={m}: {size:.3g} entries and a working tensor power "
                  f"of {power_size:.3g})", "use a lower depth or a smaller dim")
     out = np.zeros(sigdim(d, m))
