@@ -119,7 +119,7 @@ def main() -> None:
     print(f"load: {os.getloadavg()[0]:.1f}; cold = empty numba cache (CPU and wall time of the process, import "
           "included), warm = the first call in a second process on that cache (import not included)")
     print(f"{'family':<30}{'cold CPU s':>11}{'cold wall s':>12}{'warm call CPU s':>16}{'warm call wall s':>17}"
-          f"{'import s':>9}{'2nd call s':>11}  targets 10 / 1")
+          f"{'import+setup s':>15}{'2nd call s':>11}  targets 10 / 1")
     for name, (setup, call) in FAMILIES.items():
         if only and not any(o in name for o in only):
             continue
@@ -128,7 +128,7 @@ def main() -> None:
             warm = run_cell(setup, call, cache, False)
         ok = "met" if cold["cpu"] <= 10 and warm["call_wall"] <= 1 else "NOT met"
         print(f"{name:<30}{cold['cpu']:>11.1f}{cold['wall']:>12.1f}{warm['call_cpu']:>16.2f}"
-              f"{warm['call_wall']:>17.2f}{warm['import_wall']:>9.2f}{cold['again']:>11.4f}  {ok}", flush=True)
+              f"{warm['call_wall']:>17.2f}{warm['import_wall']:>15.2f}{cold['again']:>11.4f}  {ok}", flush=True)
         if args.breakdown:
             for kname, sig, t in sorted(cold["events"], key=lambda e: -e[2])[:args.top]:
                 print(f"      {t:7.2f} s  {kname}  {sig[:90]}")
