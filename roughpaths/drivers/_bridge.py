@@ -16,6 +16,7 @@ import numpy as np
 
 from ..algebra.level2 import outer
 from ..paths.rough_path import RoughPath
+from ..validation import memory_budget
 from .levy_area import _tail_zeta2, step_plan
 
 #: Gibbs sweeps that condition the explicit tail terms on the coarse area (and the fine areas on Chen's
@@ -419,3 +420,43 @@ def _refine_by_fourier_path(W, L, h, m, rng):
         z = rng.standard_normal((idx.size, plan.width))
         w[idx], A[idx] = _refine_fourier(plan, W[idx], L[idx], None, None, None, z)
     return w, A
+
+
+# ------------------------------------------------------------------ what a refinement holds
+def refine_bytes(X: RoughPath, m: int) -> float:
+    """Bytes :func:`~roughpaths.drivers.refinement.refine` holds at its peak, for ``R`` rows (paths x steps) of dimension ``d``, 8 bytes each.
+
+    Splits (``factor <= 2`` or level 1): the pieces and their stack (``2 m R (d + d²)``), the assembly with
+    ``½ w⊗w`` (three ``R m d²``), the Lévy areas (``R d²``) and one split's temporaries (twelve ``(R, d, d)``
+    and eight ``(R, d)``); at level 1 ``2 m R d + 8 R d``. The Fourier path (``factor > 2`` at level 2), per
+    step length with ``R_h`` rows and its plan (``width`` normals per row, ``M`` coarse and ``n_f`` fine
+    explicit modes): the normals ``R_h width`` of two step lengths at once (one is released when the next is
+    drawn), six coarse-mode arrays ``(R_h, M, d)`` and six fine-mode arrays ``(R_h, m, n_f, d)`` of a Gibbs
+    sweep, eight ``(R_h, m, d, d)`` area arrays; plus the Lévy areas ``R d²``, the output ``R m (d + d²)``
+    and the assembly's two ``R m d²`` temporaries; and the plans themselves, about ``8 (3 K (m - 1) + 8 (m - 1)²)``
+    bytes each with ``K = 4 m`` modes, sized before any is built.
+    """
+    inc = X.increments
+    d = inc.shape[-1]
+    R = float(inc.size // d) if d else 0.0
+    if X.level != 2:
+        return 8.0 * (2.0 * m * R * d + 8.0 * R * d) + 4096.0
+    if m <= 2 or R == 0:
+        return 8.0 * (2.0 * m * R * (d + d * d) + 3.0 * R * m * d * d + 13.0 * R * d * d + 8.0 * R * d) + 4096.0
+    h, counts = np.unique(np.broadcast_to(X.dt, inc.shape[:-1]).reshape(-1), return_counts=True)
+    # A plan of m sub-steps holds K = MODES_PER_SUBSTEP m modes: three (K, m - 1) arrays and about eight
+    # (m - 1, m - 1) ones while it is built. Where that (with the output) cannot fit, the estimate stops here,
+    # before any plan is built (building one to size it allocated 30 GiB for factor=10**9).
+    K = float(MODES_PER_SUBSTEP) * m
+    plan_bytes = 8.0 * (3.0 * K * (m - 1) + 8.0 * (m - 1.0) ** 2) * len(h)
+    floor = 8.0 * R * m * (d + 3.0 * d * d) + plan_bytes + 4096.0
+    if not floor <= memory_budget():
+        return floor
+    normals, work = [0.0, 0.0], 0.0
+    for hv, Rh in zip(h, counts.astype(float)):
+        delta = float(hv) / m
+        fine = step_plan("auto", d, [delta])[delta] if d > 1 else ("fourier", 1, 0)
+        plan = _FourierPlan(float(hv), m, d, "exact", 0, False, fine)
+        normals = sorted(normals + [Rh * plan.width])[-2:]
+        work = max(work, Rh * (6.0 * plan.M * d + 6.0 * m * fine[1] * d + 8.0 * m * d * d))
+    return 8.0 * (sum(normals) + work + R * d * d + R * m * (d + 3.0 * d * d)) + plan_bytes + 4096.0

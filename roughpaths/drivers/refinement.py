@@ -116,7 +116,7 @@ import numpy as np
 from ..paths.rough_path import RoughPath
 from ..validation import check_memory, check_positive_int, check_rng
 from ._bridge import (GIBBS_SWEEPS, MODES_PER_SUBSTEP, _assemble, _BridgePlan, _FourierPlan, _refine_bridge,
-                      _refine_by_fourier_path, _refine_fourier, _split)
+                      _refine_by_fourier_path, _refine_fourier, _split, refine_bytes)
 from ._random import PathStreams
 from ._seeded import SeededDriver
 from .base import Driver
@@ -126,36 +126,6 @@ __all__ = ["refine", "RefinedBrownianDriver", "GIBBS_SWEEPS", "MODES_PER_SUBSTEP
 
 
 # ------------------------------------------------------------------ a given sample
-def _refine_bytes(X: RoughPath, m: int) -> float:
-    """Bytes :func:`refine` holds at its peak, for ``R`` rows (paths x steps) of dimension ``d``, 8 bytes each.
-
-    Splits (``factor <= 2`` or level 1): the pieces and their stack (``2 m R (d + d²)``), the assembly with
-    ``½ w⊗w`` (three ``R m d²``), the Lévy areas (``R d²``) and one split's temporaries (twelve ``(R, d, d)``
-    and eight ``(R, d)``); at level 1 ``2 m R d + 8 R d``. The Fourier path (``factor > 2`` at level 2), per
-    step length with ``R_h`` rows and its plan (``width`` normals per row, ``M`` coarse and ``n_f`` fine
-    explicit modes): the normals ``R_h width`` of two step lengths at once (one is released when the next is
-    drawn), six coarse-mode arrays ``(R_h, M, d)`` and six fine-mode arrays ``(R_h, m, n_f, d)`` of a Gibbs
-    sweep, eight ``(R_h, m, d, d)`` area arrays; plus the Lévy areas ``R d²``, the output ``R m (d + d²)``
-    and the assembly's two ``R m d²`` temporaries.
-    """
-    inc = X.increments
-    d = inc.shape[-1]
-    R = float(inc.size // d) if d else 0.0
-    if X.level != 2:
-        return 8.0 * (2.0 * m * R * d + 8.0 * R * d) + 4096.0
-    if m <= 2 or R == 0:
-        return 8.0 * (2.0 * m * R * (d + d * d) + 3.0 * R * m * d * d + 13.0 * R * d * d + 8.0 * R * d) + 4096.0
-    h, counts = np.unique(np.broadcast_to(X.dt, inc.shape[:-1]).reshape(-1), return_counts=True)
-    normals, work = [0.0, 0.0], 0.0
-    for hv, Rh in zip(h, counts.astype(float)):
-        delta = float(hv) / m
-        fine = step_plan("auto", d, [delta])[delta] if d > 1 else ("fourier", 1, 0)
-        plan = _FourierPlan(float(hv), m, d, "exact", 0, False, fine)
-        normals = sorted(normals + [Rh * plan.width])[-2:]
-        work = max(work, Rh * (6.0 * plan.M * d + 6.0 * m * fine[1] * d + 8.0 * m * d * d))
-    return 8.0 * (sum(normals) + work + R * d * d + R * m * (d + 3.0 * d * d)) + 4096.0
-
-
 def refine(X: RoughPath, factor, rng) -> RoughPath:
     r"""Refine a Brownian rough path: split every step into ``factor`` equal substeps, Chen-consistently.
 
@@ -235,7 +205,7 @@ def refine(X: RoughPath, factor, rng) -> RoughPath:
         raise ValueError(f"X.kind must be 'geometric' (Stratonovich) or 'ito' to refine as Brownian "
                          f"motion, got {X.kind!r}; build X with brownian_rough_path.")
     d = X.increments.shape[-1]
-    check_memory(_refine_bytes(X, m), f"refining {X.increments.shape[:-1]} steps by "
+    check_memory(refine_bytes(X, m), f"refining {X.increments.shape[:-1]} steps by "
                  f"factor={m} (the refined increments and areas, with temporaries)",
                  "use a smaller factor, or refine a shorter or smaller batch of paths")
     if m == 1:
