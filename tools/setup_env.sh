@@ -74,16 +74,18 @@ fi
 # Brownian tree, the coadjoint kernels); afterwards the first call of a user does not wait for the compiler.
 echo "Compiling the numba kernels once (about a minute) ..." >&2
 WARM="$(mktemp -d)"
+MORE=""                                   # the test suite's kernels too, when the test extra is installed
+case ",$EXTRAS," in *,test,*) MORE="--more" ;; esac
 # Two processes, one per core: the main job's kernels (a --tiny run) then the other coadjoint kernels, and
 # beside them the rough-path kernels (signatures with gradients, signature kernels, the tree).
 (
     rc=0
     "$PY" -m mechanics --tiny --quiet --output "$WARM/run" >"$WARM/main.log" 2>&1 || rc=$?
     [ "$rc" -le 1 ] || echo "warning: the warm-up run failed (exit $rc, see $LOG)" >&2   # 1: a tiny-size check failed
-    "$PY" tools/warm_kernels.py --part mechanics >>"$WARM/main.log" 2>&1 \
+    "$PY" tools/warm_kernels.py --part mechanics $MORE >>"$WARM/main.log" 2>&1 \
         || echo "warning: compiling the coadjoint kernels failed (see $LOG)" >&2
 ) &
-"$PY" tools/warm_kernels.py --part roughpaths >"$WARM/rp.log" 2>&1 \
+"$PY" tools/warm_kernels.py --part roughpaths $MORE >"$WARM/rp.log" 2>&1 \
     || echo "warning: compiling the rough-path kernels failed (see $LOG)" >&2
 wait
 cat "$WARM/main.log" "$WARM/rp.log" >>"$LOG"

@@ -14,7 +14,12 @@ scheme is compiled per variant on its first use (``roughpaths._variants``): ever
 alphabet sizes, lone or long chunked paths, Lie–Euler and the implicit midpoint rule) compiles its own
 variant on a user's first call, a few seconds each (``benchmarks/bench_first_call.py``).
 
-Usage: ``python tools/warm_kernels.py [--part roughpaths|mechanics]`` (prints the time each family took).
+``--more`` adds what the test suite reaches besides (lone, wide and long chunked paths, the rough-path
+signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule): ``tools/setup_env.sh`` passes
+it when it installs the test extra, so those compiles happen at set-up on both cores, not inside the tests.
+
+Usage: ``python tools/warm_kernels.py [--part roughpaths|mechanics] [--more]`` (prints the time each family
+took).
 ``tools/setup_env.sh`` runs the two parts in two processes at once, one on each core. The few kernels both
 reach (the Brownian driver's random streams) may be compiled by both; numba replaces its cache files
 atomically, so the worst case is an entry compiled once more on a later first call.
@@ -46,6 +51,48 @@ def warm() -> None:
         for m in (2, 3):
             rp.signature_vjp(x, m, np.ones((16, rp.sigdim(d, m))))
             rp.logsignature_vjp(x, m, np.ones((16, rp.logsigdim(d, m))))
+
+
+def warm_more_signatures() -> None:
+    """For the test suite (``--more``): lone, wide (d = 6) and long chunked paths, the rough-path signature and
+    its gradient, the tensor-algebra kernels and the p-variation, which the tests reach."""
+    import roughpaths as rp
+
+    rng = np.random.default_rng(0)
+
+    def path(*shape):
+        return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
+
+    lone, wide, wide_batch, long_path = path(9, 3), path(2, 7, 6), path(9, 7, 6), path(2 * 1024 + 8, 2)
+    for x in (lone, wide, wide_batch, long_path):
+        for m in (2, 3):
+            rp.signature(x, m)
+            rp.logsignature(x, m)
+            rp.signature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.sigdim(np.shape(x)[-1], m),)))
+            rp.logsignature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.logsigdim(np.shape(x)[-1], m),)))
+    rp.signature(path(2 * 8192 + 8, 3), 2)                 # level 2, chunked
+    X = rp.RoughPath.from_path(path(10, 9, 3))
+    for m in (2, 3):
+        s = rp.rough_path_signature(X, m)
+        rp.rough_path_signature_vjp(X, m, np.ones_like(s))
+    z = rp.tensor_log(rp.signature(lone, 3), dim=3)
+    rp.tensor_exp(z, dim=3)
+    rp.lyndon_coordinates(z, dim=3)
+    rp.p_variation(lone, 2.5)
+
+
+def warm_more_coadjoint() -> None:
+    """For the test suite (``--more``): Lie–Euler and the implicit midpoint rule on so(3), se(3) and a user
+    algebra."""
+    from mechanics import ImplicitMidpoint, LieEuler, LiePoissonSystem, heavy_top, rigid_body
+    from mechanics.systems.lie_algebra import su2
+    from roughpaths import BrownianDriver, solve
+
+    for system in (LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1), rigid_body([1.0, 2.0, 3.0], sigma=0.1),
+                   heavy_top([1.0, 2.0, 3.0], chi=[0.0, 0.0, 1.0], sigma=0.1)):
+        X = BrownianDriver(system.n_noise, seed=0, dt=0.01, n_steps=2, batch_shape=(2,))
+        for method in (LieEuler(), ImplicitMidpoint()):
+            solve(system, X, np.ones((2, system.dim)), method)
 
 
 def warm_signature_kernels() -> None:
@@ -85,6 +132,9 @@ PARTS = {
     "roughpaths": (("signatures", warm), ("signature kernels", warm_signature_kernels), ("Brownian tree", warm_tree)),
     "mechanics": (("coadjoint kernels", warm_coadjoint),),
 }
+#: with ``--more`` (``tools/setup_env.sh`` when it installs the test extra): what the test suite reaches besides
+MORE = {"roughpaths": (("more signatures", warm_more_signatures),),
+        "mechanics": (("more coadjoint schemes", warm_more_coadjoint),)}
 
 
 def main() -> None:
@@ -92,9 +142,10 @@ def main() -> None:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--part", choices=sorted(PARTS), help="only this part (default: both, one after the other)")
-    part = parser.parse_args().part
-    for name in ([part] if part else sorted(PARTS, reverse=True)):
-        for what, fn in PARTS[name]:
+    parser.add_argument("--more", action="store_true", help="also what the test suite reaches")
+    args = parser.parse_args()
+    for name in ([args.part] if args.part else sorted(PARTS, reverse=True)):
+        for what, fn in PARTS[name] + (MORE[name] if args.more else ()):
             t0, c0 = time.perf_counter(), time.process_time()
             fn()
             print(f"{what}: compiled and cached in {time.perf_counter() - t0:.1f} s "
