@@ -37,6 +37,7 @@ FAMILIES = {
                                         "rt.signature(t, 3).sum().backward()"),
     "jax step (sig depth 3)": ("sig", "import jax, roughpaths.jax as rj\n"
                                       "jax.grad(lambda a: rj.signature(a, 3).sum())(x)"),
+    "signature_coefficients (words)": ("sig", "rp.signature_coefficients(x, [(0, 1), (2, 0, 1), (1, 1, 2, 0)])"),
     "signature kernel + gram": ("sig", "rp.signature_kernel(x[:4], x[4:8]); "
                                        "rp.signature_kernel_gram(x[:4], x[4:8])"),
     "Brownian driver d=2,3": ("", "for d in (2, 3):\n"
