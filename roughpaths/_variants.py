@@ -38,5 +38,4 @@ def variants(factory):
                     kernel = cache[key] = factory(*key)
         return kernel
 
-    get.made = cache                 # the variants made so far (for tests and the warm-up)
     return get
