@@ -45,6 +45,7 @@ from .systems import (
     HeavyTop,
     LieAlgebra,
     LiePoissonSystem,
+    MatrixLieAlgebra,
     QuadraticHamiltonian,
     RigidBody,
     SE3Algebra,
@@ -58,9 +59,14 @@ from .systems import (
     levy_velocity,
     rigid_body,
     se3,
+    sl,
     sl2r,
+    so,
     so3,
+    sp,
+    su,
     su2,
+    u,
     vee,
 )
 from .limits import (
@@ -77,6 +83,7 @@ __version__ = "0.1.0"
 __all__ = [
     # Lie algebras
     "LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
+    "MatrixLieAlgebra", "so", "su", "u", "sp", "sl",
     # Lie–Poisson systems
     "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",

@@ -73,11 +73,12 @@ def expm_batched(A) -> np.ndarray:
     Parameters
     ----------
     A : array_like, shape ``(..., n, n)``
-        Real matrices (float64).
+        Real (float64) or complex (complex128) matrices; complex ones (e.g. the skew-Hermitian elements of
+        su(N)) take the Padé route at every size.
 
     Returns
     -------
-    ndarray, shape ``(..., n, n)``
+    ndarray, shape ``(..., n, n)``, float64 or complex128 like ``A``
 
     Examples
     --------
@@ -95,18 +96,21 @@ def expm_batched(A) -> np.ndarray:
     >>> bool(np.array_equal(pair[0], expm_batched(B))), bool(np.isnan(pair[1]).all())
     (True, True)
     """
-    A = as_float_array(A, "A", allow_nonfinite=True)     # NaN members: documented NaN result, see above
+    if np.iscomplexobj(A):
+        A = np.asarray(A, dtype=np.complex128)
+    else:
+        A = as_float_array(A, "A", allow_nonfinite=True)     # NaN members: documented NaN result, see above
     if A.ndim < 2 or A.shape[-1] != A.shape[-2]:
         raise ValueError(f"A must have shape (..., n, n) (a batch of square matrices), got shape {A.shape}.")
     shape, n = A.shape, A.shape[-1]
     if A.size == 0:                          # no members, or 0 x 0 matrices: nothing to exponentiate
-        return np.broadcast_to(np.eye(n), shape).copy()
+        return np.broadcast_to(np.eye(n, dtype=A.dtype), shape).copy()
     flat = A.reshape(-1, n, n)
-    if n == 2:                               # closed form, member by member (compiled)
+    if n == 2 and A.dtype == np.float64:     # closed form, member by member (compiled)
         out = np.empty(flat.shape)
         _expm2(np.ascontiguousarray(flat), out)
         return out.reshape(shape)
-    out = np.full(flat.shape, np.nan)
+    out = np.full(flat.shape, np.nan, dtype=A.dtype)
     with np.errstate(over="ignore", invalid="ignore"):
         norms = np.max(np.sum(np.abs(flat), axis=-2), axis=-1)
     finite = np.isfinite(norms)

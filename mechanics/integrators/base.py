@@ -67,7 +67,8 @@ from roughpaths.validation import as_float_array, check_positive_int
 
 from ..systems.lie_algebra import SE3Algebra, SO3Algebra
 from ..systems.lie_poisson import LiePoissonSystem
-from . import _generic_kernels, _se3_kernels, _so3_kernels
+from ..systems.matrix_algebra import MatrixLieAlgebra
+from . import _generic_kernels, _isospectral, _se3_kernels, _so3_kernels
 from ._chord import chord_solve
 from ._forced import forced_sigma_and_state
 
@@ -210,7 +211,19 @@ class CoadjointSolver(Solver):
         nk = dts.size
         nsave = int(np.count_nonzero(save))
         plain = system.hamiltonian.is_quadratic and not system.has_forces      # forces: the numpy path
-        if plain:
+        matrix = isinstance(system.algebra, MatrixLieAlgebra) and not system.has_forces
+        if matrix:                      # the state held as a matrix, updated by conjugation (._isospectral)
+            nb = int(np.prod(batch, dtype=np.int64))
+            d = dX.shape[-1]
+            dX = np.broadcast_to(dX, batch + (nk, d)).reshape(nb, nk, d)
+            if dXX is not None:
+                dXX = np.broadcast_to(dXX, batch + (nk, d, d)).reshape(nb, nk, d, d)
+            y2, saved, first_bad, reason = _isospectral.integrate_matrix(
+                self._code, system, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1), y.reshape(nb, n), dX,
+                dXX, dts, save, stop_on_failure)
+            y2, saved, first_bad = y2.reshape(batch + (n,)), saved.reshape(batch + (nsave, n)), first_bad.reshape(batch)
+            chord = (reason == _isospectral.CHORD_FAILED).reshape(batch)
+        elif plain:
             # so(3): the hand-written kernel; se(3) (the heavy top): the hand-written kernel for the implicit
             # midpoint rule; every other case (se(3) Lie-Euler / Lie-Heun included, where it measured faster):
             # the generic one

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from roughpaths.validation import as_float_array
+from roughpaths.validation import as_float_array, check_memory
 
 __all__ = ["Hamiltonian", "QuadraticHamiltonian", "check_inertia"]
 
@@ -94,22 +94,40 @@ class Hamiltonian:
 class QuadraticHamiltonian(Hamiltonian):
     r""":math:`h(\mu) = \tfrac12\mu\cdot Q\mu + b\cdot\mu` with symmetric ``Q`` (``(n, n)``) and ``b`` (``(n,)``).
 
-    Use :meth:`from_inertia` for :math:`h = \tfrac12\mu\cdot\mathbb I^{-1}\mu` (symmetric positive
-    definite inertia checked).
+    A vector ``q`` (shape ``(n,)``) means the diagonal :math:`Q = \mathrm{diag}(q)`, held as the vector: the
+    gradient costs ``O(n)`` and nothing of size ``n²`` is formed (the large matrix algebras,
+    :func:`mechanics.su`, need this). Use :meth:`from_inertia` for :math:`h = \tfrac12\mu\cdot\mathbb I^{-1}\mu`
+    (symmetric positive definite inertia checked).
     """
 
     def __init__(self, q, linear=None):
-        q = as_float_array(q, "q", ndim=2)
-        if q.shape[0] != q.shape[1]:
-            raise ValueError(f"q must be square, got shape {q.shape}.")
-        if float(np.max(np.abs(q - q.T))) > 1e-12 * max(1.0, float(np.max(np.abs(q)))):
-            raise ValueError("q must be symmetric; pass 0.5 * (q + q.T).")
-        n = q.shape[0]
+        q = as_float_array(q, "q")
+        if q.ndim == 1:
+            self.q_diagonal = q
+            n = q.shape[0]
+        elif q.ndim == 2 and q.shape[0] == q.shape[1]:
+            if float(np.max(np.abs(q - q.T))) > 1e-12 * max(1.0, float(np.max(np.abs(q)))):
+                raise ValueError("q must be symmetric; pass 0.5 * (q + q.T).")
+            self.q_diagonal = None
+            n = q.shape[0]
+        else:
+            raise ValueError(f"q must be a square (n, n) matrix or a vector (n,) (the diagonal), got shape {q.shape}.")
         b = np.zeros(n) if linear is None else as_float_array(linear, "linear", ndim=1)
         if b.shape != (n,):
             raise ValueError(f"linear must have shape ({n},), got {b.shape}.")
-        self.q, self.linear = q, b
+        self._q = None if q.ndim == 1 else q
+        self.linear = b
         super().__init__(self._val, self._grad, self._hess)
+
+    @property
+    def q(self) -> np.ndarray:
+        """The matrix ``Q``, shape ``(n, n)`` (formed on first use when ``Q`` was given as its diagonal)."""
+        if self._q is None:
+            n = self.q_diagonal.shape[0]
+            check_memory(8.0 * n * n, f"the {n}x{n} matrix of a diagonal quadratic Hamiltonian",
+                         "use q_diagonal, or a solver that does not need the matrix")
+            self._q = np.diag(self.q_diagonal)
+        return self._q
 
     @classmethod
     def from_inertia(cls, inertia, linear=None) -> "QuadraticHamiltonian":
@@ -118,9 +136,13 @@ class QuadraticHamiltonian(Hamiltonian):
         return cls(np.linalg.inv(i), linear)
 
     def _val(self, mu):
+        if self.q_diagonal is not None:
+            return 0.5 * np.einsum("...i,i,...i->...", mu, self.q_diagonal, mu) + mu @ self.linear
         return 0.5 * np.einsum("...i,ij,...j->...", mu, self.q, mu) + mu @ self.linear
 
     def _grad(self, mu):
+        if self.q_diagonal is not None:
+            return self.q_diagonal * np.asarray(mu, dtype=np.float64) + self.linear
         # stacked mat-vec, not (B, n) @ (n, n): a batch member's gradient must not depend on the batch
         return (self.q.T @ np.asarray(mu, dtype=np.float64)[..., None])[..., 0] + self.linear
 
@@ -130,3 +152,25 @@ class QuadraticHamiltonian(Hamiltonian):
     @property
     def is_quadratic(self) -> bool:
         return True
+
+
+def hamiltonian_from(h, gradient, hessian, n: int, *, diagonal_vector: bool = False) -> Hamiltonian:
+    """The Hamiltonian a :class:`~mechanics.systems.lie_poisson.LiePoissonSystem` was given: a
+    :class:`Hamiltonian`, a callable ``h(mu)`` (with ``gradient``), or an inertia tensor (checked). With
+    ``diagonal_vector`` (matrix algebras of any size) a vector of principal moments stays a vector
+    (:class:`QuadraticHamiltonian` with the diagonal ``1 / moments``), never an ``n x n`` matrix."""
+    if isinstance(h, Hamiltonian):
+        return h
+    if callable(h):
+        if gradient is None:
+            raise TypeError("a callable hamiltonian needs hamiltonian_gradient=callable(mu) -> (..., n).")
+        return Hamiltonian(h, gradient, hessian)
+    if diagonal_vector and np.ndim(h) == 1:
+        moments = as_float_array(h, "inertia", ndim=1)
+        if moments.shape != (n,):
+            raise ValueError(f"inertia must have shape ({n},) (one moment per basis element) or ({n}, {n}), "
+                             f"got {moments.shape}.")
+        if not np.all(moments > 0):
+            raise ValueError(f"inertia must be positive; its smallest moment is {float(np.min(moments)):.6g}.")
+        return QuadraticHamiltonian(1.0 / moments)
+    return QuadraticHamiltonian.from_inertia(check_inertia(h, "inertia", dim=n))

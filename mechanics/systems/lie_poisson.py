@@ -64,14 +64,15 @@ import numpy as np
 
 from roughpaths.validation import as_float_array, check_antisymmetric
 
-from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
+from .hamiltonian import check_inertia, hamiltonian_from
 from ._forces import ForcesMixin
+from ._matrix_states import MatrixStatesMixin
 from .lie_algebra import LieAlgebra
+from .matrix_algebra import MatrixLieAlgebra
 
 __all__ = [
     "LiePoissonSystem",
     "levy_velocity",
-    "girsanov_shift",
     "CONVENTIONS",
 ]
 
@@ -90,7 +91,7 @@ def levy_velocity(s, xi, algebra=None) -> np.ndarray:
         Antisymmetric area perturbation, in the coordinates of the driver of ``ξ``.
     xi : array_like ``(m, n)``
         Noise vectors (rows).
-    algebra : LieAlgebra, optional
+    algebra : LieAlgebra or MatrixLieAlgebra, optional
         Default so(3) (``[x, y] = x × y``, ``n = 3``).
 
     Examples
@@ -106,23 +107,29 @@ def levy_velocity(s, xi, algebra=None) -> np.ndarray:
     if s.shape[0] != s.shape[1]:
         raise ValueError(f"s must be square, got shape {s.shape}.")
     xi = as_float_array(xi, "xi", ndim=2, last_dims=(s.shape[0], alg.dim))
-    return _levy_velocity(s, _brackets(xi, alg.structure_constants))
+    return _levy_velocity(s, _brackets(xi, alg))
 
 
-def _brackets(xi, c):
-    return np.einsum("ia,jb,abk->ijk", xi, xi, c)                        # [ξ_i, ξ_j], (m, m, n)
+def _brackets(xi, algebra):
+    """``[ξ_i, ξ_j]``, shape ``(m, m, n)``: from the structure constants, or as commutators of matrices."""
+    if isinstance(algebra, MatrixLieAlgebra):
+        return algebra.bracket(xi[:, None, :], xi[None, :, :])
+    return np.einsum("ia,jb,abk->ijk", xi, xi, algebra._c)
 
 
 def _levy_velocity(s, brackets):
     return 0.5 * np.einsum("ij,ijk->k", s, brackets)
 
 
-class LiePoissonSystem(ForcesMixin):
+class LiePoissonSystem(ForcesMixin, MatrixStatesMixin):
     r"""A stochastic Lie–Poisson (Euler–Poincaré) system on :math:`\mathfrak g^*` with SALT noise.
 
     Parameters
     ----------
-    algebra : LieAlgebra
+    algebra : LieAlgebra or MatrixLieAlgebra
+        Structure constants (small and user algebras) or a matrix algebra (:func:`~mechanics.su`,
+        :func:`~mechanics.so`, ... any size: the solvers then hold the state as a matrix and update it by
+        conjugation, :mod:`mechanics.integrators`); the equations are the same.
     hamiltonian : array_like ``(n, n)`` inertia tensor, or Hamiltonian, or callable
         An inertia tensor gives :math:`h = \tfrac12\mu\cdot\mathbb I^{-1}\mu` (symmetric positive
         definite, checked). A callable ``h(mu)`` needs ``hamiltonian_gradient=`` (and optionally
@@ -174,12 +181,13 @@ class LiePoissonSystem(ForcesMixin):
                  *, hamiltonian_gradient=None, hamiltonian_hessian=None, metric=None,
                  levy_in_dissipation: bool = True, force=None, noise_forces=None, force_jacobian=None,
                  noise_forces_jacobian=None):
-        if not isinstance(algebra, LieAlgebra):
-            raise TypeError(f"algebra must be a LieAlgebra (e.g. mechanics.systems.lie_algebra.so3()), got "
-                            f"{type(algebra).__name__}.")
+        if not isinstance(algebra, (LieAlgebra, MatrixLieAlgebra)):
+            raise TypeError(f"algebra must be a LieAlgebra (e.g. mechanics.so3()) or a MatrixLieAlgebra (e.g. "
+                            f"mechanics.su(4)), got {type(algebra).__name__}.")
         self.algebra = algebra
         n = algebra.dim
-        self.hamiltonian = self._make_hamiltonian(hamiltonian, hamiltonian_gradient, hamiltonian_hessian, n)
+        self.hamiltonian = hamiltonian_from(hamiltonian, hamiltonian_gradient, hamiltonian_hessian, n,
+                                            diagonal_vector=isinstance(algebra, MatrixLieAlgebra))
         xi = as_float_array(xi, "xi")
         if xi.ndim != 2 or xi.shape[1] != n or xi.shape[0] < 1:
             raise ValueError(f"xi must have shape (m, n) = (number of noises, {n}) with one noise "
@@ -211,27 +219,19 @@ class LiePoissonSystem(ForcesMixin):
             mtr = check_inertia(metric, "metric", dim=n)
             self._metric_inv = np.linalg.inv(mtr)
         self.xi, self.s, self.theta, self.convention = xi, s, theta, convention
-        c = algebra.structure_constants
-        self._xi_brackets = _brackets(xi, c)
+        self._xi_brackets = _brackets(xi, algebra)
         self._levy_velocity = _levy_velocity(s, self._xi_brackets)
         self._shift = self._levy_velocity if convention == "rp" else -self._levy_velocity
         # velocity shift inside the double bracket: the same as _shift, or none (dissipation from h)
         self._shift_dissipation = self._shift if self.levy_in_dissipation else np.zeros(n)
-        self._noise_matrices = np.einsum("ia,ajk->ijk", xi, c)               # B_i = ad*_{ξ_i}, (m, n, n)
+        self._matrix = isinstance(algebra, MatrixLieAlgebra)
+        # B_i = ad*_{ξ_i}, (m, n, n): formed now from structure constants, on first use for a matrix algebra
+        self._noise_matrices = None if self._matrix else np.einsum("ia,ajk->ijk", xi, algebra._c)
         for arr in (self.xi, self.s, self._xi_brackets, self._levy_velocity, self._noise_matrices,
                     self._shift_dissipation):
-            arr.setflags(write=False)
+            if arr is not None:
+                arr.setflags(write=False)
         self._set_forces(force, noise_forces, force_jacobian, noise_forces_jacobian)
-
-    @staticmethod
-    def _make_hamiltonian(h, grad, hess, n):
-        if isinstance(h, Hamiltonian):
-            return h
-        if callable(h):
-            if grad is None:
-                raise TypeError("a callable hamiltonian needs hamiltonian_gradient=callable(mu) -> (..., n).")
-            return Hamiltonian(h, grad, hess)
-        return QuadraticHamiltonian.from_inertia(check_inertia(h, "inertia", dim=n))
 
     # ------------------------------------------------------------------ attributes
     @property
@@ -293,13 +293,18 @@ class LiePoissonSystem(ForcesMixin):
 
     @property
     def noise_matrices(self) -> np.ndarray:
-        r"""Matrices ``B_i`` of :math:`\mu\mapsto\mathrm{ad}^*_{\xi_i}\mu`, shape ``(m, n, n)``."""
+        r"""Matrices ``B_i`` of :math:`\mu\mapsto\mathrm{ad}^*_{\xi_i}\mu`, shape ``(m, n, n)`` (for a matrix
+        algebra formed on first use: ``m n²`` floats, which its solvers never need)."""
+        if self._noise_matrices is None:
+            self._noise_matrices = self.algebra.ad_star_matrix(self.xi)
+            self._noise_matrices.setflags(write=False)
         return self._noise_matrices
 
     def with_s(self, s) -> "LiePoissonSystem":
         """A copy with another Lévy-area perturbation ``s`` (everything else shared)."""
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
+        new.__dict__.pop("_stack", None)
         LiePoissonSystem.__init__(new, self.algebra, self.hamiltonian, self.xi, s, self.theta,
                                   self.convention, metric=None, levy_in_dissipation=self.levy_in_dissipation,
                                   force=self.force, noise_forces=self.noise_forces,
@@ -350,7 +355,22 @@ class LiePoissonSystem(ForcesMixin):
 
     # ------------------------------------------------------------------ vector fields
     def _ad_star(self, x, mu):
+        if self._matrix:
+            x, mu = np.broadcast_arrays(x, mu)
+            return self.algebra._ad_star_unchecked(x, mu)
         return np.einsum("...i,...k,ijk->...j", x, mu, self.algebra._c)
+
+    def _ad_star_op(self, x):
+        """``[..., j, k] = ∂(ad*_x μ)_j / ∂μ_k``, shape ``(..., n, n)``."""
+        if self._matrix:
+            return self.algebra.ad_star_matrix(x)
+        return np.einsum("...i,ijk->...jk", x, self.algebra._c)
+
+    def _orbit_tangent(self, mu):
+        """``[..., j, i] = (ad*_{e_i} μ)_j``, shape ``(..., n, n)``."""
+        if self._matrix:
+            return self.algebra.coadjoint_orbit_tangent(mu)
+        return np.einsum("...k,ijk->...ji", mu, self.algebra._c)
 
     def conservative_drift(self, mu) -> np.ndarray:
         r""":math:`\mathrm{ad}^*_{\nabla\tilde h}\mu` (Hamiltonian part plus Lévy torque), shape ``(..., n)``."""
@@ -385,10 +405,9 @@ class LiePoissonSystem(ForcesMixin):
         hess = self.hamiltonian.hessian(mu)
         if self.theta == 0.0:
             return np.array(hess, dtype=np.float64)
-        c = self.algebra._c
         g = self._grad_dissipation(mu)                             # the gradient inside the bracket
-        a_g = np.einsum("...i,ijk->...jk", g, c)                 # ad*_g
-        lmu = np.einsum("...k,ijk->...ji", mu, c)                # δ ↦ ad*_δ μ
+        a_g = self._ad_star_op(g)                                # ad*_g
+        lmu = self._orbit_tangent(mu)                            # δ ↦ ad*_δ μ
         d = a_g + lmu @ hess
         if self._metric_inv is not None:
             d = self._metric_inv.T @ d
@@ -404,22 +423,21 @@ class LiePoissonSystem(ForcesMixin):
     def drift_jacobian(self, mu) -> np.ndarray:
         """Jacobian of :meth:`drift`, shape ``(..., n, n)`` (``[..., a, b] = ∂drift_a/∂μ_b``)."""
         mu = self._mu(mu)
-        c = self.algebra._c
         w = self._w(mu)
-        out = np.einsum("...i,ijk->...jk", w, c) + np.einsum("...k,ijk->...ji", mu, c) @ self._w_jacobian(mu)
+        out = self._ad_star_op(w) + self._orbit_tangent(mu) @ self._w_jacobian(mu)
         return out if self.force is None else out + self._f0_jacobian(mu)
 
     def noise(self, mu) -> np.ndarray:
         r"""Noise fields as columns: ``[..., :, i]`` is :math:`\mathrm{ad}^*_{\xi_i}\mu + F^i(\mu)`, shape ``(..., n, m)``."""
         mu = self._mu(mu)
-        out = np.einsum("iab,...b->...ai", self._noise_matrices, mu)
+        out = np.einsum("iab,...b->...ai", self.noise_matrices, mu)
         return out if self.noise_forces is None else out + self._fi(mu)
 
     def noise_jacobian(self, mu) -> np.ndarray:
         """``[..., a, i, b] = ∂ V_i^a / ∂ μ_b`` (constant without ``noise_forces``: the fields are linear), shape
         ``(..., n, m, n)``."""
         mu = self._mu(mu)
-        jac = np.transpose(self._noise_matrices, (1, 0, 2))
+        jac = np.transpose(self.noise_matrices, (1, 0, 2))
         if self.noise_forces is not None:
             return jac + self._fi_jacobian(mu)
         return np.broadcast_to(jac, mu.shape[:-1] + jac.shape)
@@ -440,7 +458,7 @@ class LiePoissonSystem(ForcesMixin):
         from roughpaths import LinearVectorFields, VectorFields
 
         if self.noise_forces is None:
-            return LinearVectorFields(self._noise_matrices, drift=self.drift, drift_jacobian=self.drift_jacobian)
+            return LinearVectorFields(self.noise_matrices, drift=self.drift, drift_jacobian=self.drift_jacobian)
         return VectorFields(self.noise, self._noise_jacobians_rp, drift=self.drift,
                             drift_jacobian=self.drift_jacobian, dim_state=self.dim, dim_noise=self.n_noise)
 
@@ -472,24 +490,3 @@ class LiePoissonSystem(ForcesMixin):
             brk = self._xi_brackets.reshape(m * m, self.dim).T
             out = out + 0.5 * (brk @ a.reshape(a.shape[:-2] + (m * m, 1)))[..., 0]
         return out
-
-
-def girsanov_shift(system: LiePoissonSystem, *, convention: str = "rp", atol: float = 1e-10) -> np.ndarray:
-    r"""Constant Girsanov drift :math:`u\in\mathbb R^m` with :math:`u^k\xi_k = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]`.
-
-    Then the corrected system driven by :math:`X` equals the uncorrected one (``s = 0``) driven by
-    :math:`X_t + u\,t` pathwise, and the two laws are equivalent (Novikov holds: ``u`` is constant).
-    For :math:`\xi_k = e_k` (a basis) :math:`u^k = \tfrac12\mathsf s^{ij}c^k_{ij}`; the paper's
-    (LieDepXis) drops the ½ — ``convention="paper"`` returns that printed value (twice ours).
-
-    Raises ``ValueError`` if :math:`\ell` is not in the span of the :math:`\xi_k` (no constant shift).
-    """
-    if convention not in CONVENTIONS:
-        raise ValueError(f"convention must be one of {CONVENTIONS}, got {convention!r}.")
-    ell = system.levy_velocity
-    u, *_ = np.linalg.lstsq(system.xi.T, ell, rcond=None)
-    resid = float(np.max(np.abs(system.xi.T @ u - ell))) if ell.size else 0.0
-    if resid > atol * max(1.0, float(np.max(np.abs(ell)))):
-        raise ValueError(f"the Lévy velocity ½ s^ij [xi_i, xi_j] = {ell} is not a combination of the noise "
-                         f"vectors xi (residual {resid:.3g}); no constant Girsanov shift exists.")
-    return 2.0 * u if convention == "paper" else u

@@ -14,7 +14,8 @@ import pytest
 
 from mechanics.integrators import ImplicitMidpoint, LieHeun
 from mechanics.systems.lie_algebra import sl2r, so3, su2
-from mechanics.systems.lie_poisson import LiePoissonSystem, girsanov_shift
+from mechanics.systems.girsanov import girsanov_shift
+from mechanics.systems.lie_poisson import LiePoissonSystem
 from mechanics.systems.rigid_body import rigid_body
 from roughpaths import RoughPath, solve
 
