@@ -35,7 +35,11 @@ driver. Perturbing the area, :math:`A\mapsto A + \mathsf s\Delta t`,
 adds exactly :math:`\ell\Delta t = \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\Delta t` to :math:`\sigma_n`: the
 discrete Proposition 2.1.
 
-Implementation: a system with a quadratic Hamiltonian and no forces runs compiled block kernels:
+Implementation: a system on a :class:`~mechanics.systems.matrix_algebra.MatrixLieAlgebra` (so(n), su(N), ...,
+any size) without forces holds the state as its matrix for a whole block and updates it by conjugation,
+:math:`M\mapsto e^{-\sigma}Me^{\sigma}` (:mod:`mechanics.integrators._isospectral`; the implicit midpoint by
+fixed-point iteration there). Otherwise a system with a quadratic Hamiltonian and no forces runs compiled block
+kernels:
 for a :class:`~mechanics.systems.lie_algebra.SO3Algebra` the hand-written ones of
 :mod:`mechanics.integrators._so3_kernels`, for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy
 top) and the implicit midpoint rule that of :mod:`mechanics.integrators._se3_kernels` (Lie–Euler and
