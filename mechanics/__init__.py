@@ -45,6 +45,7 @@ from .systems import (
     HeavyTop,
     LieAlgebra,
     LiePoissonSystem,
+    MatrixHamiltonian,
     MatrixLieAlgebra,
     QuadraticHamiltonian,
     RigidBody,
@@ -85,7 +86,7 @@ __all__ = [
     "LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
     "MatrixLieAlgebra", "so", "su", "u", "sp", "sl",
     # Lie–Poisson systems
-    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
+    "LiePoissonSystem", "Hamiltonian", "QuadraticHamiltonian", "MatrixHamiltonian", "girsanov_shift", "check_inertia", "levy_velocity",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     # phase space and reduction (Section 2.3)
     "CotangentLift", "cotangent_lift",

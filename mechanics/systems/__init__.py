@@ -13,7 +13,7 @@ on phase space that reduces to it (Section 2.3).
 
 from .classical_algebras import sl, so, sp, su, u
 from .cotangent_lift import CotangentLift, cotangent_lift
-from .hamiltonian import Hamiltonian, QuadraticHamiltonian, check_inertia
+from .hamiltonian import Hamiltonian, MatrixHamiltonian, QuadraticHamiltonian, check_inertia
 from .heavy_top import HeavyTop, heavy_top
 from .lie_algebra import (LieAlgebra, SE3Algebra, SO3Algebra, hat, rodrigues_ad_star_exp, se3, se3_ad_star_exp, sl2r,
                           so3, su2, vee)
@@ -26,7 +26,7 @@ __all__ = [
     "LieAlgebra", "SO3Algebra", "SE3Algebra", "so3", "su2", "se3", "sl2r", "hat", "vee",
     "rodrigues_ad_star_exp", "se3_ad_star_exp",
     "MatrixLieAlgebra", "so", "su", "u", "sp", "sl",
-    "Hamiltonian", "QuadraticHamiltonian", "check_inertia",
+    "Hamiltonian", "QuadraticHamiltonian", "MatrixHamiltonian", "check_inertia",
     "LiePoissonSystem", "levy_velocity", "girsanov_shift",
     "RigidBody", "rigid_body", "isotropic_xi", "HeavyTop", "heavy_top",
     "CotangentLift", "cotangent_lift",

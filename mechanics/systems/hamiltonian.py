@@ -11,7 +11,7 @@ import numpy as np
 
 from roughpaths.validation import as_float_array, check_memory
 
-__all__ = ["Hamiltonian", "QuadraticHamiltonian", "check_inertia"]
+__all__ = ["Hamiltonian", "QuadraticHamiltonian", "MatrixHamiltonian", "check_inertia"]
 
 
 def check_inertia(inertia, name: str = "inertia", *, dim: int | None = None) -> np.ndarray:
@@ -152,6 +152,48 @@ class QuadraticHamiltonian(Hamiltonian):
     @property
     def is_quadratic(self) -> bool:
         return True
+
+
+class MatrixHamiltonian(Hamiltonian):
+    r"""A Hamiltonian on the dual of a :class:`~mechanics.systems.matrix_algebra.MatrixLieAlgebra`, given on matrices.
+
+    Parameters
+    ----------
+    algebra : MatrixLieAlgebra
+    value_matrix : callable
+        ``M (..., N, N) -> (...)``: :math:`h` at the state held as the matrix ``M``.
+    gradient_matrix : callable
+        ``M (..., N, N) -> (..., N, N)``: :math:`\nabla h` as an element of the algebra (a matrix), defined by
+        :math:`dh = B(dM, \nabla h)` for the trace form ``B``; the Lie–Poisson drift is then :math:`[M, \nabla h]`.
+
+    The isospectral solvers call :meth:`gradient_matrix` directly (no coordinates: e.g. the Zeitlin model's
+    inverse Laplacian on su(N)); :meth:`value` and :meth:`gradient` in coordinates go through the algebra's
+    ``O(N²)`` maps, for everything else (energies, the coordinate schemes, checks). The Hessian, where a
+    coordinate method asks for it, is by central differences (:class:`Hamiltonian`).
+    """
+
+    def __init__(self, algebra, value_matrix, gradient_matrix):
+        if not callable(value_matrix) or not callable(gradient_matrix):
+            raise TypeError("MatrixHamiltonian needs callables value_matrix(M) and gradient_matrix(M).")
+        if not hasattr(algebra, "dual_to_matrix"):
+            raise TypeError(f"algebra must be a MatrixLieAlgebra (e.g. mechanics.su(8)), got {type(algebra).__name__}.")
+        self.algebra = algebra
+        self._value_matrix, self._gradient_matrix = value_matrix, gradient_matrix
+        super().__init__(self._value_coords, self._gradient_coords)
+
+    def value_matrix(self, M):
+        """:math:`h` at matrices ``M (..., N, N)``, shape ``(...)``."""
+        return np.asarray(self._value_matrix(M), dtype=np.float64)
+
+    def gradient_matrix(self, M):
+        """:math:`\nabla h` as matrices of the algebra, ``(..., N, N)``."""
+        return np.asarray(self._gradient_matrix(M))
+
+    def _value_coords(self, mu):
+        return self.value_matrix(self.algebra.dual_to_matrix(mu))
+
+    def _gradient_coords(self, mu):
+        return self.algebra.from_matrix(self.gradient_matrix(self.algebra.dual_to_matrix(mu)))
 
 
 def hamiltonian_from(h, gradient, hessian, n: int, *, diagonal_vector: bool = False) -> Hamiltonian:

@@ -104,3 +104,28 @@ def test_level1_driver_gives_zero_area():
     np.testing.assert_allclose(a, b, atol=1e-12)
     with_area = rp.solve(system, X, mu0, LieEuler()).final
     assert np.max(np.abs(with_area - a)) > 1e-4
+
+
+def test_a_hamiltonian_given_on_matrices():
+    """h(M) = a/2 B(M, M) + B(M, C) given on matrices (MatrixHamiltonian: the solver calls gradient_matrix) against
+    the same h in coordinates (a diagonal QuadraticHamiltonian with the linear term C's coordinates)."""
+    from mechanics import MatrixHamiltonian, QuadraticHamiltonian
+
+    g = su(4)
+    rng = np.random.default_rng(12)
+    a, c = 0.7, rng.standard_normal(g.dim)
+    C = g.to_matrix(c)
+    h_matrix = MatrixHamiltonian(g, lambda M: 0.5 * a * g.pairing(M, M) + g.pairing(M, C), lambda M: a * M + C)
+    h_coords = QuadraticHamiltonian(np.full(g.dim, a), linear=c)
+    xi = 0.4 * rng.standard_normal((3, g.dim))
+    s = np.zeros((3, 3))
+    s[1, 2], s[2, 1] = 0.5, -0.5
+    mu0 = rng.standard_normal((2, g.dim))
+    np.testing.assert_allclose(h_matrix.value(mu0), h_coords.value(mu0), atol=1e-12)
+    np.testing.assert_allclose(h_matrix.gradient(mu0), h_coords.gradient(mu0), atol=1e-12)
+    X = rp.brownian_rough_path(np.linspace(0.0, 0.5, 101), dim=3, rng=np.random.default_rng(1), batch_shape=(2,))
+    for theta in (0.0, 0.3):
+        one = LiePoissonSystem(g, h_matrix, xi, s=s, theta=theta)
+        two = LiePoissonSystem(g, h_coords, xi, s=s, theta=theta)
+        np.testing.assert_allclose(rp.solve(one, X, mu0, LieHeun()).final, rp.solve(two, X, mu0, LieHeun()).final,
+                                   atol=1e-12)
