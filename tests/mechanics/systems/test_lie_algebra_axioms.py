@@ -168,3 +168,17 @@ def test_bad_algebras_rejected():
         so3().bracket(np.ones(4), np.ones(4))
     with pytest.raises(ValueError, match="no known Casimirs"):
         LieAlgebra(se3().structure_constants).casimirs(np.ones(6))
+
+
+def test_algebras_from_constants_pickle_with_their_casimir():
+    """sl(2, R) from constants (its quadratic Casimir from the Killing form) pickles: systems on it go to
+    checkpoints and process executors like any other."""
+    import pickle
+
+    from mechanics import LiePoissonSystem, sl2r
+
+    g = sl2r()
+    h = pickle.loads(pickle.dumps(LiePoissonSystem(g, np.eye(3), 0.1 * np.eye(3)))).algebra
+    mu = np.array([0.3, -1.2, 2.0])
+    np.testing.assert_array_equal(h.casimirs(mu), g.casimirs(mu))
+    np.testing.assert_allclose(g.casimirs(mu), [mu @ np.linalg.inv(g.killing_form()) @ mu], rtol=1e-14)
