@@ -36,7 +36,7 @@ import numpy as np
 from roughpaths import __version__ as _package_version
 from roughpaths.io import atomic_savez, open_npz
 
-from .statistics import LEAF, LeafReducer
+from .statistics import LEAF, LeafReducer, moments_problem
 
 __all__ = ["fingerprint", "save_checkpoint", "load_checkpoint", "LIBRARY_MODULES"]
 
@@ -264,16 +264,11 @@ def load_checkpoint(path, fingerprint, *, bounds, dim, state_dim, time_average, 
                 raise refuse(f"{name + '_count'!r} is {stored}, but {done} chunks hold {paths} paths, of which "
                              f"{count} are in complete leaves of {LEAF}")
             mean, scatter, rows = (npz.read(name + s) for s in ("_mean", "_scatter", "_pending"))
-            for label, a in ((name + "_mean", mean), (name + "_scatter", scatter), (name + "_pending", rows)):
-                if not np.all(np.isfinite(a)):
-                    raise refuse(f"{label!r} holds non-finite values")
-            diag = np.diag(scatter)
-            scale = float(np.max(diag, initial=0.0))
-            if np.any(diag < 0) or float(np.max(np.abs(scatter - scatter.T), initial=0.0)) > 1e-9 * scale:
-                raise refuse(f"{name + '_scatter'!r} is not a scatter matrix (symmetric with a non-negative "
-                             f"diagonal)")
-            if count == 0 and (np.any(mean != 0) or np.any(scatter != 0)):
-                raise refuse(f"{name!r} holds no complete leaf but a non-zero mean or scatter")
+            if not np.all(np.isfinite(rows)):
+                raise refuse(f"{name + '_pending'!r} holds non-finite values")
+            problem = moments_problem(name, count, mean, scatter)
+            if problem is not None:
+                raise refuse(problem)
             red = LeafReducer(p)
             red.moments.count, red.moments.mean, red.moments.scatter = count, mean, scatter
             red._pending = rows

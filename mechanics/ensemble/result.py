@@ -14,7 +14,7 @@ import numpy as np
 from roughpaths import register_format
 from roughpaths.validation import arrays_equal
 
-from .statistics import RunningMoments, split_moment_features
+from .statistics import RunningMoments, moments_problem, split_moment_features
 
 __all__ = ["EnsembleResult"]
 
@@ -106,8 +106,17 @@ def _encode_ensemble(res: "EnsembleResult"):
 
 
 def _decode_ensemble(meta, arrays):
-    """The inverse of :func:`_encode_ensemble`; refuses arrays that disagree with each other or the metadata."""
+    """The inverse of :func:`_encode_ensemble`; refuses arrays that disagree with each other or the metadata, and
+    statistics no run writes (:func:`~mechanics.ensemble.statistics.moments_problem`: counts beyond ``n_paths``,
+    non-finite values, a scatter matrix that is not one)."""
     n, paths = meta["state_dim"], meta["n_paths"]
+    for key in ("n_paths", "n_steps", "state_dim", "n_snapshots"):
+        v = meta[key]
+        if isinstance(v, bool) or not isinstance(v, int) or v < (0 if key == "n_snapshots" else 1):
+            raise ValueError(f"the metadata entry {key!r} is {v!r}, not a positive whole number")
+    dt = meta["dt"]
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not np.isfinite(dt) or dt <= 0:
+        raise ValueError(f"the metadata entry 'dt' is {dt!r}, not a positive finite step")
     fs = arrays.get("final_states")
     if fs is not None and fs.shape != (paths, n):
         raise ValueError(f"final_states has shape {fs.shape}, but n_paths={paths} and state_dim={n}")
@@ -118,6 +127,14 @@ def _decode_ensemble(meta, arrays):
     if arrays["snapshot_times"].shape != (meta["n_snapshots"],):
         raise ValueError(f"snapshot_times has shape {arrays['snapshot_times'].shape}, but n_snapshots="
                          f"{meta['n_snapshots']}")
+    names = ["final"] + (["time_average"] if meta["has_time_average"] else []) + [
+        f"snapshot{k}" for k in range(meta["n_snapshots"])]
+    for name in names:
+        count = arrays[name + "_count"]
+        count = int(count) if count.shape == () and count.dtype.kind in "iu" else count
+        problem = moments_problem(name, count, arrays[name + "_mean"], arrays[name + "_scatter"], max_count=paths)
+        if problem is not None:
+            raise ValueError(problem)
     return EnsembleResult(
         final=_moments_from_arrays(arrays, "final_"),
         time_average=_moments_from_arrays(arrays, "time_average_") if meta["has_time_average"] else None,

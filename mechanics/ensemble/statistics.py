@@ -14,7 +14,7 @@ import numpy as np
 
 from roughpaths.validation import arrays_equal, as_float_array, check_memory, check_positive_int
 
-__all__ = ["RunningMoments", "moment_observable", "split_moment_features", "LeafReducer", "LEAF"]
+__all__ = ["RunningMoments", "moment_observable", "split_moment_features", "LeafReducer", "LEAF", "moments_problem"]
 
 #: Paths per leaf of :class:`LeafReducer` (part of the definition of the ensemble's statistics).
 LEAF = 64
@@ -225,3 +225,25 @@ def accumulate_moments(acc, states):
                 for j in range(i, n):
                     acc[c, r] += xi * states[c, t, j]
                     r += 1
+
+
+def moments_problem(name: str, count, mean, scatter, *, max_count=None):
+    """What is wrong with stored statistics ``(count, mean, scatter)`` read from a file, or ``None``: the one check
+    of checkpoints and saved :class:`~mechanics.ensemble.result.EnsembleResult` files (untrusted input).
+
+    Finite means and scatter, a scatter matrix symmetric (to 1e-9 of its largest diagonal entry) with a
+    non-negative diagonal, a count that is a whole number from 0 to ``max_count``, and zero statistics where the
+    count is zero.
+    """
+    if not isinstance(count, (int, np.integer)) or count < 0 or (max_count is not None and count > max_count):
+        return f"{name + '_count'!r} is {count!r}, not a number of paths from 0 to {max_count}"
+    for label, a in ((name + "_mean", mean), (name + "_scatter", scatter)):
+        if not np.all(np.isfinite(a)):
+            return f"{label!r} holds non-finite values"
+    diag = np.diag(scatter)
+    scale = float(np.max(diag, initial=0.0))
+    if np.any(diag < 0) or float(np.max(np.abs(scatter - scatter.T), initial=0.0)) > 1e-9 * scale:
+        return f"{name + '_scatter'!r} is not a scatter matrix (symmetric with a non-negative diagonal)"
+    if count == 0 and (np.any(mean != 0) or np.any(scatter != 0)):
+        return f"{name!r} holds no paths but a non-zero mean or scatter"
+    return None

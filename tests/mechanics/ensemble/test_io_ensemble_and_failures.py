@@ -53,3 +53,29 @@ def test_solution_keeps_its_failure_marks(tmp_path):
 def test_unregistered_objects_are_refused_with_the_supported_types(tmp_path):
     with pytest.raises(TypeError, match="EnsembleResult"):
         rp.save(object(), tmp_path / "x")
+
+
+@pytest.mark.parametrize("entry,value,message", [
+    ("final_count", np.array(10**6), "not a number of paths from 0 to 12"),
+    ("final_count", np.array(-1), "not a number of paths"),
+    ("final_mean", None, "non-finite"),
+    ("time_average_scatter", None, "not a scatter matrix"),
+])
+def test_a_tampered_ensemble_file_is_refused(tmp_path, entry, value, message):
+    """Files are untrusted input: counts beyond the run's paths, non-finite statistics and a scatter matrix that is
+    not one are refused by load (not returned as an EnsembleResult whose standard errors are nonsense)."""
+    rb = mechanics.rigid_body([1.0, 2.0, 3.0], sigma=0.2, theta=0.5)
+    res = mechanics.run_ensemble(rb, [0.0, 0.6, 0.8], dt=0.01, n_steps=20, n_paths=12, seed=3)
+    path = rp.save(res, tmp_path / "ens")
+    with np.load(path) as f:
+        arrays = {k: f[k] for k in f.files}
+    if value is None and entry.endswith("_mean"):
+        value = arrays[entry].copy()
+        value[0] = np.nan
+    elif value is None:
+        value = arrays[entry].copy()
+        value[0, 1] += 1.0                                               # no longer symmetric
+    arrays[entry] = value
+    np.savez(tmp_path / "bad.npz", **arrays)
+    with pytest.raises(ValueError, match=message):
+        rp.load(tmp_path / "bad.npz")
