@@ -77,7 +77,8 @@ def laplacian(P) -> np.ndarray:
 
 @functools.lru_cache(maxsize=8)
 def _factors(N: int):
-    """``(perm, d, e)``: diagonals in the order 0, +1, -1, +2, -2, ...; LDL^T factors of -Delta_N on them."""
+    """``(perm, inverse, d, e)``: the diagonals in the order 0, +1, -1, +2, -2, ... (a permutation of the
+    ``N^2`` entries and its inverse), and the LDL^T factors of -Delta_N on them."""
     perm, diag, off = [], [], []
     for m in range(N):
         d, e = band_tridiagonal(N, m)
@@ -100,9 +101,11 @@ def _factors(N: int):
     df, ef, info = lapack.dpttrf(d, e)
     if info != 0:  # pragma: no cover - the blocks are positive definite by construction
         raise RuntimeError(f"dpttrf failed (info={info}) factorising the quantised Laplacian at N={N}.")
-    for arr in (perm, df, ef):
+    inverse = np.empty_like(perm)
+    inverse[perm] = np.arange(perm.size)
+    for arr in (perm, inverse, df, ef):
         arr.setflags(write=False)
-    return perm, df, ef
+    return perm, inverse, df, ef
 
 
 def inverse_laplacian(W) -> np.ndarray:
@@ -124,20 +127,21 @@ def inverse_laplacian(W) -> np.ndarray:
     """
     arr = as_matrix(W)
     n = arr.shape[-1]
-    perm, df, ef = _factors(n)
+    perm, inverse, df, ef = _factors(n)
     batch = arr.shape[:-2]
     flat = arr.reshape((-1, n * n))
     b = flat.shape[0]
-    rhs = np.ascontiguousarray(np.take(flat, perm, axis=1))  # (B, n^2)
+    rhs = np.take(flat, perm, axis=1)  # (B, n^2), the diagonals one after the other
     rhs[:, :n] -= rhs[:, :n].mean(axis=1, keepdims=True)  # drop the l = 0 part
     rhs[:, n - 1] = 0.0
-    cols = np.asfortranarray(rhs.view(np.float64).reshape(b, n * n, 2).transpose(1, 0, 2).reshape(n * n, 2 * b))
-    x, info = lapack.dpttrs(df, ef, cols)
+    cols = np.empty((2 * b, n * n))  # C order (2B, n^2): its transpose is LAPACK's (n^2, 2B) column layout
+    cols[0::2], cols[1::2] = rhs.real, rhs.imag
+    x, info = lapack.dpttrs(df, ef, cols.T, overwrite_b=True)
     if info != 0:  # pragma: no cover
         raise RuntimeError(f"dpttrs failed (info={info}) solving the quantised Poisson equation at N={n}.")
-    sol = np.ascontiguousarray(x.reshape(n * n, b, 2).transpose(1, 0, 2)).view(np.complex128)[..., 0]
-    sol = -sol  # dpttrs solved (-Delta_N) x = rhs
+    rows = x.T
+    sol = np.empty((b, n * n), dtype=np.complex128)
+    sol.real, sol.imag = -rows[0::2], -rows[1::2]  # dpttrs solved (-Delta_N) x = rhs
     sol[:, :n] -= sol[:, :n].mean(axis=1, keepdims=True)
-    out = np.empty((b, n * n), dtype=np.complex128)
-    out[:, perm] = sol
+    out = np.take(sol, inverse, axis=1)
     return out.reshape(batch + (n, n))
