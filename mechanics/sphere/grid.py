@@ -229,6 +229,10 @@ def function_to_matrix(func, N: int, *, oversample: int = 2) -> np.ndarray:
         raise ValueError(f"oversample must be a positive integer, got {oversample!r}.")
     theta, phi, _ = sphere_grid(oversample * n, oversample * 2 * n)
     values = np.asarray(func(theta[:, None], phi[None, :]))
-    if values.shape[-2:] != (theta.size, phi.size):
-        values = np.broadcast_to(values, values.shape[:-2] + (theta.size, phi.size))
+    shape = (theta.size, phi.size)
+    try:
+        values = np.broadcast_to(values, np.broadcast_shapes(values.shape, shape))
+    except ValueError:
+        raise ValueError(f"func(theta, phi) must return values broadcastable to the grid shape {shape} (theta "
+                         f"as a column, phi as a row), got shape {values.shape}.") from None
     return coefficients_to_matrix(grid_to_coefficients(values, n), n)

@@ -17,7 +17,9 @@ one null vector :math:`(1, \dots, 1)` (:math:`l = 0`: the identity, :math:`\Delt
 The inverse. :func:`inverse_laplacian` solves :math:`\Delta_N P = W` on all :math:`2N-1` diagonals at once,
 as one block-diagonal tridiagonal system of size :math:`N^2` whose :math:`LDL^{\mathsf T}` factors
 (LAPACK ``dpttrf``) are computed once per :math:`N`; a solve is LAPACK ``dpttrs`` on the real and imaginary
-parts (:math:`O(N^2)` per matrix: 0.1 ms at N = 64 and about 2 ms at N = 256, gather and scatter included).
+parts (:math:`O(N^2)` per matrix; CPU time on one core, gather and scatter included: 0.1 ms at N = 64,
+0.5 ms at N = 128, about 3 ms at N = 256, about one complex N x N product (2.8 ms at N = 256, 0.36 ms at
+N = 128; load 6 on 2 cores)).
 The :math:`l = 0` part, :math:`\operatorname{tr}(W)I/N` (a constant vorticity; on a closed sphere the total
 vorticity, :math:`\int\omega\,dA = \sqrt{4\pi}\,\omega_{00}`, is zero), has no preimage: it is removed
 from :math:`W` first, and the solution is the one with :math:`\operatorname{tr}P = 0`. On the main

@@ -44,9 +44,10 @@ eigenvalues :math:`-l(l+1)`, :math:`l = |m|, \dots, N-1` on the :math:`m`-th dia
 (``scipy.linalg.eigh_tridiagonal``) are the :math:`T_{lm}` up to sign; the sign is fixed by the two rules
 above, read as inner products (:math:`\langle [S_-, T_{l,m+1}], T_{lm}\rangle > 0`, and :math:`T_{mm}`'s
 entries, which all have one sign, of sign :math:`(-1)^m`), never by a single tiny entry. Cost
-:math:`O(N^3)` once per :math:`N` (0.3 s of CPU at N = 128, 1.5 s at N = 256); the basis is stored band by
-band, :math:`N^3/3` floats (45 MB at N = 256), cached for :math:`N\le 256` and streamed (two bands at a
-time) above.
+:math:`O(N^3)` once per :math:`N` (CPU time on one core: 0.05 s at N = 128, 0.3 s at N = 256); the basis is
+stored band by band, :math:`N^3/3` floats (45 MB at N = 256), cached for :math:`N\le 256` and streamed (two
+bands at a time) above, where every call rebuilds it (2.5 s at N = 512). The dynamics never needs it: only
+the maps to coefficients and grids do.
 
 *The vorticity matrix.* The field :math:`\omega = \sum\omega_{lm}Y_{lm}` goes to the
 :math:`\mathfrak{su}(N)`-type element :math:`W = i\sum_{l,m}\omega_{lm}T_{lm}` (skew-Hermitian exactly when

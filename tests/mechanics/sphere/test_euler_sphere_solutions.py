@@ -162,3 +162,17 @@ def test_steady_field_error_is_the_truncation_and_falls_with_n():
         errs.append(np.sqrt(np.sum(w[:, None] * 2 * np.pi / (4 * N) * diff ** 2)))
     assert -3.9 < fitted_slope(ns, errs) < -3.2
     assert errs[-1] < 1e-4
+
+
+@pytest.mark.slow
+def test_wave_and_casimirs_at_n_64_and_128():
+    wave = RossbyHaurwitzWave(5, {(5, 2): 0.4, (5, 5): 0.1j, (5, 0): -0.3}, rotation=0.3)
+    for N in (64, 128):
+        H = ZeitlinHamiltonian(N)
+        W = rk4_flow(H.vector_field, wave.matrix(0.0, N), 1.0, 50)
+        exact = wave.matrix(1.0, N)
+        assert np.linalg.norm(W - exact) / np.linalg.norm(exact) < 5e-9
+        W0 = wave.matrix(0.0, N)
+        Wm = isospectral_midpoint(W0, drift(N), 0.01, 8)
+        c0, c1 = casimirs(W0), casimirs(Wm)
+        np.testing.assert_allclose(c1, c0, rtol=1e-12, atol=1e-12 * np.abs(c0).max())

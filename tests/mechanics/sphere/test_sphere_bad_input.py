@@ -37,6 +37,7 @@ CASES = [
     (lambda: matrix_to_grid(W8, 8, 4), ValueError, "n_lon must be at least 15"),
     (lambda: function_to_matrix(3.0, 8), TypeError, "func must be a callable"),
     (lambda: function_to_matrix(lambda t, p: t, 8, oversample=0), ValueError, "oversample"),
+    (lambda: function_to_matrix(lambda t, p: np.ones(3), 8), ValueError, "broadcastable to the grid"),
     (lambda: ZeitlinHamiltonian(8, time_unit="seconds"), ValueError, "time_unit must be"),
     (lambda: ZeitlinHamiltonian(8).value_matrix(np.eye(6)), ValueError, "must be 8 x 8"),
     (lambda: ZeitlinHamiltonian(8).gradient_matrix("W"), TypeError, "W must be"),
