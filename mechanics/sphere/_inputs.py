@@ -6,7 +6,7 @@ import numbers
 
 import numpy as np
 
-from roughpaths.validation import check_positive_int
+from roughpaths.validation import check_memory, check_positive_int
 
 #: The largest matrix size the quantised basis is built for (the basis takes N^3/3 floats while it is built).
 MAX_N = 4096
@@ -65,3 +65,8 @@ def as_coefficients(omega, name: str = "omega") -> tuple[np.ndarray, int]:
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} has non-finite entries (NaN or inf).")
     return arr, L
+
+
+def check_bytes(nbytes: float, what: str, fix: str) -> None:
+    """Refuse, before allocating, an estimated ``nbytes`` above the library's memory budget."""
+    check_memory(float(nbytes), what, fix)

@@ -39,7 +39,7 @@ import numbers
 
 import numpy as np
 
-from ._inputs import as_coefficients, check_size
+from ._inputs import as_coefficients, check_bytes, check_size
 from .quantisation import coefficients_to_matrix, lm_index, matrix_to_coefficients
 
 __all__ = ["sphere_grid", "coefficients_to_grid", "grid_to_coefficients", "matrix_to_grid", "grid_to_matrix",
@@ -126,6 +126,8 @@ def coefficients_to_grid(omega, n_lat: int, n_lon: int) -> np.ndarray:
     x = np.cos(theta)
     batch = arr.shape[:-1]
     flat = arr.reshape((-1, L * L))
+    check_bytes(48.0 * flat.shape[0] * n_lon * n_lat + 16.0 * L * n_lat, f"the grid values ({n_lat} x {n_lon})",
+                "use a coarser grid or fewer fields at a time")
     spectrum = np.zeros((flat.shape[0], n_lon, n_lat), dtype=np.complex128)
     for k, p in _legendre_offsets(L, x):
         m = np.arange(L - k)
@@ -164,6 +166,8 @@ def grid_to_coefficients(values, L: int) -> np.ndarray:
     n_lat, n_lon = arr.shape[-2:]
     _check_grid_size(n_lat, "values.shape[-2] (n_lat)", L)
     _check_grid_size(n_lon, "values.shape[-1] (n_lon)", 2 * L - 1)
+    check_bytes(64.0 * arr.size + 16.0 * L * n_lat, f"the transform of the grid values ({n_lat} x {n_lon})",
+                "pass fewer fields at a time")
     arr = np.asarray(arr, dtype=np.complex128)
     if not np.all(np.isfinite(arr)):
         raise ValueError("values has non-finite entries (NaN or inf).")
@@ -227,6 +231,8 @@ def function_to_matrix(func, N: int, *, oversample: int = 2) -> np.ndarray:
         raise TypeError(f"func must be a callable func(theta, phi) -> values, got {type(func).__name__}.")
     if isinstance(oversample, bool) or not isinstance(oversample, numbers.Integral) or oversample < 1:
         raise ValueError(f"oversample must be a positive integer, got {oversample!r}.")
+    check_bytes(96.0 * oversample * n * oversample * 2 * n, f"the oversampled grid ({oversample * n} x "
+                f"{oversample * 2 * n})", "use a smaller oversample")
     theta, phi, _ = sphere_grid(oversample * n, oversample * 2 * n)
     values = np.asarray(func(theta[:, None], phi[None, :]))
     shape = (theta.size, phi.size)

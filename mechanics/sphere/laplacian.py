@@ -47,7 +47,7 @@ import functools
 import numpy as np
 from scipy.linalg import lapack
 
-from ._inputs import as_matrix
+from ._inputs import as_matrix, check_bytes
 from .quantisation import band_tridiagonal, ladder, weights
 
 __all__ = ["laplacian", "inverse_laplacian"]
@@ -68,6 +68,7 @@ def laplacian(P) -> np.ndarray:
     """
     arr = as_matrix(P, "P")
     n = arr.shape[-1]
+    check_bytes(48.0 * arr.size, f"the Laplacian of {arr.size // (n * n)} matrices of size {n}", "pass fewer at a time")
     mu, a = weights(n), ladder(n)
     s = (n - 1) / 2.0
     out = (2.0 * np.multiply.outer(mu, mu) - 2.0 * s * (s + 1.0)) * arr
@@ -129,6 +130,8 @@ def inverse_laplacian(W) -> np.ndarray:
     """
     arr = as_matrix(W)
     n = arr.shape[-1]
+    check_bytes(48.0 * n * n + 96.0 * arr.size, f"the Poisson solve of {arr.size // (n * n)} matrices of size {n}",
+                "pass fewer matrices at a time")
     perm, inverse, df, ef = _factors(n)
     batch = arr.shape[:-2]
     flat = arr.reshape((-1, n * n))

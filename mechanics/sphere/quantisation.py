@@ -78,7 +78,7 @@ import functools
 import numpy as np
 from scipy.linalg import eigh_tridiagonal
 
-from ._inputs import as_coefficients, as_matrix, check_size
+from ._inputs import as_coefficients, as_matrix, check_bytes, check_size
 
 __all__ = ["hbar", "spin_matrices", "lm_index", "harmonic_matrix", "coefficients_to_matrix",
            "matrix_to_coefficients"]
@@ -185,6 +185,8 @@ def _cached_basis(N: int) -> tuple:
 
 def band_basis(N: int):
     """Iterate ``(m, V_m)`` over the diagonals (descending m; cached for ``N <= 256``, else streamed)."""
+    check_bytes(8.0 * (N ** 3 / 3.0 if N <= _CACHE_MAX_N else 4.0 * N * N), f"the quantised basis at N = {N}",
+                "use a smaller N")
     if N <= _CACHE_MAX_N:
         bands = _cached_basis(N)
         return ((m, bands[m]) for m in range(N - 1, -1, -1))
@@ -271,6 +273,8 @@ def coefficients_to_matrix(omega, N: int | None = None) -> np.ndarray:
         raise ValueError(f"omega holds modes up to l = {L - 1}, but N = {n} holds only l < {n}; pass "
                          f"omega[..., :{n * n}] (the truncation) or a larger N.")
     batch = arr.shape[:-1]
+    check_bytes(32.0 * n * n * max(1, arr.size // (L * L)) + 2.0 ** 25, "the vorticity matrices",
+                "pass fewer coefficient vectors at a time")
     out = np.zeros(batch + (n, n), dtype=np.complex128)
     for m, vec in band_basis(n):
         if m >= L:
@@ -306,6 +310,7 @@ def matrix_to_coefficients(W, L: int | None = None) -> np.ndarray:
     if keep > n:
         raise ValueError(f"L = {keep} exceeds the matrix size N = {n} (a matrix holds the modes l < N).")
     batch = arr.shape[:-2]
+    check_bytes(32.0 * arr.size + 2.0 ** 25, "the coefficients of the matrices", "pass fewer matrices at a time")
     out = np.zeros(batch + (keep * keep,), dtype=np.complex128)
     scale = 4.0 * np.pi / n
     for m, vec in band_basis(n):

@@ -57,3 +57,18 @@ CASES = [
 def test_bad_input_is_refused_clearly(call, error, message):
     with pytest.raises(error, match=message):
         call()
+
+
+def test_requests_above_the_memory_budget_are_refused_before_allocating(monkeypatch):
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
+    small = np.zeros((100, 100), dtype=complex)
+    with pytest.raises(ValueError, match="Poisson solve .* memory budget"):
+        inverse_laplacian(small)
+    with pytest.raises(ValueError, match="grid values .* memory budget"):
+        coefficients_to_grid(np.zeros(4), 200, 400)
+    with pytest.raises(ValueError, match="oversampled grid .* memory budget"):
+        function_to_matrix(lambda t, p: t + 0 * p, 64, oversample=4)
+    with pytest.raises(ValueError, match="quantised basis .* memory budget"):
+        harmonic_matrix(200, 1, 0)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**8))
+    assert inverse_laplacian(small).shape == (100, 100)
