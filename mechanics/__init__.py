@@ -78,6 +78,8 @@ from .limits import (
     rigid_body_wong_zakai_limit,
     simulate_wong_zakai_rigid_body,
 )
+from . import sphere
+from .sphere import RossbyHaurwitzWave, ZeitlinHamiltonian
 
 __version__ = "0.1.0"
 
@@ -101,4 +103,6 @@ __all__ = [
     # coloured noise and the Wong–Zakai anomaly
     "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "simulate_wong_zakai_rigid_body",
     "PlanarExample", "planar_example", "planar_limit_moments",
+    # Euler on the sphere (Zeitlin's model on su(N)): the subpackage and its two main objects
+    "sphere", "ZeitlinHamiltonian", "RossbyHaurwitzWave",
 ]

@@ -1,0 +1,74 @@
+"""Bad input to mechanics.sphere is refused with a ValueError/TypeError that names the argument and the fix."""
+
+import numpy as np
+import pytest
+
+from mechanics.sphere import (RossbyHaurwitzWave, ZeitlinHamiltonian, casimirs, coefficients_to_grid,
+                              coefficients_to_matrix, energy, function_to_matrix, grid_to_coefficients,
+                              grid_to_matrix, harmonic_matrix, hbar, inverse_laplacian, laplacian, lm_index,
+                              matrix_to_coefficients, matrix_to_grid, real_harmonic_matrix, sphere_grid)
+
+W8 = 1j * harmonic_matrix(8, 2, 0)
+
+CASES = [
+    (lambda: hbar(1), ValueError, "N must satisfy 2 <= N"),
+    (lambda: hbar(2.5), TypeError, "N must be an integer"),
+    (lambda: hbar(True), TypeError, "N must be an integer"),
+    (lambda: harmonic_matrix(8, 8, 0), ValueError, "0 <= l < N"),
+    (lambda: harmonic_matrix(8, 3, -4), ValueError, r"\|m\| <= l"),
+    (lambda: harmonic_matrix(8, 2.0, 0), TypeError, "l must be an integer"),
+    (lambda: lm_index(2, 3), ValueError, r"\|m\| <= l"),
+    (lambda: coefficients_to_matrix(np.ones(5)), ValueError, "L\\*\\*2"),
+    (lambda: coefficients_to_matrix(np.ones(16), 3), ValueError, "truncation"),
+    (lambda: coefficients_to_matrix("abc"), TypeError, "omega"),
+    (lambda: coefficients_to_matrix(np.full(4, np.nan)), ValueError, "non-finite"),
+    (lambda: matrix_to_coefficients(np.ones((3, 4))), ValueError, r"\(\.\.\., N, N\)"),
+    (lambda: matrix_to_coefficients(W8, 9), ValueError, "exceeds the matrix size"),
+    (lambda: matrix_to_coefficients(np.ones((2, 2), dtype=object)), TypeError, "numeric"),
+    (lambda: laplacian(np.ones(4)), ValueError, "P must have shape"),
+    (lambda: inverse_laplacian(np.full((4, 4), np.inf)), ValueError, "non-finite"),
+    (lambda: inverse_laplacian(None), TypeError, "W must be"),
+    (lambda: sphere_grid(0, 4), ValueError, "n_lat must be at least 1"),
+    (lambda: sphere_grid(4, 2.0), TypeError, "n_lon must be an integer"),
+    (lambda: coefficients_to_grid(np.ones(9), 4, 4), ValueError, "n_lon must be at least 5"),
+    (lambda: grid_to_coefficients(np.ones((3, 8)), 4), ValueError, "n_lat"),
+    (lambda: grid_to_coefficients(np.ones((4, 8)), 0), ValueError, "L .* positive integer"),
+    (lambda: grid_to_matrix(np.ones((8, 8)), 8), ValueError, "n_lon"),
+    (lambda: matrix_to_grid(W8, 8, 4), ValueError, "n_lon must be at least 15"),
+    (lambda: function_to_matrix(3.0, 8), TypeError, "func must be a callable"),
+    (lambda: function_to_matrix(lambda t, p: t, 8, oversample=0), ValueError, "oversample"),
+    (lambda: function_to_matrix(lambda t, p: np.ones(3), 8), ValueError, "broadcastable to the grid"),
+    (lambda: ZeitlinHamiltonian(8, time_unit="seconds"), ValueError, "time_unit must be"),
+    (lambda: ZeitlinHamiltonian(8).value_matrix(np.eye(6)), ValueError, "must be 8 x 8"),
+    (lambda: ZeitlinHamiltonian(8).gradient_matrix("W"), TypeError, "W must be"),
+    (lambda: casimirs(W8, (0, 2)), ValueError, "orders must be positive integers"),
+    (lambda: casimirs(W8, (2.5,)), ValueError, "orders must be positive integers"),
+    (lambda: energy(np.ones((2, 3))), ValueError, r"\(\.\.\., N, N\)"),
+    (lambda: real_harmonic_matrix(8, 0, 0), ValueError, "l = 0 is the identity"),
+    (lambda: RossbyHaurwitzWave(0, {(0, 0): 1.0}, 1.0), ValueError, "degree must be"),
+    (lambda: RossbyHaurwitzWave(3, {(2, 1): 1.0}, 1.0), ValueError, "l = degree = 3"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0, (3, -1): 1.0}, 1.0), ValueError, "real field"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, np.nan), ValueError, "rotation"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 3), ValueError, "L must exceed"),
+]
+
+
+@pytest.mark.parametrize("call, error, message", CASES)
+def test_bad_input_is_refused_clearly(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+def test_requests_above_the_memory_budget_are_refused_before_allocating(monkeypatch):
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
+    small = np.zeros((100, 100), dtype=complex)
+    with pytest.raises(ValueError, match="Poisson solve .* memory budget"):
+        inverse_laplacian(small)
+    with pytest.raises(ValueError, match="grid values .* memory budget"):
+        coefficients_to_grid(np.zeros(4), 200, 400)
+    with pytest.raises(ValueError, match="oversampled grid .* memory budget"):
+        function_to_matrix(lambda t, p: t + 0 * p, 64, oversample=4)
+    with pytest.raises(ValueError, match="quantised basis .* memory budget"):
+        harmonic_matrix(200, 1, 0)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**8))
+    assert inverse_laplacian(small).shape == (100, 100)
