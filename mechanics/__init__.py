@@ -79,7 +79,7 @@ from .limits import (
     simulate_wong_zakai_rigid_body,
 )
 from . import sphere
-from .sphere import RossbyHaurwitzWave, ZeitlinHamiltonian
+from .sphere import RossbyHaurwitzWave, ZeitlinHamiltonian, zeitlin_system
 
 __version__ = "0.1.0"
 
@@ -104,5 +104,5 @@ __all__ = [
     "RigidBodyWongZakai", "rigid_body_wong_zakai_limit", "simulate_wong_zakai_rigid_body",
     "PlanarExample", "planar_example", "planar_limit_moments",
     # Euler on the sphere (Zeitlin's model on su(N)): the subpackage and its two main objects
-    "sphere", "ZeitlinHamiltonian", "RossbyHaurwitzWave",
+    "sphere", "ZeitlinHamiltonian", "RossbyHaurwitzWave", "zeitlin_system",
 ]

@@ -135,6 +135,15 @@ class CoadjointSolver(Solver):
             raise ValueError(f"the driver is a {kind!r} rough path; the coadjoint schemes solve the geometric "
                              f"(Stratonovich-type) RDE. Convert an Itô lift with XX + ½(t-s)I first.")
 
+    def step_bytes(self, fields):
+        """Bytes per batch member of one step's temporaries, for :func:`roughpaths.solve`'s memory check: on a
+        matrix Lie algebra about 40 matrices of ``N × N`` (the state, the increment, the exponential's Padé
+        powers and products, the velocities) and the state's coordinates; ``None`` (the generic estimate) else."""
+        alg = fields.algebra
+        if isinstance(alg, MatrixLieAlgebra):
+            return 40.0 * alg.matrix_size ** 2 * alg.dtype.itemsize + 8.0 * 4 * alg.dim
+        return None
+
     # -------------------------------------------------------------- the scheme
     def _sigma(self, system, mu, dt, eta):
         """Lie-algebra increment ``sigma (..., n)`` and a convergence mask (``None``: always converged)."""
