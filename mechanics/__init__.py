@@ -34,10 +34,12 @@ from .analysis import (
 from .integrators import (
     ChordConvergenceError,
     CoadjointSolver,
+    GroupSolution,
     ImplicitMidpoint,
     LieEuler,
     LieHeun,
     check_on_orbit,
+    solve_with_group,
 )
 from .systems import (
     CotangentLift,
@@ -94,6 +96,7 @@ __all__ = [
     "CotangentLift", "cotangent_lift",
     # integrators
     "CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError", "check_on_orbit",
+    "solve_with_group", "GroupSolution",
     # equilibria, phase portraits, Gibbs measures
     "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",
     "modified_hamiltonian", "rigid_body_vector_field", "lagrange_top_sleeping_stability",

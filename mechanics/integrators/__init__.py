@@ -9,6 +9,7 @@ the state is held as a matrix and updated by conjugation (isospectral), at the c
 """
 
 from .base import ChordConvergenceError, CoadjointSolver, ImplicitMidpoint, LieEuler, LieHeun, check_on_orbit
+from .reconstruction import GroupSolution, solve_with_group
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
-           "check_on_orbit"]
+           "check_on_orbit", "GroupSolution", "solve_with_group"]
