@@ -8,6 +8,15 @@ import numpy as np
 import scipy.special as sp
 
 
+def random_su(rng, N, batch=()):
+    """A random su(N) matrix (skew-Hermitian, trace-free), batch first."""
+    A = rng.standard_normal(batch + (N, N)) + 1j * rng.standard_normal(batch + (N, N))
+    A = A - np.conj(np.swapaxes(A, -1, -2))
+    idx = np.arange(N)
+    A[..., idx, idx] -= np.trace(A, axis1=-2, axis2=-1)[..., None] / N
+    return A
+
+
 def spin(N):
     """(S1, S2, S3) from the definition: S3 = diag(s, ..., -s), S+|mu> = sqrt(s(s+1) - mu(mu+1)) |mu+1>."""
     s = (N - 1) / 2

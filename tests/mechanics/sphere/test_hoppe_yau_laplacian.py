@@ -9,16 +9,8 @@ and sends the identity (l = 0) to zero. Oracles: the dense N^2 x N^2 operator bu
 import numpy as np
 import pytest
 
-from _sphere_oracles import dense_laplacian, spin
+from _sphere_oracles import dense_laplacian, random_su, spin
 from mechanics.sphere import inverse_laplacian, laplacian
-
-
-def random_su(rng, N, batch=()):
-    A = rng.standard_normal(batch + (N, N)) + 1j * rng.standard_normal(batch + (N, N))
-    A = A - np.conj(np.swapaxes(A, -1, -2))
-    idx = np.arange(N)
-    A[..., idx, idx] -= np.trace(A, axis1=-2, axis2=-1)[..., None] / N
-    return A
 
 
 @pytest.mark.parametrize("N", [2, 3, 4, 7])

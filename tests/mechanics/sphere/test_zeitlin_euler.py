@@ -16,17 +16,10 @@ Oracles: dense Laplacian from spin matrices, scipy's harmonics and quadrature.
 import numpy as np
 import pytest
 
-from _sphere_oracles import Field, bracket, dense_laplacian, fitted_slope, flat, project, quadrature, spin
+from _sphere_oracles import (Field, bracket, dense_laplacian, fitted_slope, flat, project, quadrature, random_su,
+                             spin)
 from mechanics.sphere import (ZeitlinHamiltonian, casimirs, coefficients_to_matrix, energy, enstrophy, hbar,
                               matrix_to_coefficients)
-
-
-def random_su(rng, N, batch=()):
-    A = rng.standard_normal(batch + (N, N)) + 1j * rng.standard_normal(batch + (N, N))
-    A = A - np.conj(np.swapaxes(A, -1, -2))
-    idx = np.arange(N)
-    A[..., idx, idx] -= np.trace(A, axis1=-2, axis2=-1)[..., None] / N
-    return A
 
 
 def pairing(A, C):
