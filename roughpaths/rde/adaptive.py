@@ -69,8 +69,11 @@ class PIController:
     dt0 : float, optional
         First step tried (default ``(t1 - t0) / 64``).
     dt_min : float, optional
-        Smallest step (default ``(t1 - t0) · 2^-30``). A step at ``dt_min`` is accepted whatever its error;
-        ``Solution.stats["at_dt_min"]`` counts them.
+        Smallest step (default ``(t1 - t0) · 2^-30``). A step at ``dt_min`` whose error still exceeds the
+        tolerance is a failure of the members concerned, counted in ``Solution.stats["at_dt_min"]``: by
+        ``solve(..., on_failure=...)`` it raises a ``ValueError`` at once naming the fix (``"raise"``), or marks
+        those members failed and finishes the others (``"mask"``). An unreachable tolerance thus fails after
+        about ``log(dt0 / dt_min) / log(1 / factor_min)`` attempts.
     dt_max : float, optional
         Largest step (default ``t1 - t0``).
     safety : float
@@ -83,7 +86,7 @@ class PIController:
         ``icoeff=1, pcoeff=0`` is the plain integral controller (``docs/adaptive-steps.md`` compares them).
     max_steps : int
         Most attempts (accepted plus rejected) before ``solve`` gives up with a ``ValueError`` (default
-        10⁵), so a tolerance that cannot be met never hangs.
+        10⁵): a bound on the work of tolerances that can be met (one that cannot fails at ``dt_min``).
 
     Examples
     --------
@@ -146,6 +149,15 @@ def _whole_step(W, XX):
     W1, W2 = W[..., 0, :], W[..., 1, :]
     XXw = XX[..., 0, :, :] + XX[..., 1, :, :] + W1[..., :, None] * W2[..., None, :]
     return (W1 + W2)[..., None, :], XXw[..., None, :, :]
+
+
+def _unmet_message(unmet, batch, t, h, r, control):
+    """The message of a step at ``dt_min`` whose error exceeds the tolerance (``on_failure="raise"``)."""
+    first = tuple(int(v) for v in np.argwhere(unmet)[0])
+    return (f"the error tolerance cannot be met: the step [{t:.6g}, {t + h:.6g}] at dt_min = {h:.3g} still has "
+            f"{r:.3g} times the error {control!r} allows, for {int(unmet.sum())} batch member(s) (first {first}); "
+            f"loosen rtol/atol, lower dt_min (PIController(dt_min=...)), or pass on_failure='mask' to mark these "
+            f"members failed (Solution.failed) and finish the others.")
 
 
 def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_at, on_failure, batch, progress=None):
@@ -227,12 +239,20 @@ def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_
             err = np.sqrt(np.mean(((y2 - y1) / scale) ** 2, axis=-1))
             bad = ~np.all(np.isfinite(y2), axis=-1) & healthy
             ok = healthy & ~bad
-            r = float(err[ok].max()) * math.sqrt(T / hstep) if ok.any() else 0.0
+            err = err * math.sqrt(T / hstep)
+            r = float(err[ok].max()) if ok.any() else 0.0
             if bad.any():
                 r = math.inf
+            if at_floor and not r <= 1.0:           # the tolerance cannot be met at dt_min: fail, never crawl
+                unmet = ok & ~(err <= 1.0)
+                at_min += int(unmet.sum())
+                if on_failure == "raise" and unmet.any():
+                    raise ValueError(_unmet_message(unmet, batch, ts[0], hstep, float(np.max(err[unmet])), control))
+                failed_step[unmet] = accepted
+                healthy &= ~unmet
+                r = math.inf if bad.any() else float(np.max(err[ok & healthy], initial=0.0))
             if r <= 1.0 or at_floor:
                 accepted += 1
-                at_min += int(r > 1.0)
                 if bad.any():
                     failed_step[bad] = accepted - 1
                     if on_failure == "raise":
