@@ -71,6 +71,7 @@ from ..paths.rough_path import RoughPath
 from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_real
 from ._random import PathStreams
 from ._seeded import check_seed, selected_paths
+from .base import Driver
 from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width
 from .areas import _Sampler
 
@@ -85,7 +86,7 @@ def _reduce(node):
     return reduce_node(*node)
 
 
-class BrownianTree:
+class BrownianTree(Driver):
     r"""A Brownian path with Lévy areas on ``[t0, t1]``, queried on any sub-interval (module docstring).
 
     Parameters
@@ -130,6 +131,9 @@ class BrownianTree:
 
     #: The level of the rough path it answers (increments and areas).
     level = 2
+    #: It answers on any times of ``[t0, t1]`` (the :class:`~roughpaths.Driver` protocol): steps are chosen by
+    #: a step controller, its only grid step is ``[t0, t1]``.
+    any_times = True
 
     def __init__(self, dim, *, seed, t0=0.0, t1=1.0, batch_shape=(), levy_area="auto", levy_area_error=None,
                  polygon_levels=3, resolution=40, cache_size=None):
@@ -261,7 +265,49 @@ class BrownianTree:
         new.node_bytes = max(1, new.n_paths) * self.node_bytes // max(1, self.n_paths)
         new._cache = OrderedDict()
         new._root_node = None
+        new.__dict__.pop("_members", None)
         return new
+
+    @property
+    def times(self):
+        """``[t0, t1]``: the tree has no grid of its own (``Driver`` protocol; steps come from a controller)."""
+        return np.array([self.t0, self.t1])
+
+    def blocks(self, max_steps=None):
+        raise ValueError("a BrownianTree has no grid to cut into blocks: solve it with a step controller "
+                         "(step_control=PIController(rtol, atol) or FixedSteps(dt)), or materialise a grid with "
+                         "tree.rough_path(times).")
+
+    def increments_and_areas(self, times, paths=None):
+        """Increments and Stratonovich areas between ``times`` (the ``Driver`` protocol for ``any_times``).
+
+        Parameters
+        ----------
+        times : array_like, shape ``(n + 1,)`` or ``(len(paths), n + 1)``
+            Increasing times in ``[t0, t1]``; a 2-D array gives each selected path its own times.
+        paths : array_like of int, optional
+            Flat path indices; ``None``: all paths (``times`` then 1-D).
+
+        Returns
+        -------
+        dX, dXX : ndarray
+            ``batch_shape + (n, d)`` and ``batch_shape + (n, d, d)``, or with the leading axis ``len(paths)``;
+            path ``paths[k]`` answers bitwise as it does in the whole tree.
+        """
+        if paths is None:
+            W, A = self.increments_and_levy_areas(times)
+        else:
+            paths = selected_paths(paths, self.n_paths, "tree")
+            t = np.broadcast_to(np.asarray(times, dtype=np.float64), (paths.size, np.shape(times)[-1]))
+            if t.ndim == 2 and (t == t[:1]).all():
+                W, A = self.increments_and_levy_areas(t[0])
+                W, A = W.reshape((self.n_paths,) + W.shape[-2:])[paths], A.reshape((self.n_paths,) + A.shape[-3:])[paths]
+            else:
+                subs = self.__dict__.setdefault("_members", {})
+                parts = [(subs[p] if p in subs else subs.setdefault(p, self.select([p]))).increments_and_levy_areas(tk)
+                         for p, tk in zip(paths.tolist(), t)]
+                W, A = np.concatenate([w for w, _ in parts]), np.concatenate([a for _, a in parts])
+        return W, A + 0.5 * W[..., :, None] * W[..., None, :]
 
     # ------------------------------------------------------------------ nodes
     def _streams(self, tag, depth, index):

@@ -74,6 +74,13 @@ class Solver:
        batch member, the index of the first step after which the member was non-finite (``-1`` if
        never). With ``stop_on_failure`` it may return as soon as a member fails. The default loops
        :meth:`step`; compiled fast paths override this method and must return what stepping returns.
+    9. ``error_estimate`` (class attribute, declared data for adaptive steps,
+       :mod:`roughpaths.rde.step_control`): ``"step_doubling"`` (the default: an attempt is one step over
+       ``[t, t + h]`` and two over its halves on the same path, the difference estimating the local error) or
+       ``None`` (the scheme offers no estimate a controller can trust; adaptive steps refuse it).
+       ``error_order`` (default ``None``: the declared ``order``) is the strong order the estimate's error ratio
+       follows, ``r ∝ h ** error_order``; step doubling needs an order of at least 1 and the area
+       (``increment_level >= 2``), or its difference is dominated by the missing area instead of the error.
     """
 
     increment_level: int = 1
@@ -81,6 +88,8 @@ class Solver:
     smooth_order: float = 0.0
     calculus: str = "stratonovich"
     preserves: tuple = ()
+    error_estimate: str | None = "step_doubling"
+    error_order: float | None = None
 
     def check_fields(self, fields):
         """Return ``fields`` if this solver can integrate it (contract item 5)."""

@@ -22,6 +22,7 @@ class Euler(Solver):
     order = 0.5
     smooth_order = 1.0
     calculus = "ito"
+    error_estimate = None        # order ½: a doubling difference measures the missing area, not the error
 
     def step(self, fields, y, t, dt, dX, dXX):
         V = fields.fields(y, t)
@@ -41,6 +42,7 @@ class Heun(Solver):
     increment_level = 1
     order = 0.5
     smooth_order = 2.0
+    error_estimate = None        # order ½: a doubling difference measures the missing area, not the error
 
     def step(self, fields, y, t, dt, dX, dXX):
         V = fields.fields(y, t)
