@@ -57,9 +57,9 @@ def sigma(t, xp=np):
 
 def _burst_fields():
     import roughpaths as rp
-    return rp.VectorFields(lambda t, y: sigma(t) * np.einsum("iab,...b->...ai", M, y),
-                           lambda t, y: np.broadcast_to(sigma(t) * M, y.shape[:-1] + M.shape),
-                           dim_state=3, dim_noise=2, time_dependent=True)
+    return rp.VectorFields(lambda t, y: sigma(t)[..., None] * np.einsum("iab,...b->...ai", M, y),
+                           lambda t, y: sigma(t)[..., None, None] * np.broadcast_to(M, y.shape[:-1] + M.shape),
+                           dim_state=3, dim_noise=2, time_dependent=True, batched_time=True)
 
 
 def _rms(a, b):

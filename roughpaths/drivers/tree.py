@@ -72,6 +72,7 @@ from ..validation import as_float_array, check_batch_shape, check_memory, check_
 from ._random import PathStreams
 from ._seeded import check_seed, selected_paths
 from .base import Driver
+from ._tree_members import member_cells
 from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width
 from .areas import _Sampler
 
@@ -265,7 +266,7 @@ class BrownianTree(Driver):
         new.node_bytes = max(1, new.n_paths) * self.node_bytes // max(1, self.n_paths)
         new._cache = OrderedDict()
         new._root_node = None
-        new.__dict__.pop("_members", None)
+        new.__dict__.pop("_walk_cache", None)
         return new
 
     @property
@@ -291,22 +292,30 @@ class BrownianTree(Driver):
         Returns
         -------
         dX, dXX : ndarray
-            ``batch_shape + (n, d)`` and ``batch_shape + (n, d, d)``, or with the leading axis ``len(paths)``;
-            path ``paths[k]`` answers bitwise as it does in the whole tree.
+            ``batch_shape + (n, d)`` and ``batch_shape + (n, d, d)``, or with the leading axis ``len(paths)``.
+            On 1-D ``times`` path ``paths[k]`` answers bitwise as it does in the whole tree; on 2-D ``times`` each
+            path is walked on its own (:mod:`roughpaths.drivers._tree_members`): bitwise the same in any query
+            of any set of paths, and equal to the shared-times answer to round-off (its cells are Chen products
+            of the same nodes, accumulated in another order).
         """
         if paths is None:
             W, A = self.increments_and_levy_areas(times)
         else:
             paths = selected_paths(paths, self.n_paths, "tree")
             t = np.broadcast_to(np.asarray(times, dtype=np.float64), (paths.size, np.shape(times)[-1]))
-            if t.ndim == 2 and (t == t[:1]).all():
+            if np.ndim(times) == 1:                  # shared times: the tree's own walk, then the rows
                 W, A = self.increments_and_levy_areas(t[0])
                 W, A = W.reshape((self.n_paths,) + W.shape[-2:])[paths], A.reshape((self.n_paths,) + A.shape[-3:])[paths]
+            elif self._prefix is not None:          # one vectorised walk for every path on its own times
+                T, L = self.t1 - self.t0, self.resolution
+                idx = np.minimum(np.round((t - self.t0) / T * 2.0 ** L).astype(np.int64), 2 ** L)
+                if np.any(t < self.t0) or np.any(t > self.t1) or not np.all(np.diff(idx, axis=-1) > 0):
+                    raise ValueError(f"times must increase strictly in [t0, t1] = [{self.t0}, {self.t1}] on the "
+                                     f"tree's grid (t1 - t0)·2^-{L}, row by row.")
+                W, A = member_cells(self, paths, idx, _SPLIT)
             else:
-                subs = self.__dict__.setdefault("_members", {})
-                parts = [(subs[p] if p in subs else subs.setdefault(p, self.select([p]))).increments_and_levy_areas(tk)
-                         for p, tk in zip(paths.tolist(), t)]
-                W, A = np.concatenate([w for w, _ in parts]), np.concatenate([a for _, a in parts])
+                W, A = (np.concatenate(x) for x in zip(*[self.select([p]).increments_and_levy_areas(tk)
+                                                         for p, tk in zip(paths.tolist(), t)]))
         return W, A + 0.5 * W[..., :, None] * W[..., None, :]
 
     # ------------------------------------------------------------------ nodes

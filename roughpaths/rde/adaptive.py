@@ -77,7 +77,7 @@ class _Attempt:
 class _TreeSteps:
     """The proposer of :func:`~roughpaths.solve`'s loop on an ``any_times`` driver: lanes, snapping, targets."""
 
-    def __init__(self, run, tree, control, solver, save_at, shared):
+    def __init__(self, run, tree, control, solver, save_at, shared, fields):
         L = getattr(tree, "resolution", 40)
         t0, t1 = float(tree.t0), float(tree.t1)
         self.run, self.tree, self.control, self.t0, self.t1, self.L = run, tree, control, t0, t1, L
@@ -106,6 +106,8 @@ class _TreeSteps:
         self.lane_members = [np.arange(P)] if self.shared else [np.array([m]) for m in range(P)]
         self.paths = np.broadcast_to(np.arange(tree.n_paths).reshape(tree.batch_shape), run.batch).ravel()
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
+        self.vector = bool(getattr(solver, "member_times", False)) and (
+            not getattr(fields, "time_dependent", False) or getattr(fields, "batched_time", False))
         order = solver.error_order if solver.error_order is not None else solver.order
         self.state = control.init(t0, t1, n, order)
         self.dt_min, self.dt_max = control.dt_min(T), control.dt_max(T)
@@ -142,22 +144,24 @@ class _TreeSteps:
         self.floor[act] = ((j - i) <= self.min_cells) | ((j - i) * cell <= self.dt_min * (1 + 1e-12))
         self.bad = np.zeros(self.run.members, dtype=bool)
         self.tried = np.zeros(self.run.members, dtype=bool)
-        adaptive, out = self.control.adaptive, []
+        cols = [i, (i + j) // 2, j] if self.control.adaptive else [i, j]
+        ts = self.t0 + cell * np.stack(cols, axis=-1).astype(np.float64)          # (lanes, 3) or (lanes, 2)
+        if self.shared:
+            members, ts, h = self.lane_members[0], ts[0], float((j[0] - i[0]) * cell)
+            W, XX = self.tree.increments_and_areas(ts, None if self.whole_batch else self.paths)
+            W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
+        else:
+            members, h = act, (j - i) * cell
+            W, XX = self.tree.increments_and_areas(ts, self.paths[act])
+        if self.shared or self.vector:            # one call: the batch on shared steps, or each member on its own
+            return [self._attempt(members, ts, W, XX, h)]
         pairs, inverse = np.unique(np.stack([i, j]), axis=1, return_inverse=True)
-        for g in range(pairs.shape[1]):
-            lanes = act[inverse.ravel() == g]
-            gi, gj = int(pairs[0, g]), int(pairs[1, g])
-            ts = self.t0 + cell * np.array([gi, (gi + gj) // 2, gj] if adaptive else [gi, gj], dtype=np.float64)
-            members = np.concatenate([self.lane_members[k] for k in lanes]) if lanes.size > 1 else \
-                self.lane_members[lanes[0]]
-            if self.whole_batch:
-                W, XX = self.tree.increments_and_areas(ts)
-                W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
-            else:
-                W, XX = self.tree.increments_and_areas(ts, self.paths[members])
-            whole = _whole_step(W, XX) if adaptive else None
-            out.append(_Attempt(members, ts, W, XX, np.zeros(ts.size - 1, dtype=bool), whole, (gj - gi) * cell))
-        return out
+        groups = [np.flatnonzero(inverse.ravel() == g) for g in range(pairs.shape[1])]
+        return [self._attempt(members[k], ts[k[0]], W[k], XX[k], h[k[0]]) for k in groups]
+
+    def _attempt(self, members, ts, W, XX, h):
+        whole = _whole_step(W, XX) if self.control.adaptive else None
+        return _Attempt(members, ts, W, XX, np.zeros(ts.shape[-1] - 1, dtype=bool), whole, h)
 
     def judge(self, a, y_new, saved, first_bad, err):
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""

@@ -19,6 +19,7 @@ class Euler(Solver):
     """
 
     increment_level = 1
+    member_times = True
     order = 0.5
     smooth_order = 1.0
     calculus = "ito"
@@ -40,6 +41,7 @@ class Heun(Solver):
     """
 
     increment_level = 1
+    member_times = True
     order = 0.5
     smooth_order = 2.0
     error_estimate = None        # order ½: a doubling difference measures the missing area, not the error

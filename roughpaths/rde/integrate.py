@@ -208,7 +208,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
                             f"its own definition.")
         fields = fields.with_drift(drift)
     run = _Run(y, batch, on_failure, getattr(driver, "any_times", False))
-    steps = (_TreeSteps(run, driver, control, solver, save_at, bool(shared_steps)) if run.flat else
+    steps = (_TreeSteps(run, driver, control, solver, save_at, bool(shared_steps), fields) if run.flat else
              _GridSteps(run, driver, save_at, block_steps, level))
     total, desc, unit = steps.progress_total
     report = run.report = progress_reporter(progress, total, desc=desc, unit=unit)
@@ -222,7 +222,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
                                                                stop_on_failure=a.stop)
                     err = None
                     if a.whole is not None:             # the declared estimate: step doubling
-                        y_one = solver.integrate(fields, y_start, a.times[[0, -1]], *a.whole, a.save[:1],
+                        y_one = solver.integrate(fields, y_start, a.times[..., [0, -1]], *a.whole, a.save[:1],
                                                  stop_on_failure=False)[0]
                         err = control.error_ratio(y_start, y_new, y_new - y_one, a.h, steps.span)
                     steps.judge(a, y_new, saved, first_bad, err)

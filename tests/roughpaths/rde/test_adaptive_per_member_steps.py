@@ -8,6 +8,7 @@ shared sequence, which follows the most demanding member.
 """
 
 import numpy as np
+import pytest
 
 import roughpaths as rp
 
@@ -64,3 +65,60 @@ def test_members_take_fewer_steps_than_the_shared_sequence():
     shared = rp.solve(V, tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end", shared_steps=True)
     assert own.stats["accepted"].max() <= shared.stats["accepted"]
     assert own.stats["accepted"].mean() < 0.8 * shared.stats["accepted"]
+
+
+def _per_member_ladder(paths, rtols, ref_steps, seed):
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=seed, batch_shape=(paths,))
+    ref = rp.solve(V, tree.rough_path(np.linspace(0.0, 1.0, ref_steps + 1)), np.ones(3), rp.Davie(),
+                   save_at="end").final
+    errs, steps = [], []
+    for rtol in rtols:
+        sol = rp.solve(V, tree, np.ones(3), rp.Davie(), step_control=rp.PIController(rtol, rtol), save_at="end")
+        errs.append(float(np.sqrt(np.mean(np.sum((sol.final - ref) ** 2, axis=-1)))))
+        steps.append(int(sol.stats["accepted"].max()))
+    return np.polyfit(np.log(rtols), np.log(errs), 1)[0], errs, steps
+
+
+def test_strong_error_per_member_is_proportional_to_rtol():
+    """Each member on its own steps: the RMS over members of the strong error at t = 1 against a fine fixed-step
+    solve on the same tree falls in proportion to rtol (an error-per-step rule would give 2/3). At coarser
+    tolerances (rtol 1e-2, about 20 steps per member) the fit is pre-asymptotic, about 1.3."""
+    slope, errs, steps = _per_member_ladder(12, [3e-3, 1.5e-3, 7.5e-4], 2 ** 13, seed=11)
+    assert max(steps) * 8 <= 2 ** 13, steps
+    assert 0.8 <= slope <= 1.25, (slope, errs)
+
+
+@pytest.mark.slow
+def test_strong_error_per_member_is_proportional_to_rtol_full():
+    slope, errs, steps = _per_member_ladder(64, [3e-3, 1e-3, 3e-4], 2 ** 15, seed=12)
+    assert max(steps) * 8 <= 2 ** 15, steps
+    assert 0.85 <= slope <= 1.15, (slope, errs)
+
+
+def test_time_dependent_fields_with_batched_time_step_members_in_one_call():
+    """``batched_time=True`` fields take every member's own times at once: the same answer (to round-off of the
+    user's callable) as the same fields evaluated one time at a time, member by member; a member is bitwise the
+    same alone and in the batch; a callable that does not broadcast ``t`` is refused at construction."""
+    def sig(t):
+        return 0.2 + 2.0 * np.exp(-((t - 0.5) / 0.05) ** 2)
+
+    def make(batched):
+        ex = (lambda t: t[..., None]) if batched else (lambda t: t)
+        return rp.VectorFields(lambda t, y: ex(sig(t)) * np.einsum("iab,...b->...ai", M, y),
+                               lambda t, y: ex(sig(t))[..., None] * np.broadcast_to(M, y.shape[:-1] + M.shape),
+                               dim_state=3, dim_noise=2, time_dependent=True, batched_time=batched)
+
+    tree = rp.BrownianTree(2, seed=3, batch_shape=(5,))
+    ctrl = rp.PIController(1e-2, 1e-2, dt_max=1 / 16)
+    fast = rp.solve(make(True), tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end")
+    slow = rp.solve(make(False), tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end")
+    assert np.array_equal(fast.stats["accepted"], slow.stats["accepted"])
+    np.testing.assert_allclose(fast.final, slow.final, rtol=1e-12, atol=0)
+    alone = rp.solve(make(True), tree.select([3]), np.ones(3), rp.Davie(), step_control=ctrl, save_at="end")
+    assert np.array_equal(alone.final[0], fast.final[3])
+    with pytest.raises(ValueError, match="batched_time=True but failed on t of shape"):
+        rp.VectorFields(lambda t, y: sig(t) * np.einsum("iab,...b->...ai", M, y), dim_state=3, dim_noise=2,
+                        time_dependent=True, batched_time=True)
+    with pytest.raises(ValueError, match="needs time_dependent=True"):
+        rp.VectorFields(lambda y: np.einsum("iab,...b->...ai", M, y), dim_state=3, dim_noise=2, batched_time=True)
