@@ -1,17 +1,17 @@
-r"""Queries of a :class:`~roughpaths.BrownianTree` where every path has times of its own, in one vectorised walk.
+r"""Queries of a :class:`~roughpaths.BrownianTree` where every path has times of its own, in one compiled walk.
 
 Adaptive steps per batch member ask each path about a different interval. :func:`member_cells` answers them
-all in one descent of the tree, depth by depth: at each depth the nodes of every path that hold one of its
-query points strictly inside are split together (one compiled call, each row with the stream of its own
-``(path, depth, index)``), and the nodes that lie within one of its cells are reduced together. A cell is
-then the Chen product of its canonical dyadic nodes, assembled in left-to-right order by the same formulas
-as the tree's own walk (``BrownianTree._cells``), per row; so a path's answer does not depend on the other
-paths of the query or on their times (bitwise; ``tests/roughpaths/rde/test_adaptive_per_member_steps.py``).
+all in one compiled call: for each path, the tree's own depth-first walk from the root, splitting the nodes
+that hold one of its query points strictly inside (each with the stream of its ``(path, depth, index)``, so
+the nodes are bitwise the tree's) and Chen-multiplying the others, left to right, into the cell they lie
+in. A path's answer depends on its own times only, bitwise, whatever the other paths of the query; it
+equals the tree's answer on shared times (``BrownianTree._cells``) to round-off, since the cells there are
+assembled by another order of the same sums.
 
-Cost: a depth costs one split call over the rows that need it and one reduction; a query of ``Q`` paths
-with ``n`` cells down to depth ``k`` splits at most ``Q (n + 1) k`` rows (far fewer when the points share
-ancestors), with no cache. Compiling :func:`_split_rows_nb` (first call, empty cache) costs about as much
-as the tree's own split kernel (see ``benchmarks/bench_first_call.py``).
+The children of the last node split at each depth of each path are kept (if 64 MiB hold one such pair per
+depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk splits
+only the few nodes near its new times. Compiling :func:`_walk_nb` (first call, empty cache) costs about
+8 s of CPU (measured at load 6, after the tree's own kernels); from numba's cache, 0.03 s.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ._random import _pcg64_normals, _pcg64_seed, _seed_states
-from ._tree_kernels import _reduce_nb, _refine_segments_nb, polygon_area, reduce_node, split_width
+from ._tree_kernels import _reduce_nb, _refine_segments_nb, split_width
 
 __all__ = ["member_cells"]
 
@@ -95,29 +95,6 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
             top += 2
 
 
-@njit(cache=True, nogil=True)
-def _split_rows_nb(prefix, paths, tag, depth, index, width, w, G, delta, fine, GL, GR):
-    """``_split_seeded_nb`` with a node index per row: row ``r`` draws from stream ``(tag, paths[r], depth, index[r])``."""
-    P = w.shape[0]
-    m = prefix.size
-    ent = np.empty((P, m + 5), dtype=np.uint32)
-    for r in range(P):
-        for q in range(m):
-            ent[r, q] = prefix[q]
-        ent[r, m] = tag
-        ent[r, m + 1] = paths[r]
-        ent[r, m + 2] = depth
-        ent[r, m + 3] = index[r] >> 32
-        ent[r, m + 4] = index[r] & 0xFFFFFFFF
-    seeds = np.empty((P, 4), dtype=np.uint64)
-    _seed_states(ent, seeds)
-    states = np.empty((P, 4), dtype=np.uint64)
-    _pcg64_seed(seeds, states)
-    z = np.empty((P, width))
-    _pcg64_normals(states, z)
-    _refine_segments_nb(w, G, delta, z, fine, GL, GR)
-
-
 def member_cells(tree, rows, idx, tag):
     """``(W (Q, n, d), A (Q, n, d, d))``: row ``q`` of ``tree`` (flat index ``rows[q]``) on the grid cells
     ``[idx[q, k], idx[q, k + 1])`` (``idx (Q, n + 1)`` strictly increasing grid indices per row; ``tag`` the
@@ -137,57 +114,4 @@ def member_cells(tree, rows, idx, tag):
     _walk_nb(tree._prefix, np.ascontiguousarray(w), np.ascontiguousarray(G), rows, tree._paths[rows],
              np.ascontiguousarray(idx, dtype=np.int64), tree.resolution, float(tree.t1 - tree.t0), tag,
              split_width(w.shape[1], d), W, A, *cache)
-    return W, A
-
-
-def _member_cells_numpy(tree, rows, idx, tag):
-    """``(W (Q, n, d), A (Q, n, d, d))``: row ``q`` of ``tree`` (flat index ``rows[q]``) on the grid cells
-    ``[idx[q, k], idx[q, k + 1])`` (``idx (Q, n + 1)`` strictly increasing grid indices per row; ``tag`` the
-    tree's split stream tag). Needs the tree's seeded fast path (``tree._prefix``)."""
-    L, d = tree.resolution, tree.dim
-    Q, n = idx.shape[0], idx.shape[1] - 1
-    if tree._root_node is None:
-        tree._root_node = tree._root()
-    w, G = tree._root_node
-    nseg = w.shape[1]
-    fq, fidx, fw, fG = np.arange(Q), np.zeros(Q, dtype=np.int64), w[rows], G[rows]
-    first, last = idx[:, 0], idx[:, -1]
-    parts, depth = [], 0
-    while fq.size:
-        size = 1 << (L - depth)
-        lo = fidx * size
-        g = idx[fq]
-        keep = (lo + size > first[fq]) & (lo < last[fq])
-        inside = ((g > lo[:, None]) & (g < (lo + size)[:, None])).any(axis=1)
-        red = keep & ~inside                                 # within one cell: reduced to its (W, A)
-        if red.any():
-            Wr, Ar = reduce_node(fw[red], fG[red])
-            parts.append((fq[red], (g[red] <= lo[red, None]).sum(axis=1) - 1, lo[red], Wr, Ar))
-        sp = keep & inside                                  # a query point strictly inside: split
-        if not sp.any():
-            break
-        fw_s, fG_s = np.ascontiguousarray(fw[sp]), np.ascontiguousarray(fG[sp])
-        P = fw_s.shape[0]
-        fine, GL, GR = np.empty((P, 2 * nseg, d)), np.empty((P, d, d)), np.empty((P, d, d))
-        _split_rows_nb(tree._prefix, tree._paths[rows[fq[sp]]], np.int64(tag), np.int64(depth), fidx[sp],
-                       split_width(nseg, d), fw_s, fG_s, float((tree.t1 - tree.t0) / 2 ** depth / nseg), fine, GL, GR)
-        fq, fidx = np.concatenate([fq[sp], fq[sp]]), np.concatenate([2 * fidx[sp], 2 * fidx[sp] + 1])
-        fw, fG = np.concatenate([fine[:, :nseg], fine[:, nseg:]]), np.concatenate([GL, GR])
-        depth += 1
-    q, c, lo, Wn, An = (np.concatenate(x) for x in zip(*parts))
-    order = np.lexsort((lo, c, q))
-    q, c, Wn, An = q[order], c[order], Wn[order], An[order]
-    cell = q * n + c
-    starts = np.flatnonzero(np.r_[True, cell[1:] != cell[:-1]])
-    counts = np.diff(np.r_[starts, cell.size])
-    W, A = np.empty((Q, n, d)), np.empty((Q, n, d, d))
-    for r in np.unique(counts).tolist():                  # cells of r nodes together, as the tree's walk sums them
-        s = starts[counts == r]
-        take = s[:, None] + np.arange(r)
-        Wk, Ak = Wn[take], An[take]
-        acc = 0 + Ak[:, 0]
-        for k in range(1, r):
-            acc = acc + Ak[:, k]
-        W[q[s], c[s]] = Wk.sum(axis=1)
-        A[q[s], c[s]] = acc + polygon_area(Wk)
     return W, A

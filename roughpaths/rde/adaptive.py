@@ -8,11 +8,14 @@ rejection).
 
 Lanes
 -----
-By default every batch member is a *lane* with steps of its own (its attempts, error ratio, controller
-state and saved times are its own), so a member's result is bitwise the same alone or in any batch. With
-``shared_steps=True`` the batch is one lane: the error ratio is the maximum over its healthy members and
-all take the same steps (``Solution.times`` then has one axis). Lanes at the same interval are integrated
-together; the others one by one (a general solver takes one ``times`` array per call).
+With ``shared_steps=False`` every batch member is a *lane* with steps of its own (its attempts, error ratio,
+controller state and saved times are its own), so a member's result is bitwise the same alone or in any
+batch. With ``shared_steps=True`` the batch is one lane: the error ratio is the maximum over its healthy
+members and all take the same steps (``Solution.times`` then has one axis). The default is per member when
+the solver takes every member on its own times in one call (``Solver.member_times``, fields autonomous or
+``batched_time``), shared otherwise. Per member, the tree answers all lanes in one compiled walk
+(:mod:`roughpaths.drivers._tree_members`); a solver without ``member_times`` is called once per group of
+lanes on the same interval.
 
 The error estimate (step doubling)
 ----------------------------------
@@ -100,17 +103,17 @@ class _TreeSteps:
             self.targets = np.array(sorted(snapped - {0} | {end}))
         self.save_all = isinstance(save_at, str) and save_at == "all"
         P = run.members
-        self.shared = shared or P == 0
+        self.vector = bool(getattr(solver, "member_times", False)) and (
+            not getattr(fields, "time_dependent", False) or getattr(fields, "batched_time", False))
+        self.shared = (not self.vector if shared is None else bool(shared)) or P == 0
         self.lanes = n = 1 if self.shared else P
         self.lane_of = np.zeros(P, dtype=np.int64) if self.shared else np.arange(P)     # the lane of each member
         self.lane_members = [np.arange(P)] if self.shared else [np.array([m]) for m in range(P)]
         self.paths = np.broadcast_to(np.arange(tree.n_paths).reshape(tree.batch_shape), run.batch).ravel()
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
-        self.vector = bool(getattr(solver, "member_times", False)) and (
-            not getattr(fields, "time_dependent", False) or getattr(fields, "batched_time", False))
         order = solver.error_order if solver.error_order is not None else solver.order
         self.state = control.init(t0, t1, n, order)
-        self.dt_min, self.dt_max = control.dt_min(T), control.dt_max(T)
+        self.dt_min = control.dt_min(T)
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
         self.i, self.j = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))

@@ -62,7 +62,7 @@ def _resolve_solver(solver) -> Solver:
 
 
 def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_failure="raise",
-          block_steps=None, executor=None, chunks=None, step_control=None, shared_steps=False,
+          block_steps=None, executor=None, chunks=None, step_control=None, shared_steps=None,
           progress=None) -> Solution:
     r"""Solve the RDE :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i`, :math:`Y_{t_0} = y_0`, on the driver's grid.
 
@@ -116,11 +116,16 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         error estimate, ``Solver.error_estimate``: ``Davie``, ``LogODE``, a coadjoint ``LieHeun``),
         :class:`~roughpaths.FixedSteps` ``(dt)``, or any object following the :class:`~roughpaths.StepController`
         contract. ``Solution.stats`` then holds ``accepted``, ``rejected`` and ``at_dt_min``.
-    shared_steps : bool
-        With a step controller: ``False`` (default) gives every batch member steps of its own (its result is
-        bitwise the same alone or in any batch; the stats are arrays over the batch; with ``save_at="all"``,
+    shared_steps : bool, optional
+        With a step controller: ``False`` gives every batch member steps of its own (its result is bitwise the
+        same alone or in any batch; the stats are arrays over the batch; with ``save_at="all"``,
         ``Solution.times`` has the batch's axes, shorter rows repeating their last time and state); ``True``
-        makes the batch take the same steps (the error ratio is the maximum over its members).
+        makes the batch take the same steps (the error ratio is the maximum over its members). ``None``
+        (default): steps per member where the solver steps members on their own times in one call
+        (``Solver.member_times``: ``Davie``, ``LogODE``, ``Heun``, ``Euler``, on autonomous fields or fields
+        declared ``batched_time``), shared steps otherwise (e.g. the coadjoint solvers of :mod:`mechanics`,
+        whose compiled kernels take one time grid), where per-member steps cost one call per member per
+        attempt. ``Solution.stats["shared_steps"]`` says which ran.
     progress : None, bool or callable
         Report progress and the time left (:mod:`roughpaths.progress`): ``None``/``False`` silent (default),
         ``True`` a bar on standard error (``tqdm`` if importable, else a plain line), a callable is called
@@ -208,7 +213,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
                             f"its own definition.")
         fields = fields.with_drift(drift)
     run = _Run(y, batch, on_failure, getattr(driver, "any_times", False))
-    steps = (_TreeSteps(run, driver, control, solver, save_at, bool(shared_steps), fields) if run.flat else
+    steps = (_TreeSteps(run, driver, control, solver, save_at, shared_steps, fields) if run.flat else
              _GridSteps(run, driver, save_at, block_steps, level))
     total, desc, unit = steps.progress_total
     report = run.report = progress_reporter(progress, total, desc=desc, unit=unit)

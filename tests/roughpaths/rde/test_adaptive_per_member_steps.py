@@ -1,6 +1,6 @@
 """Adaptive steps per batch member: a member's result is bitwise the same alone or in any batch.
 
-Claims: with ``shared_steps=False`` (the default) each member's attempts, error ratios, controller state and
+Claims: with ``shared_steps=False`` (the default for solvers that step members on their own times) each member's attempts, error ratios, controller state and
 saved times are its own, so solving member ``i`` alone (``tree.select([i])``, its ``y0``) gives bitwise its
 states, times and counts in the whole batch and in any other batch; rejected attempts leave no trace (a
 member's answer is the fixed-step solve on its own accepted steps' halves); members take fewer steps than the
@@ -112,7 +112,9 @@ def test_time_dependent_fields_with_batched_time_step_members_in_one_call():
     tree = rp.BrownianTree(2, seed=3, batch_shape=(5,))
     ctrl = rp.PIController(1e-2, 1e-2, dt_max=1 / 16)
     fast = rp.solve(make(True), tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end")
-    slow = rp.solve(make(False), tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end")
+    slow = rp.solve(make(False), tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end", shared_steps=False)
+    assert not fast.stats["shared_steps"] and not slow.stats["shared_steps"]
+    assert rp.solve(make(False), tree, np.ones(3), rp.Davie(), step_control=ctrl, save_at="end").stats["shared_steps"]
     assert np.array_equal(fast.stats["accepted"], slow.stats["accepted"])
     np.testing.assert_allclose(fast.final, slow.final, rtol=1e-12, atol=0)
     alone = rp.solve(make(True), tree.select([3]), np.ones(3), rp.Davie(), step_control=ctrl, save_at="end")
