@@ -31,8 +31,9 @@ from .norms import (area_holder_seminorm, area_p_variation, holder_distance, hol
                     rough_path_holder_norm, rough_path_p_variation)
 from .paths import RoughPath, RoughPathN, chen_defect, rough_integral
 from .progress import Progress, ProgressRecord, progress_reporter
-from .rde import (SOLVERS, Davie, Davie3, Euler, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
-                  NonFiniteStateError, PIController, Solution, Solver, VectorFields, central_jacobian, solve)
+from .rde import (SOLVERS, Davie, Davie3, Euler, FixedSteps, Heun, LinearDrift, LinearVectorFields, LogODE, LogODE3,
+                  NonFiniteStateError, PIController, Solution, Solver, StepController, VectorFields, central_jacobian,
+                  solve)
 from .signatures import (LinearKernel, MMDTestResult, RBFKernel, SignatureStream, basepoint,
                          brownian_expected_signature, invisibility_reset, lead_lag, logsignature,
                          logsignature_vjp, rough_path_signature, rough_path_signature_vjp, sig_mmd_test, signature,
@@ -41,7 +42,7 @@ from .signatures import (LinearKernel, MMDTestResult, RBFKernel, SignatureStream
 
 __all__ = [
     # RDE entry point, solvers, vector fields, rough integral
-    "solve", "Solution", "NonFiniteStateError", "PIController", "Driver", "Solver", "Euler", "Heun", "Davie",
+    "solve", "Solution", "NonFiniteStateError", "PIController", "FixedSteps", "StepController", "Driver", "Solver", "Euler", "Heun", "Davie",
     "LogODE", "LogODE3", "Davie3", "SOLVERS", "expm_batched", "VectorFields", "LinearVectorFields", "LinearDrift",
     "central_jacobian", "rough_integral",
     # progress and the time left of long work (the progress= option)

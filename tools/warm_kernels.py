@@ -110,7 +110,9 @@ def warm_tree() -> None:
     import roughpaths as rp
 
     for d in (2, 3):
-        rp.BrownianTree(d, seed=0).area(0.1, 0.3)
+        tree = rp.BrownianTree(d, seed=0, batch_shape=(2,))
+        tree.area(0.1, 0.3)
+        tree.increments_and_areas([[0.1, 0.3], [0.2, 0.4]], [0, 1])      # the per-member walk (adaptive steps)
 
 
 def warm_coadjoint() -> None:

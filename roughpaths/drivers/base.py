@@ -11,6 +11,13 @@ long or large runs need memory for one block only. A driver has
 * :meth:`Driver.rough_path`, the whole path materialised (the blocks concatenated);
 * optionally ``select(paths)``: a driver for a subset of the paths (flat indices), bitwise equal to
   those paths of the full driver; ``solve(..., executor=...)`` uses it to split a batch.
+
+A driver that answers on *any* times of its interval ``[t0, t1]`` (a :class:`~roughpaths.BrownianTree`) sets
+``any_times = True`` and has ``t0``, ``t1`` and ``increments_and_areas(times, paths=None)``: the increments
+``(..., n, d)`` and (Stratonovich) areas ``(..., n, d, d)`` between the ``n + 1`` increasing ``times``, for all
+paths or for the flat path indices ``paths`` (then with one leading axis, ``(len(paths), n, ...)``, and
+``times`` may be ``(len(paths), n + 1)``: each path on its own times). ``solve`` then chooses the steps with a
+step controller (:mod:`roughpaths.rde.step_control`); its ``times`` are ``[t0, t1]``, its one grid step.
 """
 
 from __future__ import annotations
@@ -27,6 +34,7 @@ class Driver:
     dim: int = 0
     level: int = 2
     batch_shape: tuple = ()
+    any_times: bool = False
 
     @property
     def n_steps(self) -> int:

@@ -71,6 +71,8 @@ from ..paths.rough_path import RoughPath
 from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_real
 from ._random import PathStreams
 from ._seeded import check_seed, selected_paths
+from .base import Driver
+from ._tree_members import member_cells
 from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width
 from .areas import _Sampler
 
@@ -85,7 +87,7 @@ def _reduce(node):
     return reduce_node(*node)
 
 
-class BrownianTree:
+class BrownianTree(Driver):
     r"""A Brownian path with Lévy areas on ``[t0, t1]``, queried on any sub-interval (module docstring).
 
     Parameters
@@ -130,6 +132,9 @@ class BrownianTree:
 
     #: The level of the rough path it answers (increments and areas).
     level = 2
+    #: It answers on any times of ``[t0, t1]`` (the :class:`~roughpaths.Driver` protocol): steps are chosen by
+    #: a step controller, its only grid step is ``[t0, t1]``.
+    any_times = True
 
     def __init__(self, dim, *, seed, t0=0.0, t1=1.0, batch_shape=(), levy_area="auto", levy_area_error=None,
                  polygon_levels=3, resolution=40, cache_size=None):
@@ -261,7 +266,57 @@ class BrownianTree:
         new.node_bytes = max(1, new.n_paths) * self.node_bytes // max(1, self.n_paths)
         new._cache = OrderedDict()
         new._root_node = None
+        new.__dict__.pop("_walk_cache", None)
         return new
+
+    @property
+    def times(self):
+        """``[t0, t1]``: the tree has no grid of its own (``Driver`` protocol; steps come from a controller)."""
+        return np.array([self.t0, self.t1])
+
+    def blocks(self, max_steps=None):
+        raise ValueError("a BrownianTree has no grid to cut into blocks: solve it with a step controller "
+                         "(step_control=PIController(rtol, atol) or FixedSteps(dt)), or materialise a grid with "
+                         "tree.rough_path(times).")
+
+    def increments_and_areas(self, times, paths=None):
+        """Increments and Stratonovich areas between ``times`` (the ``Driver`` protocol for ``any_times``).
+
+        Parameters
+        ----------
+        times : array_like, shape ``(n + 1,)`` or ``(len(paths), n + 1)``
+            Increasing times in ``[t0, t1]``; a 2-D array gives each selected path its own times.
+        paths : array_like of int, optional
+            Flat path indices; ``None``: all paths (``times`` then 1-D).
+
+        Returns
+        -------
+        dX, dXX : ndarray
+            ``batch_shape + (n, d)`` and ``batch_shape + (n, d, d)``, or with the leading axis ``len(paths)``.
+            On 1-D ``times`` path ``paths[k]`` answers bitwise as it does in the whole tree; on 2-D ``times`` each
+            path is walked on its own (:mod:`roughpaths.drivers._tree_members`): bitwise the same in any query
+            of any set of paths, and equal to the shared-times answer to round-off (its cells are Chen products
+            of the same nodes, accumulated in another order).
+        """
+        if paths is None:
+            W, A = self.increments_and_levy_areas(times)
+        else:
+            paths = selected_paths(paths, self.n_paths, "tree")
+            t = np.broadcast_to(np.asarray(times, dtype=np.float64), (paths.size, np.shape(times)[-1]))
+            if np.ndim(times) == 1:                  # shared times: the tree's own walk, then the rows
+                W, A = self.increments_and_levy_areas(t[0])
+                W, A = W.reshape((self.n_paths,) + W.shape[-2:])[paths], A.reshape((self.n_paths,) + A.shape[-3:])[paths]
+            elif self._prefix is not None:          # one vectorised walk for every path on its own times
+                T, L = self.t1 - self.t0, self.resolution
+                idx = np.minimum(np.round((t - self.t0) / T * 2.0 ** L).astype(np.int64), 2 ** L)
+                if np.any(t < self.t0) or np.any(t > self.t1) or not np.all(np.diff(idx, axis=-1) > 0):
+                    raise ValueError(f"times must increase strictly in [t0, t1] = [{self.t0}, {self.t1}] on the "
+                                     f"tree's grid (t1 - t0)·2^-{L}, row by row.")
+                W, A = member_cells(self, paths, idx, _SPLIT)
+            else:
+                W, A = (np.concatenate(x) for x in zip(*[self.select([p]).increments_and_levy_areas(tk)
+                                                         for p, tk in zip(paths.tolist(), t)]))
+        return W, A + 0.5 * W[..., :, None] * W[..., None, :]
 
     # ------------------------------------------------------------------ nodes
     def _streams(self, tag, depth, index):

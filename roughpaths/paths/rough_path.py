@@ -28,7 +28,7 @@ import numpy as np
 from ..validation import arrays_equal, as_float_array, check_antisymmetric, check_times
 from ..algebra.level2 import outer
 
-__all__ = ["RoughPath", "chen_defect"]
+__all__ = ["RoughPath", "chen_defect", "grid_index"]
 
 _KINDS = ("geometric", "ito", "general")
 
@@ -249,19 +249,7 @@ class RoughPath:
     # ------------------------------------------------------------------ queries
     def index_of(self, t, name: str = "t") -> np.ndarray:
         """Grid indices of the times ``t`` (scalar or array); each must be a grid point."""
-        tt = as_float_array(t, name)
-        grid = self._times
-        idx = np.clip(np.searchsorted(grid, tt), 0, grid.size - 1)
-        left = np.clip(idx - 1, 0, grid.size - 1)
-        idx = np.where(np.abs(grid[left] - tt) < np.abs(grid[idx] - tt), left, idx)
-        tol = 1e-10 * max(1.0, float(np.max(np.abs(grid))))
-        off = np.abs(grid[idx] - tt) > tol
-        if np.any(off):
-            bad = float(np.ravel(tt)[int(np.argmax(np.ravel(off)))])
-            raise ValueError(f"{name}={bad!r} is not a grid time of this rough path (grid runs from "
-                             f"{grid[0]!r} to {grid[-1]!r} in {grid.size - 1} steps); query grid times "
-                             f"only, or refine/restrict the path to a grid containing it.")
-        return idx
+        return grid_index(self._times, t, name)
 
     def _pair(self, s, t):
         i, j = self.index_of(s, "s"), self.index_of(t, "t")
@@ -428,3 +416,20 @@ def chen_defect(fine: RoughPath, coarse: RoughPath) -> float:
     if fine.level == 2 and coarse.level == 2:
         err += float(np.max(np.abs(r.areas - coarse.areas)))
     return err
+
+
+def grid_index(grid, t, name: str = "t") -> np.ndarray:
+    """Indices into the increasing ``grid`` of the times ``t`` (scalar or array); each must be a grid point
+    (to ``1e-10`` relative), else a ``ValueError`` names ``name``, the time and the grid."""
+    tt = as_float_array(t, name)
+    idx = np.clip(np.searchsorted(grid, tt), 0, grid.size - 1)
+    left = np.clip(idx - 1, 0, grid.size - 1)
+    idx = np.where(np.abs(grid[left] - tt) < np.abs(grid[idx] - tt), left, idx)
+    tol = 1e-10 * max(1.0, float(np.max(np.abs(grid))))
+    off = np.abs(grid[idx] - tt) > tol
+    if np.any(off):
+        bad = float(np.ravel(tt)[int(np.argmax(np.ravel(off)))])
+        raise ValueError(f"{name}={bad!r} is not a grid time of this rough path (grid runs from "
+                         f"{grid[0]!r} to {grid[-1]!r} in {grid.size - 1} steps); query grid times "
+                         f"only, or refine/restrict the path to a grid containing it.")
+    return idx

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rough_path import RoughPath
+from .rough_path import RoughPath, grid_index
 from ..algebra.tensor import (from_lyndon_coordinates, lyndon_coordinates, sigdim, tensor_exp,
                              tensor_inverse, tensor_log, tensor_product)
 from ..validation import as_float_array, check_antisymmetric, check_memory, check_positive_int, check_times
@@ -259,7 +259,7 @@ class RoughPathN:
     # ------------------------------------------------------------------ queries
     def index_of(self, t, name: str = "t") -> np.ndarray:
         """Grid indices of the times ``t`` (each must be a grid point)."""
-        return RoughPath(np.zeros((self.n_steps, 1)), times=self._times, check=False).index_of(t, name)
+        return grid_index(self._times, t, name)
 
     def _prefix(self) -> np.ndarray:
         """:math:`\\mathbf{X}_{t_0, t_k}` for every ``k``, shape ``(..., K + 1, D)`` (cached)."""

@@ -1,36 +1,39 @@
-r"""Adaptive steps on a :class:`~roughpaths.BrownianTree`: :class:`PIController` and the loop behind ``solve``.
+r"""Steps on a driver that answers on any times (a :class:`~roughpaths.BrownianTree`): the attempts of :func:`~roughpaths.solve`.
 
 ``solve(fields, tree, y0, solver, step_control=PIController(rtol, atol))`` integrates on ``[tree.t0,
-tree.t1]`` with steps chosen from an error estimate. The tree answers the increment and area on any
-interval, so a rejected step asks the same tree again on a shorter interval: the Brownian path is fixed
-by the seed, and rejection introduces no bias (no resampling, no conditioning on the rejection).
+tree.t1]`` with steps chosen by the controller (:mod:`roughpaths.rde.step_control`). The tree answers the
+increment and area on any interval, so a rejected step asks the same tree again on a shorter interval: the
+Brownian path is fixed by the seed, and rejection introduces no bias (no resampling, no conditioning on the
+rejection).
+
+Lanes
+-----
+With ``shared_steps=False`` every batch member is a *lane* with steps of its own (its attempts, error ratio,
+controller state and saved times are its own), so a member's result is bitwise the same alone or in any
+batch. With ``shared_steps=True`` the batch is one lane: the error ratio is the maximum over its healthy
+members and all take the same steps (``Solution.times`` then has one axis). The default is per member when
+the solver takes every member on its own times in one call (``Solver.member_times``, fields autonomous or
+``batched_time``), shared otherwise. Per member, the tree answers all lanes in one compiled walk
+(:mod:`roughpaths.drivers._tree_members`); a solver without ``member_times`` is called once per group of
+lanes on the same interval.
 
 The error estimate (step doubling)
 ----------------------------------
-An attempt on ``[t, t + h]`` takes one step of the solver over the whole interval, ``y_1``, and two over
-its halves, ``y_2``, with the increments and areas of the same tree (the whole step's are the Chen product
-of the halves', so both see the same path). The local error of an order-1 scheme on non-commuting noise is
-its missing level-3 term, of size :math:`h^{3/2}`; ``y_2 - y_1`` is of that size and estimates it. The
-two-step value ``y_2`` is kept. Random local errors add in mean square, so ``N = T/h`` steps of local
-error :math:`\epsilon` give a global error :math:`\sqrt{T/h}\,\epsilon`; the controller therefore bounds
+For ``Solver.error_estimate == "step_doubling"`` an attempt on ``[t, t + h]`` takes one step of the solver
+over the whole interval, ``y_1``, and two over its halves, ``y_2``, with the increments and areas of the
+same tree (the whole step's are the Chen product of the halves', so both see the same path). The local
+error of an order-1 scheme on non-commuting noise is its missing level-3 term, of size :math:`h^{3/2}`;
+``y_2 - y_1`` is of that size and estimates it. The two-step value ``y_2`` is kept. The controller turns it
+into an error ratio (:meth:`~roughpaths.PIController.error_ratio`: an RMS over the ``e`` components, times
+:math:`\sqrt{T/h}`, the predicted global error, since random local errors add in mean square), so the
+strong error of an order-1 scheme is proportional to ``rtol`` (an error-per-step rule would give
+``rtol^(2/3)``). A controller without estimate (``adaptive = False``) gets one solver step per attempt.
 
-.. math:: r = \sqrt{\tfrac{T}{h}}\;\max_{\text{members}}\Bigl(\tfrac1e\sum_a
-          \Bigl(\frac{y_2^a - y_1^a}{\mathrm{atol} + \mathrm{rtol}\max(|y^a|, |y_2^a|)}\Bigr)^2\Bigr)^{1/2}
-          \le 1,
-
-the predicted global error in units of the tolerance (``T = t1 - t0``). Since :math:`r \propto h`, the
-steps shrink in proportion to the tolerance and the strong error of an order-1 scheme is proportional to
-``rtol`` (an error-per-step rule, :math:`\epsilon \le \mathrm{tol}`, would give ``rtol^(2/3)``).
-The steps are shared by the batch: the norm is the maximum over its members (for steps of its own,
-solve member ``i`` on ``tree.select([i])``, which answers bitwise as member ``i`` does).
-
-The step size
+The step ends
 -------------
-The next step is :math:`h\,\min(f_{\max}, \max(f_{\min}, s\,r_n^{-(\beta_I + \beta_P)}\,r_{n-1}^{\beta_P}))`
-(``safety`` ``s``, ``icoeff`` :math:`\beta_I`, ``pcoeff`` :math:`\beta_P`; :math:`f_{\max} = 1` right
-after a rejection). Step ends are snapped to the dyadic grid of spacing at most ``h/8`` (a relative change
-of at most 1/16), so a query walks only about :math:`\log_2(T/h) + 4` levels of the tree. Save times and
-``t1`` are never stepped over.
+Step ends are snapped to the dyadic grid of spacing at most ``h/8`` (a relative change of at most 1/16), so a
+query walks only about :math:`\log_2(T/h) + 4` levels of the tree. Save times and ``t1`` are never stepped
+over. A step at ``dt_min`` whose error ratio exceeds 1 fails its members (``on_failure``).
 
 What is exact and what is approximate
 -------------------------------------
@@ -43,96 +46,13 @@ tree itself (see :mod:`roughpaths.drivers.tree`); the error estimate (of the rig
 
 from __future__ import annotations
 
-import contextlib
 import math
-import time as _time
 
 import numpy as np
 
-from ..progress import progress_reporter
-from ..validation import check_memory, check_positive_int, check_positive_real
-from .base import Solver
-from .solution import NonFiniteStateError, Solution, _failure_message
+from ..validation import check_memory
 
-__all__ = ["PIController"]
-
-
-class PIController:
-    r"""Adaptive step sizes for :func:`~roughpaths.solve` on a :class:`~roughpaths.BrownianTree`.
-
-    Parameters
-    ----------
-    rtol, atol : float
-        Relative and absolute tolerances (``rtol >= 0``, ``atol >= 0``, not both 0). They bound the
-        *predicted global* error (module docstring): the strong error of an order-1 scheme is about
-        proportional to them.
-    dt0 : float, optional
-        First step tried (default ``(t1 - t0) / 64``).
-    dt_min : float, optional
-        Smallest step (default ``(t1 - t0) · 2^-30``). A step at ``dt_min`` is accepted whatever its error;
-        ``Solution.stats["at_dt_min"]`` counts them.
-    dt_max : float, optional
-        Largest step (default ``t1 - t0``).
-    safety : float
-        Factor applied to the predicted step (default 0.8).
-    factor_min, factor_max : float
-        Bounds on the ratio of consecutive steps (defaults 0.2 and 5).
-    icoeff, pcoeff : float
-        Integral and proportional exponents :math:`\beta_I`, :math:`\beta_P` (defaults 0.7 and 0.3). The
-        error ratio is proportional to the step, so :math:`\beta_I + \beta_P = 1` is the dead-beat sum;
-        ``icoeff=1, pcoeff=0`` is the plain integral controller (``docs/adaptive-steps.md`` compares them).
-    max_steps : int
-        Most attempts (accepted plus rejected) before ``solve`` gives up with a ``ValueError`` (default
-        10⁵), so a tolerance that cannot be met never hangs.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import roughpaths as rp
-    >>> M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
-    >>> tree = rp.BrownianTree(2, seed=0, batch_shape=(4,))
-    >>> sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(),
-    ...                step_control=rp.PIController(rtol=1e-2, atol=1e-2), save_at="end")
-    >>> sol.final.shape, sol.stats["accepted"] > 0, float(sol.times[-1])
-    ((4, 2), True, 1.0)
-    """
-
-    def __init__(self, rtol, atol, dt0=None, *, dt_min=None, dt_max=None, safety=0.8, factor_min=0.2,
-                 factor_max=5.0, icoeff=0.7, pcoeff=0.3, max_steps=100_000):
-        self.rtol = check_positive_real(rtol, "rtol", allow_zero=True)
-        self.atol = check_positive_real(atol, "atol", allow_zero=True)
-        if self.rtol == 0.0 and self.atol == 0.0:
-            raise ValueError("rtol and atol are both 0: no error can be met; give a positive tolerance, e.g. "
-                             "PIController(rtol=1e-3, atol=1e-6).")
-        self.dt0 = None if dt0 is None else check_positive_real(dt0, "dt0")
-        self.dt_min = None if dt_min is None else check_positive_real(dt_min, "dt_min")
-        self.dt_max = None if dt_max is None else check_positive_real(dt_max, "dt_max")
-        if self.dt_min is not None and self.dt_max is not None and self.dt_min > self.dt_max:
-            raise ValueError(f"dt_min={dt_min!r} exceeds dt_max={dt_max!r}; swap them.")
-        self.safety = check_positive_real(safety, "safety")
-        if self.safety > 1.0:
-            raise ValueError(f"safety must lie in (0, 1], got {safety!r}; the default is 0.8.")
-        self.factor_min = check_positive_real(factor_min, "factor_min")
-        self.factor_max = check_positive_real(factor_max, "factor_max")
-        if not self.factor_min < 1.0 < self.factor_max:
-            raise ValueError(f"need factor_min < 1 < factor_max, got factor_min={factor_min!r}, "
-                             f"factor_max={factor_max!r}; the defaults are 0.2 and 5.")
-        self.icoeff = check_positive_real(icoeff, "icoeff")
-        self.pcoeff = check_positive_real(pcoeff, "pcoeff", allow_zero=True)
-        self.max_steps = check_positive_int(max_steps, "max_steps")
-
-    def __repr__(self) -> str:
-        return (f"PIController(rtol={self.rtol!r}, atol={self.atol!r}, dt0={self.dt0!r}, icoeff={self.icoeff!r}, "
-                f"pcoeff={self.pcoeff!r})")
-
-    def _factor(self, r, r_prev, after_reject):
-        """Ratio of the next step to this one, from the error ratios ``r`` (this step) and ``r_prev``."""
-        if not math.isfinite(r):
-            return self.factor_min
-        r = max(r, 1e-10)
-        f = self.safety * r ** -(self.icoeff + self.pcoeff) * max(r_prev, 1e-10) ** self.pcoeff
-        hi = 1.0 if after_reject else self.factor_max
-        return min(hi, max(self.factor_min, f))
+__all__ = []
 
 
 def _areas(W, A):
@@ -148,117 +68,176 @@ def _whole_step(W, XX):
     return (W1 + W2)[..., None, :], XXw[..., None, :, :]
 
 
-def solve_adaptive(fields, tree, y, solver: Solver, control: PIController, save_at, on_failure, batch, progress=None):
-    """The adaptive loop of :func:`~roughpaths.solve` (arguments already checked there; ``y`` broadcast).
-    ``progress`` reports the time reached, ``t - t0`` of ``t1 - t0``, after every accepted step."""
-    if not isinstance(control, PIController):
-        raise TypeError(f"step_control must be a roughpaths.PIController, got {type(control).__name__}; "
-                        f"e.g. step_control=PIController(rtol=1e-3, atol=1e-6).")
-    if solver.order < 1.0 or solver.increment_level < 2:
-        raise ValueError(f"adaptive steps assume a strong order-1 scheme that uses the area (the error estimate "
-                         f"and the step rule are built for it), got {solver!r} (order {solver.order}); use "
-                         f"Davie(), LogODE() or a coadjoint LieHeun().")
-    L, t0, t1 = tree.resolution, tree.t0, tree.t1
-    T = t1 - t0
-    n_cells = 1 << L
-    cell = T / n_cells
-    end = n_cells
-    # targets: the grid indices of the save times (the loop never steps over them) and t1
-    if isinstance(save_at, str):
-        if save_at not in ("all", "end"):
-            raise ValueError(f"save_at must be 'all', 'end' or an array of times in [t0, t1], got {save_at!r}.")
-        targets = [end]
-    else:
-        st = np.asarray(save_at, dtype=np.float64).ravel()
-        if st.size == 0 or not np.all(np.isfinite(st)) or st.min() < t0 or st.max() > t1:
-            raise ValueError(f"save_at times must be finite and lie in the tree's [t0, t1] = [{t0}, {t1}], got "
-                             f"{save_at!r}.")
-        snapped = {min(int(round((v - t0) / T * n_cells)), end) for v in st}
-        marks = np.array(sorted(snapped | {0, end}))
-        if np.any(np.diff(marks) < 2):
-            raise ValueError(f"save_at has times closer than two cells of the tree's grid ((t1 - t0)·2^-{L - 1}) to "
-                             f"each other or to t0, t1; a step between them cannot be halved. Drop the near "
-                             f"duplicates.")
-        targets = sorted(snapped - {0} | {end})
-    save_all = isinstance(save_at, str) and save_at == "all"
-    save_idx = ({end} if save_at == "end" else set()) if isinstance(save_at, str) else snapped
-    dt_min = control.dt_min if control.dt_min is not None else T * 2.0 ** -30
-    dt_max = min(control.dt_max, T) if control.dt_max is not None else T
-    h = min(control.dt0 if control.dt0 is not None else T / 64, dt_max)
-    min_cells = max(2, int(math.ceil(dt_min / cell)))
-    e = y.shape[-1]
-    members = int(np.prod(batch, dtype=np.int64))
+class _Attempt:
+    """One call of the solver: flat ``members``, ``times``, ``dX``, ``dXX``, ``save`` mask, the ``whole`` step (or None)."""
 
-    saved_t = [t0] if (save_all or 0 in save_idx) else []
-    saved_y = [y.copy()] if saved_t else []
-    failed_step = np.full(batch, -1, dtype=np.int64)
-    healthy = np.ones(batch, dtype=bool)
-    i, k_target, t_acc = 0, 0, [t0]
-    accepted = rejected = at_min = 0
-    r_prev, after_reject = 1.0, False
-    t_start = _time.perf_counter()
-    no_save = np.zeros(2, dtype=bool)
-    report = progress_reporter(progress, T, desc="solve (adaptive)", unit="time")
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"), (report or contextlib.nullcontext()):
-        while i < end:
-            if accepted + rejected >= control.max_steps:
-                raise ValueError(f"adaptive solve took {control.max_steps} attempts and reached t = "
-                                 f"{t0 + i * cell:.6g} of [{t0}, {t1}] ({accepted} accepted, {rejected} rejected); "
-                                 f"loosen rtol/atol or raise PIController(max_steps=...).")
-            while targets[k_target] <= i:
-                k_target += 1
-            target = targets[k_target]
-            # snap the step end to a dyadic grid of spacing <= h/8, never past the next target
-            depth = min(L, max(0, int(math.ceil(math.log2(T / h))) + 3))
-            unit = 1 << (L - depth)
-            j = int(round((i + h / cell) / unit)) * unit
-            j = max(j, i + min_cells, (i // unit + 1) * unit)
-            if j >= target or target - j < min_cells:
-                j = target
-            at_floor = (j - i) <= min_cells or (j - i) * cell <= dt_min * (1 + 1e-12)
-            ts = t0 + cell * np.array([i, (i + j) // 2, j], dtype=np.float64)
-            W, A = tree.increments_and_levy_areas(ts)
-            W, XX = np.broadcast_to(W, batch + W.shape[-2:]), np.broadcast_to(_areas(W, A), batch + A.shape[-3:])
-            y2, _, _ = solver.integrate(fields, y, ts, W, XX, no_save, stop_on_failure=False)
-            y1, _, _ = solver.integrate(fields, y, ts[[0, 2]], *_whole_step(W, XX), no_save[:1],
-                                        stop_on_failure=False)
-            hstep = (j - i) * cell
-            scale = control.atol + control.rtol * np.maximum(np.abs(y), np.abs(y2))
-            err = np.sqrt(np.mean(((y2 - y1) / scale) ** 2, axis=-1))
-            bad = ~np.all(np.isfinite(y2), axis=-1) & healthy
-            ok = healthy & ~bad
-            r = float(err[ok].max()) * math.sqrt(T / hstep) if ok.any() else 0.0
-            if bad.any():
-                r = math.inf
-            if r <= 1.0 or at_floor:
-                accepted += 1
-                at_min += int(r > 1.0)
-                if bad.any():
-                    failed_step[bad] = accepted - 1
-                    if on_failure == "raise":
-                        msg, mem, steps = _failure_message(failed_step, np.array(t_acc + [ts[2]]), batch)
-                        raise NonFiniteStateError(msg, mem, steps)
-                    healthy &= ~bad
-                y = np.where(healthy[..., None], y2, np.nan)
-                i = j
-                t_acc.append(t0 + i * cell if i < end else t1)
-                if save_all or i in save_idx:
-                    saved_t.append(t_acc[-1])
-                    saved_y.append(y.copy())
-                    if len(saved_t) & (len(saved_t) - 1) == 0:       # at every doubling: the budget read is slow
-                        check_memory(16.0 * members * e * len(saved_t), f"the saved states ({len(saved_t)} times "
-                                     f"so far, and growing)", "save fewer times (save_at='end' or an array of times)")
-                f = control._factor(r, r_prev, after_reject)
-                r_prev, after_reject = max(r, 1e-10), False
-                if report is not None:
-                    report.update(i * cell)        # exact: cell = T / 2^L, and end * cell == T
-            else:
-                rejected += 1
-                f = control._factor(r, r_prev, True)
-                after_reject = True
-            h = min(dt_max, max(dt_min, hstep * f))
-    stats = {"solver": repr(solver), "step_control": repr(control), "n_steps": accepted, "accepted": accepted,
-             "rejected": rejected, "at_dt_min": at_min, "batch_shape": batch,
-             "wall_time": _time.perf_counter() - t_start}
-    states = np.stack(saved_y, axis=-2) if saved_y else np.empty(batch + (0, e))
-    return Solution(times=np.array(saved_t), states=states, failed_step=failed_step, stats=stats)
+    def __init__(self, members, times, dX, dXX, save, whole=None, h=None):
+        self.members, self.times, self.dX, self.dXX, self.save, self.whole, self.h = \
+            members, times, dX, dXX, save, whole, h
+        self.stop = False
+
+
+class _TreeSteps:
+    """The proposer of :func:`~roughpaths.solve`'s loop on an ``any_times`` driver: lanes, snapping, targets."""
+
+    def __init__(self, run, tree, control, solver, save_at, shared, fields):
+        L = getattr(tree, "resolution", 40)
+        t0, t1 = float(tree.t0), float(tree.t1)
+        self.run, self.tree, self.control, self.t0, self.t1, self.L = run, tree, control, t0, t1, L
+        self.span = T = t1 - t0
+        self.end, self.cell = end, cell = 1 << L, T / (1 << L)
+        if isinstance(save_at, str):
+            if save_at not in ("all", "end"):
+                raise ValueError(f"save_at must be 'all', 'end' or an array of times in [t0, t1], got {save_at!r}.")
+            self.targets, self.save_idx = np.array([end]), ({end} if save_at == "end" else set())
+        else:
+            st = np.asarray(save_at, dtype=np.float64).ravel()
+            if st.size == 0 or not np.all(np.isfinite(st)) or st.min() < t0 or st.max() > t1:
+                raise ValueError(f"save_at times must be finite and lie in the tree's [t0, t1] = [{t0}, {t1}], got "
+                                 f"{save_at!r}.")
+            self.save_idx = snapped = {min(int(round((v - t0) / T * end)), end) for v in st}
+            if np.any(np.diff(np.array(sorted(snapped | {0, end}))) < 2):
+                raise ValueError(f"save_at has times closer than two cells of the tree's grid ((t1 - t0)·2^-{L - 1}) "
+                                 f"to each other or to t0, t1; a step between them cannot be halved. Drop the near "
+                                 f"duplicates.")
+            self.targets = np.array(sorted(snapped - {0} | {end}))
+        self.save_all = isinstance(save_at, str) and save_at == "all"
+        P = run.members
+        self.vector = bool(getattr(solver, "member_times", False)) and (
+            not getattr(fields, "time_dependent", False) or getattr(fields, "batched_time", False))
+        self.shared = (not self.vector if shared is None else bool(shared)) or P == 0
+        self.lanes = n = 1 if self.shared else P
+        self.lane_of = np.zeros(P, dtype=np.int64) if self.shared else np.arange(P)     # the lane of each member
+        self.lane_members = [np.arange(P)] if self.shared else [np.array([m]) for m in range(P)]
+        self.paths = np.broadcast_to(np.arange(tree.n_paths).reshape(tree.batch_shape), run.batch).ravel()
+        self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
+        order = solver.error_order if solver.error_order is not None else solver.order
+        self.state = control.init(t0, t1, n, order)
+        self.dt_min = control.dt_min(T)
+        self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
+        self.i, self.j = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+        self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))
+        self.t_acc = [[t0] for _ in range(n)]
+        keep0 = self.save_all or 0 in self.save_idx
+        self.saved = [([t0], [run.y[m].copy()]) if keep0 else ([], []) for m in self.lane_members]
+        self.y_new, self.err = np.empty_like(run.y), np.zeros(P)
+        self.progress_total, self.reached = (T, "solve (adaptive)", "time"), 0.0
+
+    def propose(self):
+        """The attempts of every lane not yet at ``t1``, lanes on the same interval together (``[]``: done)."""
+        act = self.act = np.flatnonzero(self.i < self.end)
+        if act.size == 0:
+            return []
+        tries = self.accepted + self.rejected
+        if (tries >= self.control.max_steps).any():
+            k = int(np.argmax(tries))
+            raise ValueError(f"adaptive solve took {self.control.max_steps} attempts and reached t = "
+                             f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] "
+                             f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
+                             f"or raise the controller's max_steps.")
+        L, cell, i, h = self.L, self.cell, self.i[act], self.state["h"][act]
+        target = self.targets[np.searchsorted(self.targets, i, side="right")]
+        depth = np.clip(np.ceil(np.log2(self.span / h)).astype(np.int64) + 3, 0, L)
+        unit = np.left_shift(np.int64(1), L - depth)
+        j = np.round((i + h / cell) / unit).astype(np.int64) * unit
+        j = np.maximum(np.maximum(j, i + self.min_cells), (i // unit + 1) * unit)
+        j = np.where((j >= target) | (target - j < self.min_cells), target, j)
+        self.j[act] = j
+        self.floor = np.zeros(self.lanes, dtype=bool)
+        self.floor[act] = ((j - i) <= self.min_cells) | ((j - i) * cell <= self.dt_min * (1 + 1e-12))
+        self.bad = np.zeros(self.run.members, dtype=bool)
+        self.tried = np.zeros(self.run.members, dtype=bool)
+        cols = [i, (i + j) // 2, j] if self.control.adaptive else [i, j]
+        ts = self.t0 + cell * np.stack(cols, axis=-1).astype(np.float64)          # (lanes, 3) or (lanes, 2)
+        if self.shared:
+            members, ts, h = self.lane_members[0], ts[0], float((j[0] - i[0]) * cell)
+            W, XX = self.tree.increments_and_areas(ts, None if self.whole_batch else self.paths)
+            W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
+        else:
+            members, h = act, (j - i) * cell
+            W, XX = self.tree.increments_and_areas(ts, self.paths[act])
+        if self.shared or self.vector:            # one call: the batch on shared steps, or each member on its own
+            return [self._attempt(members, ts, W, XX, h)]
+        pairs, inverse = np.unique(np.stack([i, j]), axis=1, return_inverse=True)
+        groups = [np.flatnonzero(inverse.ravel() == g) for g in range(pairs.shape[1])]
+        return [self._attempt(members[k], ts[k[0]], W[k], XX[k], h[k[0]]) for k in groups]
+
+    def _attempt(self, members, ts, W, XX, h):
+        whole = _whole_step(W, XX) if self.control.adaptive else None
+        return _Attempt(members, ts, W, XX, np.zeros(ts.shape[-1] - 1, dtype=bool), whole, h)
+
+    def judge(self, a, y_new, saved, first_bad, err):
+        """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
+        self.y_new[a.members] = y_new
+        self.tried[a.members] = True
+        self.bad[a.members] = ~np.all(np.isfinite(y_new), axis=-1)
+        if err is not None:
+            self.err[a.members] = err
+
+    def _lane_ratios(self, ok):
+        r = np.zeros(self.lanes)
+        np.maximum.at(r, self.lane_of[ok], self.err[ok])                # NaN propagates: never accepted
+        r[self.lane_of[self.bad & self.run.healthy]] = math.inf
+        return r
+
+    def adapt(self, attempts):
+        """Fail the members that miss the tolerance at ``dt_min``, let the controller decide, advance the lanes."""
+        run, act, cell = self.run, self.act, self.cell
+        bad = self.bad & run.healthy
+        ok = self.tried & run.healthy & ~bad
+        r = None
+        if self.control.adaptive:
+            unmet = ok & ~(self.err <= 1.0) & self.floor[self.lane_of]
+            if unmet.any():                         # the tolerance cannot be met at dt_min: fail, never crawl
+                np.add.at(self.at_min, self.lane_of[unmet], 1)
+                m = np.flatnonzero(unmet)
+                run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t0 + self.i[
+                    self.lane_of[m[0]]] * cell, (self.j - self.i)[self.lane_of[m[0]]] * cell, self.control))
+                ok &= ~unmet
+            r = self._lane_ratios(ok)
+        t, h = self.t0 + self.i * cell, (self.j - self.i) * cell
+        accept = (np.asarray(self.control.adapt(self.state, t, h, r), dtype=bool) | self.floor) & (self.i < self.end)
+        self.rejected[act[~accept[act]]] += 1
+        lanes = np.flatnonzero(accept)
+        if lanes.size == 0:
+            return
+        members = np.flatnonzero(accept[self.lane_of] & self.tried)
+        if bad[members].any():
+            m = members[bad[members]]
+            run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
+        run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
+        self.accepted[lanes] += 1
+        self.i[lanes] = self.j[lanes]
+        for k in lanes.tolist():
+            ik = int(self.i[k])
+            tn = self.t0 + ik * cell if ik < self.end else self.t1
+            self.t_acc[k].append(tn)
+            if self.save_all or ik in self.save_idx:
+                self.saved[k][0].append(tn)
+                self.saved[k][1].append(run.y[self.lane_members[k]].copy())
+        run.check_saves(sum(len(ts) for ts, _ in self.saved) // self.lanes, growing=True)
+        reached = float(np.min(self.i)) * cell           # exact: cell = T / 2^L, and end * cell == T
+        if reached > self.reached:
+            self.reached = reached
+            run.progress(reached)
+
+    def _times_of(self, member):
+        """The accepted step ends of ``member`` (flat index) and its attempt's end: for failure messages."""
+        k = int(self.lane_of[member])
+        return np.array(self.t_acc[k] + [self.t0 + float(self.j[k]) * self.cell])
+
+    def finish(self):
+        """``(times, states, stats)``: one time axis for shared steps and for save times; per member otherwise."""
+        run = self.run
+        if self.shared or not self.save_all:
+            times = np.array(self.saved[0][0])
+            states = np.concatenate([np.stack(ys, axis=-2) if ys else np.empty((len(m), 0, run.e))
+                                     for (_, ys), m in zip(self.saved, self.lane_members)])
+        else:          # each member its own step ends; shorter rows repeat their last time (t1) and state
+            K = max(len(ts) for ts, _ in self.saved)
+            times = np.array([ts + ts[-1:] * (K - len(ts)) for ts, _ in self.saved]).reshape(run.batch + (K,))
+            states = np.stack([np.concatenate(ys + ys[-1:] * (K - len(ys))) for _, ys in self.saved])
+        stats = {k: (int(v[0]) if self.shared else v.reshape(run.batch))
+                 for k, v in (("accepted", self.accepted), ("rejected", self.rejected), ("at_dt_min", self.at_min))}
+        stats.update(step_control=repr(self.control), n_steps=stats["accepted"], shared_steps=self.shared)
+        return times, states.reshape(run.batch + states.shape[-2:]), stats

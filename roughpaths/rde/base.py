@@ -74,6 +74,17 @@ class Solver:
        batch member, the index of the first step after which the member was non-finite (``-1`` if
        never). With ``stop_on_failure`` it may return as soon as a member fails. The default loops
        :meth:`step`; compiled fast paths override this method and must return what stepping returns.
+    9. ``error_estimate`` (class attribute, declared data for adaptive steps,
+       :mod:`roughpaths.rde.step_control`): ``"step_doubling"`` (the default: an attempt is one step over
+       ``[t, t + h]`` and two over its halves on the same path, the difference estimating the local error) or
+       ``None`` (the scheme offers no estimate a controller can trust; adaptive steps refuse it).
+       ``error_order`` (default ``None``: the declared ``order``) is the strong order the estimate's error ratio
+       follows, ``r ∝ h ** error_order``; step doubling needs an order of at least 1 and the area
+       (``increment_level >= 2``), or its difference is dominated by the missing area instead of the error.
+    10. ``member_times`` (class attribute, default ``False``): ``integrate`` also accepts ``times`` of shape
+        ``(..., K + 1)`` with the batch axes of ``y``, each member on its own steps (adaptive steps per member);
+        :meth:`step` then gets ``t`` and ``dt`` of shape ``(..., 1)``. ``solve`` uses it for fields that do not
+        depend on time; otherwise it calls ``integrate`` once per group of members on the same steps.
     """
 
     increment_level: int = 1
@@ -81,6 +92,9 @@ class Solver:
     smooth_order: float = 0.0
     calculus: str = "stratonovich"
     preserves: tuple = ()
+    error_estimate: str | None = "step_doubling"
+    error_order: float | None = None
+    member_times: bool = False
 
     def check_fields(self, fields):
         """Return ``fields`` if this solver can integrate it (contract item 5)."""
@@ -113,20 +127,21 @@ class Solver:
 
     def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
         """Advance ``y`` over a block of steps (contract item 8) by calling :meth:`step` per step."""
-        n = times.shape[0] - 1
         saved = np.empty(y.shape[:-1] + (int(np.count_nonzero(save)), y.shape[-1]))
         first_bad = np.full(y.shape[:-1], -1, dtype=np.int64)
         dts = np.diff(times)
+        per = times.ndim > 1                            # contract item 10: each member its own times
         slot = 0
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            for k in range(n):
+            for k in range(times.shape[-1] - 1):
                 if dXX is None:
                     dxx = None
                 elif isinstance(dXX, tuple):
                     dxx = tuple(a[(Ellipsis, k) + (slice(None),) * (a.ndim - dX.ndim + 1)] for a in dXX)
                 else:
                     dxx = dXX[..., k, :, :]
-                y = self.step(fields, y, times[k], dts[k], dX[..., k, :], dxx)
+                t, dt = (times[..., k, None], dts[..., k, None]) if per else (times[k], dts[k])
+                y = self.step(fields, y, t, dt, dX[..., k, :], dxx)
                 bad = ~np.all(np.isfinite(y), axis=-1)
                 if bad.any():
                     first_bad[bad & (first_bad < 0)] = k

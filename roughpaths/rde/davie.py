@@ -31,6 +31,7 @@ class Davie(Solver):
     """
 
     increment_level = 2
+    member_times = True
     order = 1.0
     smooth_order = 2.0
 

@@ -19,9 +19,11 @@ class Euler(Solver):
     """
 
     increment_level = 1
+    member_times = True
     order = 0.5
     smooth_order = 1.0
     calculus = "ito"
+    error_estimate = None        # order ½: a doubling difference measures the missing area, not the error
 
     def step(self, fields, y, t, dt, dX, dXX):
         V = fields.fields(y, t)
@@ -39,8 +41,10 @@ class Heun(Solver):
     """
 
     increment_level = 1
+    member_times = True
     order = 0.5
     smooth_order = 2.0
+    error_estimate = None        # order ½: a doubling difference measures the missing area, not the error
 
     def step(self, fields, y, t, dt, dX, dXX):
         V = fields.fields(y, t)

@@ -1,12 +1,15 @@
-r"""The entry point :func:`solve` for rough differential equations.
+r"""The entry point :func:`solve` for rough differential equations, and its one time loop.
 
-Solves :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i` on the grid of a :class:`~roughpaths.RoughPath`
-(or of a :class:`~roughpaths.Driver`, consumed block by block) with a one-step solver that
-follows the contract of :class:`roughpaths.Solver`. The time loop runs over steps in Python
-(or inside a solver's compiled block kernel); every step is vectorised over the batch (the driver's
-batch axes broadcast against those of ``y0``), so no Python loop runs per path. Batch members never
-affect each other: a member that becomes non-finite is reported by its index and step, and with
-``on_failure="mask"`` the healthy members' results are returned unchanged.
+Solves :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i` with a one-step solver that follows the contract of
+:class:`roughpaths.Solver`. One loop serves every driver: the steps are proposed (a grid driver's blocks in
+:mod:`roughpaths.rde._grid`; a step controller's attempts on a driver that answers on any times, e.g. a
+:class:`~roughpaths.BrownianTree`, in :mod:`roughpaths.rde.adaptive`), the driver answers their increments
+and areas, the solver integrates them (with the declared error estimate for an adaptive controller), the
+controller accepts or rejects, and the states are saved or the failures marked; the failures, the memory
+check of the saved states and the statistics exist once (:class:`_Run`). Every step is vectorised over the
+batch, so no Python loop runs per path on a grid. Batch members never affect each other: a member that
+becomes non-finite is reported by its index and step, and with ``on_failure="mask"`` the healthy members'
+results are returned unchanged.
 """
 
 from __future__ import annotations
@@ -17,13 +20,15 @@ import numpy as np
 
 from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
 from ..drivers.base import Driver
-from ..drivers.tree import BrownianTree
 from ..progress import progress_reporter
 from ..paths.rough_path import RoughPath
 from ..paths.rough_path_n import RoughPathN
-from .adaptive import solve_adaptive
+from ._grid import _GridSteps
+from .adaptive import _TreeSteps
 from .base import Solver
 from .solution import NonFiniteStateError, Solution, _failure_message
+from ._split import _solve_split
+from .step_control import FixedSteps
 from .davie import Davie
 from .euler import Euler, Heun
 from .logode import LogODE
@@ -57,7 +62,8 @@ def _resolve_solver(solver) -> Solver:
 
 
 def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_failure="raise",
-          block_steps=None, executor=None, chunks=None, step_control=None, progress=None) -> Solution:
+          block_steps=None, executor=None, chunks=None, step_control=None, shared_steps=None,
+          progress=None) -> Solution:
     r"""Solve the RDE :math:`dY = V_0(Y)\,dt + V_i(Y)\,d\mathbf{X}^i`, :math:`Y_{t_0} = y_0`, on the driver's grid.
 
     Parameters
@@ -71,7 +77,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     driver : RoughPath, RoughPathN, Driver or BrownianTree
         Batch shape ``B_X``, dimension ``d``, ``N`` steps; a :class:`~roughpaths.Driver` is
         consumed block by block (memory for one block). A :class:`~roughpaths.BrownianTree` is
-        solved on ``[tree.t0, tree.t1]`` with adaptive steps (``step_control``). Level 2 for level-2
+        solved on ``[tree.t0, tree.t1]`` with the steps of ``step_control``. Level 2 for level-2
         solvers, a :class:`~roughpaths.RoughPathN` of level >= 3 for level-3 solvers (``LogODE3``, ``Davie3``).
         Convention: area :math:`\mathbb{X}^{ij} = \int (X^i - X^i_s)\,dX^j`.
     y0 : array_like, shape ``(..., e)``
@@ -83,7 +89,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     drift : callable, matrix ``(e, e)`` or LinearDrift, optional
         Extra drift added to :math:`V_0`, e.g. ``fields.friz_oberhauser_drift(s)`` (vector fields only).
     save_at : "all", "end" or array_like of grid times
-        Which states to keep (default all ``N + 1``; with adaptive steps every accepted step, or the
+        Which states to keep (default all ``N + 1``; with a step controller every accepted step, or the
         given times in ``[t0, t1]``, which the steps then hit). Times are given in increasing order, as
         ``Solution.times`` returns them: unsorted times are refused, never reordered (a repeated time
         is saved once).
@@ -103,20 +109,32 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         module-level functions do). A lazy driver must offer ``select(paths)``.
     chunks : int, optional
         Number of groups for ``executor`` (default ``min(members, 4 × CPU count)``).
-    step_control : PIController, optional
-        Adaptive steps, for a :class:`~roughpaths.BrownianTree` driver and an order-1 solver (``Davie``,
-        ``LogODE``, a coadjoint ``LieHeun``): step doubling on the same tree, the steps shared by the
-        batch (:mod:`roughpaths.rde.adaptive`; ``docs/adaptive-steps.md``). ``Solution.stats`` then holds
-        ``accepted``, ``rejected`` and ``at_dt_min``. Fixed steps (``None``) need a grid: a
-        ``RoughPath``, a ``Driver``, or ``tree.rough_path(times)``.
+    step_control : StepController, optional
+        The step controller (:mod:`roughpaths.rde.step_control`). ``None``: the driver's grid (a ``RoughPath``,
+        a ``Driver``). A :class:`~roughpaths.BrownianTree` needs one: :class:`~roughpaths.PIController` for
+        adaptive steps (step doubling on the same tree, ``docs/adaptive-steps.md``; the solver must declare an
+        error estimate, ``Solver.error_estimate``: ``Davie``, ``LogODE``, a coadjoint ``LieHeun``),
+        :class:`~roughpaths.FixedSteps` ``(dt)``, or any object following the :class:`~roughpaths.StepController`
+        contract. ``Solution.stats`` then holds ``accepted``, ``rejected`` and ``at_dt_min``.
+    shared_steps : bool, optional
+        With a step controller: ``False`` gives every batch member steps of its own (its result is bitwise the
+        same alone or in any batch; the stats are arrays over the batch; with ``save_at="all"``,
+        ``Solution.times`` has the batch's axes, shorter rows repeating their last time and state); ``True``
+        makes the batch take the same steps (the error ratio is the maximum over its members). ``None``
+        (default): steps per member where the solver steps members on their own times in one call
+        (``Solver.member_times``: ``Davie``, ``LogODE``, ``Heun``, ``Euler``, on autonomous fields or fields
+        declared ``batched_time``), shared steps otherwise (e.g. the coadjoint solvers of :mod:`mechanics`,
+        whose compiled kernels take one time grid), where per-member steps cost one call per member per
+        attempt. ``Solution.stats["shared_steps"]`` says which ran.
     progress : None, bool or callable
         Report progress and the time left (:mod:`roughpaths.progress`): ``None``/``False`` silent (default),
         ``True`` a bar on standard error (``tqdm`` if importable, else a plain line), a callable is called
         with a :class:`~roughpaths.ProgressRecord` ``(done, total, elapsed, eta)``. On a grid, ``done`` counts
         steps of every member (``total = N × members``) and advances once per block of steps: per block of
         a :class:`~roughpaths.Driver` (``block_steps``), per finished group with ``executor`` (in group
-        order), once at the end for a ``RoughPath`` (a single block). With adaptive steps, ``done`` is the
-        time reached, ``t - t0`` of ``total = t1 - t0``, once per accepted step. Never changes the numbers.
+        order), once at the end for a ``RoughPath`` (a single block). With a step controller, ``done`` is the
+        time every member has reached, ``t - t0`` of ``total = t1 - t0``, reported when it grows (with shared
+        steps once per accepted step). Never changes the numbers.
 
     Returns
     -------
@@ -162,21 +180,14 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     _check_save_at(save_at)
     if block_steps is not None:
         block_steps = check_positive_int(block_steps, "block_steps")
-    if isinstance(driver, BrownianTree):
-        if step_control is None:
-            raise ValueError("a BrownianTree driver needs adaptive steps: pass step_control=PIController(rtol, "
-                             "atol), or solve on a grid with driver=tree.rough_path(times).")
-        if executor is not None:
-            raise ValueError("executor= splits a batch solved on a fixed grid; adaptive steps are shared by the "
-                             "batch, so solve the tree serially (or one tree per process).")
-    elif step_control is not None:
-        raise ValueError(f"step_control needs a driver that answers on any interval, a roughpaths.BrownianTree; "
-                         f"got a {type(driver).__name__}, whose grid is fixed. Build BrownianTree(dim, seed=...) "
-                         f"or drop step_control.")
+    control = _check_control(step_control, driver, solver)
     if executor is not None:
-        return _solve_split(fields, driver, y0, solver, executor, chunks, progress, drift=drift, save_at=save_at,
+        if control is not None:
+            raise ValueError("executor= splits a batch solved on a fixed grid; with a step controller solve serially "
+                             "(the members' steps are their own: a member's result is the same in any batch).")
+        return _solve_split(solve, fields, driver, y0, solver, executor, chunks, progress, drift=drift, save_at=save_at,
                             on_failure=on_failure, block_steps=block_steps)
-    if not isinstance(driver, (RoughPath, RoughPathN, Driver, BrownianTree)):
+    if not isinstance(driver, (RoughPath, RoughPathN, Driver)):
         raise TypeError(f"driver must be a RoughPath, a RoughPathN, a Driver (e.g. roughpaths.BrownianDriver) or a "
                         f"BrownianTree, got {type(driver).__name__}; build a path with "
                         f"RoughPath.from_path(values, times=...) or RoughPath(increments, areas, times=...).")
@@ -201,108 +212,107 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
             raise TypeError(f"drift= is for vector fields; {type(fields).__name__} takes its drift from "
                             f"its own definition.")
         fields = fields.with_drift(drift)
-    if step_control is not None:
-        return solve_adaptive(fields, driver, y, solver, step_control, save_at, on_failure, batch, progress)
-
-    times = np.asarray(driver.times)
-    n = driver.n_steps
-    if isinstance(save_at, str):
-        if save_at == "all":
-            idx = np.arange(n + 1)
-        elif save_at == "end":
-            idx = np.array([n])
-        else:
-            raise ValueError(f"save_at must be 'all', 'end' or an array of grid times, got {save_at!r}.")
-    else:
-        idx = np.unique(_index_of(driver, save_at).ravel())
-    save_mask = np.zeros(n + 1, dtype=bool)
-    save_mask[idx] = True
-    members = float(np.prod(batch, dtype=np.float64))
-    check_memory(8.0 * members * idx.size * e, f"the saved states ({members:.0f} member(s) x {idx.size} "
-                 f"time(s) x {e})", "save fewer times (save_at='end' or a coarser array of grid times) or "
-                 "solve the batch in parts")
-    work, blocks_what = _working_bytes(driver, block_steps, members, e, level, int(idx.size),
-                                       getattr(solver, "step_bytes", lambda f: None)(fields))
-    check_memory(work, f"the solver's working arrays ({members:.0f} member(s): {blocks_what}, the states saved "
-                       f"per block and one step's temporaries)",
-                 "pass a smaller block_steps, or solve the batch in parts (driver.select(...), or executor=...)")
-    out = np.empty(batch + (idx.size, e))
-    slot = 0
-    if save_mask[0]:
-        out[..., 0, :] = y
-        slot = 1
-
-    failed_step = np.full(batch, -1, dtype=np.int64)
-    blocks = driver.blocks(block_steps) if isinstance(driver, Driver) else (driver,)
-    k0 = 0
-    n_blocks = 0
-    report = progress_reporter(progress, n * members, desc="solve", unit="member-steps")
+    run = _Run(y, batch, on_failure, getattr(driver, "any_times", False))
+    steps = (_TreeSteps(run, driver, control, solver, save_at, shared_steps, fields) if run.flat else
+             _GridSteps(run, driver, save_at, block_steps, level,
+                        getattr(solver, "step_bytes", lambda f: None)(fields)))
+    total, desc, unit = steps.progress_total
+    report = run.report = progress_reporter(progress, total, desc=desc, unit=unit)
     t_start = _time.perf_counter()
-    try:
-        for block in blocks:
-            kb = block.n_steps
-            save = save_mask[k0 + 1:k0 + kb + 1]
-            y, saved, first_bad = solver.integrate(fields, y, block.times, block.increments,
-                                                   _higher_levels(block, level), save,
-                                                   stop_on_failure=(on_failure == "raise"))
-            new_bad = (first_bad >= 0) & (failed_step < 0)
-            if new_bad.any():
-                failed_step[new_bad] = first_bad[new_bad] + k0
-                if on_failure == "raise":
-                    msg, members, steps = _failure_message(failed_step, times, batch)
-                    raise NonFiniteStateError(msg, members, steps)
-                y[failed_step >= 0] = np.nan
-            nsave = saved.shape[-2]
-            out[..., slot:slot + nsave, :] = saved
-            slot += nsave
-            k0 += kb
-            n_blocks += 1
-            if report is not None:
-                report.update(k0 * members)
+    try:      # the one loop: propose, ask the driver (in propose), integrate, adapt, save or mark failures
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            while attempts := steps.propose():
+                for a in attempts:
+                    y_start = run.y[a.members]
+                    y_new, saved, first_bad = solver.integrate(fields, y_start, a.times, a.dX, a.dXX, a.save,
+                                                               stop_on_failure=a.stop)
+                    err = None
+                    if a.whole is not None:             # the declared estimate: step doubling
+                        y_one = solver.integrate(fields, y_start, a.times[..., [0, -1]], *a.whole, a.save[:1],
+                                                 stop_on_failure=False)[0]
+                        err = control.error_ratio(y_start, y_new, y_new - y_one, a.h, steps.span)
+                    steps.judge(a, y_new, saved, first_bad, err)
+                steps.adapt(attempts)
     finally:
         if report is not None:
             report.close()
-    if k0 != n:
-        raise RuntimeError(f"the driver's blocks covered {k0} of its {n} steps; its blocks() is broken.")
-    if on_failure == "mask" and (failed_step >= 0).any():
-        mark = (failed_step[..., None] >= 0) & (idx > failed_step[..., None])
-        out[mark] = np.nan
-    stats = {"solver": repr(solver), "n_steps": n, "n_blocks": n_blocks, "batch_shape": batch,
-             "wall_time": _time.perf_counter() - t_start}
-    return Solution(times=times[idx].copy(), states=out, failed_step=failed_step, stats=stats)
+    times, states, stats = steps.finish()
+    stats.update(solver=repr(solver), batch_shape=batch, wall_time=_time.perf_counter() - t_start)
+    return Solution(times=times, states=states, failed_step=run.failed.reshape(batch), stats=stats)
 
 
-def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_saved: int, step_bytes=None):
-    """Bytes a fixed-step :func:`solve` holds besides its saved states, and what holds them (for the message).
+def _check_control(control, driver, solver):
+    """The step controller of a solve (``None``: the driver's own grid), checked against driver and solver."""
+    any_times = getattr(driver, "any_times", False)
+    if control is None:
+        if any_times:
+            raise ValueError(f"a {type(driver).__name__} driver needs a step controller: pass "
+                             f"step_control=PIController(rtol, atol) (or FixedSteps(dt)), or solve on a grid with "
+                             f"driver=tree.rough_path(times).")
+        return None
+    if not all(hasattr(control, k) for k in ("adaptive", "init", "adapt", "dt_min", "dt_max", "max_steps")):
+        raise TypeError(f"step_control must follow the StepController contract (roughpaths.PIController, FixedSteps "
+                        f"or a StepController subclass), got {type(control).__name__}; e.g. "
+                        f"step_control=PIController(rtol=1e-3, atol=1e-6).")
+    if not any_times:
+        if isinstance(control, FixedSteps) and control.dt is None:
+            return None
+        raise ValueError(f"step_control needs a driver that answers on any interval, a roughpaths.BrownianTree; "
+                         f"got a {type(driver).__name__}, whose grid is fixed. Build BrownianTree(dim, seed=...) "
+                         f"or drop step_control.")
+    q = solver.error_order if solver.error_order is not None else solver.order
+    if control.adaptive and (solver.error_estimate != "step_doubling" or not q > 0):
+        raise ValueError(f"adaptive steps need the solver's declared error estimate (Solver.error_estimate, step "
+                         f"doubling for an order-1 scheme that uses the area), got {solver!r} (error_estimate="
+                         f"{solver.error_estimate!r}, order {solver.order}); use Davie(), LogODE() or a coadjoint "
+                         f"LieHeun(), or FixedSteps(dt) for this solver.")
+    return control
 
-    With ``M`` members, ``N`` steps, blocks of ``K`` steps, ``d`` noise and ``e`` state dimensions:
 
-    * a lazy driver's blocks: two of ``driver.block_nbytes(K)`` (the generator makes the next block while
-      the loop still holds the last; one if a block covers the grid); a ``RoughPath`` is read in place;
-    * the states a block saves before they are copied out, ``8 M min(K, saved) e``;
-    * the state, its copy and the failure indices, ``8 M (2 e + 1)``;
-    * one step's temporaries, per member: the slice of the area (d²) and of level 3 (d³) the step is given,
-      the fields' values and their product with the area (2 e d), their Jacobians (d e²), the linear
-      generators (2 e²) with a log-ODE step's matrix exponential (up to 14 e², scaling and squaring) and up to
-      eight state-sized sums (8 e), 8 bytes each; or what the solver states for itself
-      (``solver.step_bytes(fields)``, bytes per member, where it defines the method: the coadjoint solvers on a
-      matrix Lie algebra hold ``N × N`` matrices, not ``e × e`` generators).
-    """
-    N, d = driver.n_steps, driver.dim
-    if isinstance(driver, Driver):
-        K = block_steps if block_steps is not None else getattr(driver, "default_block_steps", lambda: N)()
-        K = min(K, N)
-        nb = 2 if K < N else 1
-        # a driver without block_nbytes (one of the caller's own) states nothing of its blocks
-        per_block = driver.block_nbytes(K) if hasattr(driver, "block_nbytes") else 0.0
-        blocks, what = nb * per_block, f"{nb} driver block(s) of {K} steps"
-    else:
-        K, blocks, what = N, 0.0, "the path read in place"
-    d3 = float(d) ** 3 if level >= 3 else 0.0
-    step = float(d) ** 2 + d3 + 2.0 * e * d + float(d) * e * e + 16.0 * e * e + 8.0 * e
-    if step_bytes is not None:
-        step = float(d) ** 2 + d3 + step_bytes / 8.0
-    return (blocks + 8.0 * members * (min(K, n_saved) * e + 2 * e + 1 + step) + 4096.0), what
+class _Run:
+    """What the loop keeps once for every proposer: the state, the failures, the saved states' memory check."""
+
+    def __init__(self, y, batch, on_failure, flat):
+        self.batch, self.e, self.on_failure, self.flat = batch, y.shape[-1], on_failure, flat
+        self.members = int(np.prod(batch, dtype=np.int64))
+        self.y = y.reshape(self.members, self.e) if flat else y
+        self.failed = np.full(self.members, -1, dtype=np.int64)
+        self.healthy = np.ones(self.members, dtype=bool)
+        self.report, self._checked = None, 1
+
+    def fail(self, members, steps, times=None, unmet=None):
+        """Members (flat indices) failed at ``steps``: raise (``on_failure="raise"``) or mark them."""
+        self.failed[members] = steps
+        if self.on_failure == "raise":
+            if unmet is not None:
+                raise ValueError(_unmet_message(members, self.batch, *unmet))
+            at = times if not callable(times) else (lambda m: times(int(np.ravel_multi_index(m, self.batch)) if m else 0))
+            msg, mem, st = _failure_message(self.failed.reshape(self.batch), at, self.batch)
+            raise NonFiniteStateError(msg, mem, st)
+        self.healthy[members] = False
+
+    def check_saves(self, n_times, growing=False):
+        """Refuse saved states past the memory budget (a growing count is checked at every doubling)."""
+        if growing and n_times < 2 * self._checked:
+            return
+        self._checked = n_times
+        check_memory((16.0 if growing else 8.0) * self.members * n_times * self.e,
+                     f"the saved states ({self.members} member(s) x {n_times} time(s){' so far' if growing else ''} "
+                     f"x {self.e})", "save fewer times (save_at='end' or a coarser array of times) or solve the batch "
+                     "in parts")
+
+    def progress(self, done):
+        if self.report is not None:
+            self.report.update(done)
+
+
+def _unmet_message(members, batch, r, t, h, control):
+    """The message of a step at ``dt_min`` whose error exceeds the tolerance (``on_failure="raise"``)."""
+    first = tuple(int(v) for v in np.unravel_index(int(members[0]), batch))
+    return (f"the error tolerance cannot be met: the step [{t:.6g}, {t + h:.6g}] at dt_min = {h:.3g} still has "
+            f"{r:.3g} times the error {control!r} allows, for {len(members)} batch member(s) (first {first}); "
+            f"loosen rtol/atol, lower dt_min (PIController(dt_min=...)), or pass on_failure='mask' to mark these "
+            f"members failed (Solution.failed) and finish the others.")
 
 
 def _check_save_at(save_at) -> None:
@@ -320,83 +330,3 @@ def _check_save_at(save_at) -> None:
         raise ValueError(f"save_at must be in increasing order (Solution.times and states follow it), but "
                          f"save_at[{k}]={float(t[k])!r} > save_at[{k + 1}]={float(t[k + 1])!r} in "
                          f"save_at={shown}; sort it (np.sort(save_at)) and read the states in that order.")
-
-
-def _higher_levels(block, increment_level):
-    """The ``dXX`` argument of contract item 8: None, the areas, or ``(areas, level-3 components)``."""
-    if increment_level < 2:
-        return None
-    if increment_level == 2:
-        return block.areas
-    return block.areas, block.step_level(3)
-
-
-def _index_of(driver, save_at):
-    if isinstance(driver, (RoughPath, RoughPathN)):
-        return driver.index_of(save_at, "save_at")
-    return RoughPath(np.zeros((driver.n_steps, driver.dim)), times=driver.times, check=False).index_of(
-        save_at, "save_at")
-
-
-def _chunk_of(driver, batch, lo, hi):
-    """Members ``lo:hi`` of the flattened batch of ``driver`` (broadcast to ``batch``)."""
-    if isinstance(driver, RoughPath):
-        n, d = driver.n_steps, driver.dim
-        inc = np.broadcast_to(driver.increments, batch + (n, d)).reshape((-1, n, d))[lo:hi]
-        areas = None
-        if driver.areas is not None:
-            areas = np.broadcast_to(driver.areas, batch + (n, d, d)).reshape((-1, n, d, d))[lo:hi]
-        x0 = np.broadcast_to(driver.x0, batch + (d,)).reshape((-1, d))[lo:hi]
-        return RoughPath(inc, areas, times=driver.times, x0=x0, kind=driver.kind, check=False)
-    if driver.batch_shape != batch:
-        raise ValueError(f"with executor=, a lazy driver's batch shape {driver.batch_shape} must be the "
-                         f"batch shape of the solve {batch}; give y0 without extra batch axes.")
-    if not hasattr(driver, "select"):
-        raise TypeError(f"executor= needs to split the driver's batch, but {type(driver).__name__} has no "
-                        f"select(paths) method; materialise it with driver.rough_path() or solve serially.")
-    return driver.select(np.arange(lo, hi))
-
-
-def _solve_split(fields, driver, y0, solver, executor, chunks, progress, **kw):
-    import os
-
-    from ..validation import check_positive_int
-
-    if not hasattr(executor, "submit"):
-        raise TypeError(f"executor must be a concurrent.futures.Executor (e.g. ProcessPoolExecutor(), or a "
-                        f"Dask client's get_executor()), got {type(executor).__name__}.")
-    if not isinstance(driver, (RoughPath, Driver)):
-        raise TypeError(f"driver must be a RoughPath or a Driver, got {type(driver).__name__}.")
-    y = as_float_array(y0, "y0", min_ndim=1)
-    batch = check_same_batch(y.shape[:-1], driver.batch_shape, "y0", "driver")
-    members = int(np.prod(batch, dtype=np.int64))
-    if kw["drift"] is not None:
-        fields = fields.with_drift(kw["drift"])
-    kw["drift"] = None
-    if members == 0:
-        return solve(fields, driver, y0, solver, progress=progress, **kw)
-    n_chunks = min(members, 4 * (os.cpu_count() or 1)) if chunks is None else check_positive_int(chunks, "chunks")
-    bounds = np.linspace(0, members, min(n_chunks, members) + 1).round().astype(int)
-    yflat = np.broadcast_to(y, batch + y.shape[-1:]).reshape((-1, y.shape[-1]))
-    mode, kw["on_failure"] = kw["on_failure"], "mask"
-    report = progress_reporter(progress, driver.n_steps * members, desc="solve", unit="member-steps")
-    futures = [executor.submit(solve, fields, _chunk_of(driver, batch, lo, hi), yflat[lo:hi], solver, **kw)
-               for lo, hi in zip(bounds[:-1], bounds[1:])]
-    parts = []
-    try:
-        for hi, f in zip(bounds[1:], futures):       # in group order: each finished group reports its members
-            parts.append(f.result())
-            if report is not None:
-                report.update(driver.n_steps * int(hi))
-    finally:
-        if report is not None:
-            report.close()
-    states = np.concatenate([s.states for s in parts], axis=0).reshape(batch + parts[0].states.shape[-2:])
-    failed = np.concatenate([s.failed_step for s in parts]).reshape(batch)
-    if mode == "raise" and (failed >= 0).any():
-        msg, mem, steps = _failure_message(failed, np.asarray(driver.times), batch)
-        raise NonFiniteStateError(msg, mem, steps)
-    stats = {"solver": repr(solver), "n_steps": driver.n_steps, "n_blocks": sum(s.stats["n_blocks"] for s in parts),
-             "batch_shape": batch, "chunks": len(parts),
-             "wall_time": max(s.stats["wall_time"] for s in parts)}
-    return Solution(times=parts[0].times, states=states, failed_step=failed, stats=stats)

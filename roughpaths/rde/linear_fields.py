@@ -108,7 +108,7 @@ class LinearVectorFields(VectorFields):
         Mx, G2 = self._linear_parts(dX, L)
         G = Mx + G2
         if self._drift is not None:
-            G = G + dt * self.drift_matrix
+            G = G + np.asarray(dt)[..., None] * self.drift_matrix        # dt a scalar, or (..., 1) per member
         return G
 
     def friz_oberhauser_drift(self, s):

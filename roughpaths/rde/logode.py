@@ -44,6 +44,7 @@ class LogODE(Solver):
     """
 
     increment_level = 2
+    member_times = True
     order = 1.0
     smooth_order = 2.0
 

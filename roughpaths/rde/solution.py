@@ -1,7 +1,6 @@
 r"""The result of :func:`~roughpaths.solve`: :class:`Solution`, and :class:`NonFiniteStateError`.
 
-Shared by the fixed-step loop (:mod:`roughpaths.rde.integrate`) and the adaptive one
-(:mod:`roughpaths.rde.adaptive`).
+Made by the one time loop of :mod:`roughpaths.rde.integrate`, on a grid or with a step controller.
 """
 
 from __future__ import annotations
@@ -40,7 +39,9 @@ class Solution:
     Attributes
     ----------
     times : ndarray, shape ``(K,)``
-        The saved times (all grid times by default; with adaptive steps, every accepted step's end).
+        The saved times (all grid times by default; with a step controller, every accepted step's end). With
+        steps per member and ``save_at="all"``, shape ``(..., K)``: each member's own step ends, a shorter row
+        repeating its last time (``t1``) and state.
     states : ndarray, shape ``(..., K, e)``
         The solution at ``times``; leading axes are the broadcast batch of driver and ``y0``.
     failed_step : ndarray of int, shape ``(...)``
@@ -48,9 +49,10 @@ class Solution:
         a healthy member (all ``-1`` unless ``on_failure="mask"`` kept a batch with failures). The
         states of a failed member are NaN from that step on.
     stats : dict
-        ``solver``, ``n_steps``, ``n_blocks``, ``batch_shape``, ``wall_time`` (seconds); with adaptive steps
-        (``step_control``) ``step_control``, ``accepted`` (``= n_steps``), ``rejected`` and ``at_dt_min``
-        instead of ``n_blocks``.
+        ``solver``, ``n_steps``, ``n_blocks``, ``batch_shape``, ``wall_time`` (seconds); with a step controller
+        (``step_control``) ``step_control``, ``shared_steps``, ``accepted`` (``= n_steps``), ``rejected`` and
+        ``at_dt_min`` (members failed at ``dt_min``) instead of ``n_blocks``: integers with shared steps, arrays
+        over the batch with steps per member.
     """
 
     times: np.ndarray
@@ -85,10 +87,12 @@ class Solution:
 
 
 def _failure_message(failed_step, times, batch) -> tuple:
+    """``(message, members, steps)``; ``times`` the step ends ``(K,)``, or a callable of a member giving its own."""
     members = [tuple(int(i) for i in idx) for idx in np.argwhere(failed_step >= 0)]
     steps = [int(failed_step[m]) for m in members]
     first = int(np.argmin(steps))
     k, m = steps[first], members[first]
+    times = times(m) if callable(times) else times
     msg = (f"the solution became non-finite at step {k} (t = {float(times[k + 1]):.6g}, step from "
            f"t = {float(times[k]):.6g}) for batch member {m}")
     if len(members) > 1:

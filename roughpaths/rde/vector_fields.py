@@ -114,6 +114,12 @@ class VectorFields:
         If True, every callable takes ``(t, y)`` (``t`` a float) instead of ``y``; the solvers pass
         the time (see each solver for where in the step the fields are evaluated). Default False:
         autonomous fields.
+    batched_time : bool
+        With ``time_dependent=True``: the callables also accept ``t`` as an array of shape ``(..., 1)`` (the
+        batch axes of ``y`` and one axis), each point at its own time, and broadcast it themselves (e.g.
+        ``sigma(t)[..., None] * ...`` for an ``(..., e, d)`` output); checked at construction against
+        one-point evaluations. Then adaptive steps per member (:func:`~roughpaths.solve`) step every member
+        on its own times in one call instead of one call per member. Default False.
 
     Notes
     -----
@@ -145,15 +151,20 @@ class VectorFields:
 
     is_linear = False
     time_dependent = False
+    batched_time = False
 
     def __init__(self, fields, jacobians=None, *, drift=None, drift_jacobian=None,
-                 dim_state=None, dim_noise=None, time_dependent=False):
+                 dim_state=None, dim_noise=None, time_dependent=False, batched_time=False):
         from ..validation import check_positive_int
         if dim_state is None or dim_noise is None:
             raise TypeError("dim_state (e) and dim_noise (d) are required for callable vector fields, "
                             "e.g. VectorFields(f, dim_state=3, dim_noise=2).")
         if not isinstance(time_dependent, (bool, np.bool_)):
             raise TypeError(f"time_dependent must be True or False, got {time_dependent!r}.")
+        if batched_time not in (True, False) or (batched_time and not time_dependent):
+            raise ValueError(f"batched_time must be True or False and needs time_dependent=True, got "
+                             f"batched_time={batched_time!r}, time_dependent={time_dependent!r}.")
+        self.batched_time = bool(batched_time)
         self.dim_state = check_positive_int(dim_state, "dim_state")
         self.dim_noise = check_positive_int(dim_noise, "dim_noise")
         from ..validation import check_memory
@@ -226,8 +237,16 @@ class VectorFields:
             # differences (e.g. a Friz–Oberhauser drift of fields without Jacobians) amplifies the
             # last-bit differences of a batched BLAS product in the user's callable to ~1e-10
             scale = max(1.0, float(np.nanmax(np.abs(fb), initial=0.0)))
+            tb = np.array([[[0.1], [0.4], [0.7]], [[0.2], [0.5], [0.9]]]) if self.batched_time else None
+            if tb is not None:
+                try:
+                    fb = np.broadcast_to(np.asarray(fn(tb, yb)), fb.shape)
+                except Exception as exc:
+                    raise ValueError(f"{name} was declared batched_time=True but failed on t of shape (2, 3, 1): "
+                                     f"{type(exc).__name__}: {exc}; broadcast t against the output (e.g. "
+                                     f"sigma(t)[..., None] * ...) or drop batched_time.") from None
             for k in ((0, 0), (1, 2)):
-                one = np.asarray(fn(0.25, yb[k]))
+                one = np.asarray(fn(0.25 if tb is None else float(tb[k][0]), yb[k]))
                 if not np.allclose(fb[k], one, rtol=1e-8, atol=1e-8 * scale, equal_nan=True):
                     raise ValueError(f"{name} is not batched correctly: for a batch y of shape (2, 3, {e}) "
                                      f"its row {k} differs from {name} evaluated at that point alone; the "
@@ -335,7 +354,7 @@ class VectorFields:
             return self
         new = object.__new__(VectorFields)
         new.dim_state, new.dim_noise = self.dim_state, self.dim_noise
-        new.time_dependent = self.time_dependent
+        new.time_dependent, new.batched_time = self.time_dependent, self.batched_time
         new._fields, new._jac = self._fields, self._jac
         new._raw = (self._raw[0], self._raw[1], extra) if hasattr(self, "_raw") else (None, None, extra)
         return self._add_drift_to(new, f, fj)

@@ -87,14 +87,20 @@ def test_adaptive_solve_reports_the_time_reached_per_accepted_step():
     V = rp.LinearVectorFields(M)
     tree = rp.BrownianTree(2, seed=9, batch_shape=(4,), t0=0.5, t1=2.0)
     ctrl = rp.PIController(1e-2, 1e-2)
-    ref = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl)
+    ref = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, shared_steps=True)
     seen = []
-    got = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, progress=seen.append)
+    got = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, progress=seen.append, shared_steps=True)
     assert np.array_equal(got.states, ref.states) and np.array_equal(got.times, ref.times)
     assert got.stats["accepted"] == ref.stats["accepted"] == len(seen)
     _check_records(seen, 1.5)
     # save_at="all" keeps every accepted step: the reports are the saved times, less t0
     assert [r.done for r in seen] == pytest.approx(list(got.times[1:] - 0.5), rel=0, abs=1e-15)
+    # steps per member: the time every member has reached, reported when it grows
+    seen = []
+    own = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, progress=seen.append)
+    _check_records(seen, 1.5)
+    assert 0 < len(seen) <= own.stats["accepted"].max()
+    assert np.array_equal(own.states, rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl).states)
 
 
 def test_bad_progress_is_refused_by_name():

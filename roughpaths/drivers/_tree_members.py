@@ -1,0 +1,117 @@
+r"""Queries of a :class:`~roughpaths.BrownianTree` where every path has times of its own, in one compiled walk.
+
+Adaptive steps per batch member ask each path about a different interval. :func:`member_cells` answers them
+all in one compiled call: for each path, the tree's own depth-first walk from the root, splitting the nodes
+that hold one of its query points strictly inside (each with the stream of its ``(path, depth, index)``, so
+the nodes are bitwise the tree's) and Chen-multiplying the others, left to right, into the cell they lie
+in. A path's answer depends on its own times only, bitwise, whatever the other paths of the query; it
+equals the tree's answer on shared times (``BrownianTree._cells``) to round-off, since the cells there are
+assembled by another order of the same sums.
+
+The children of the last node split at each depth of each path are kept (if 64 MiB hold one such pair per
+depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk splits
+only the few nodes near its new times. Compiling :func:`_walk_nb` (first call, empty cache) costs about
+8 s of CPU (measured at load 6, after the tree's own kernels); from numba's cache, 0.03 s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ._random import _pcg64_normals, _pcg64_seed, _seed_states
+from ._tree_kernels import _reduce_nb, _refine_segments_nb, split_width
+
+__all__ = ["member_cells"]
+
+_WALK_CACHE_BYTES = 64 * 2 ** 20
+
+
+@njit(cache=True, nogil=True)
+def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
+    """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`); the children
+    of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none;
+    a 1-row cache with ``cidx.shape[0] == 0`` disables it)."""
+    Q, n = idx.shape[0], idx.shape[1] - 1
+    nseg, d = root_w.shape[1], root_w.shape[2]
+    m = prefix.size
+    cap = L + 4
+    sd, si = np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64)
+    sw, sG = np.empty((cap, nseg, d)), np.empty((cap, d, d))
+    ent = np.empty((1, m + 5), dtype=np.uint32)
+    seeds, states = np.empty((1, 4), dtype=np.uint64), np.empty((1, 4), dtype=np.uint64)
+    z, fine = np.empty((1, width)), np.empty((1, 2 * nseg, d))
+    GL, GR, Wn, An = np.empty((1, d, d)), np.empty((1, d, d)), np.empty((1, d)), np.empty((1, d, d))
+    for q in range(m):
+        ent[0, q] = prefix[q]
+    ent[0, m] = tag
+    for q in range(Q):
+        W[q] = 0.0
+        A[q] = 0.0
+        first, last = idx[q, 0], idx[q, n]
+        sd[0], si[0] = 0, 0
+        sw[0], sG[0] = root_w[rows[q]], root_G[rows[q]]
+        top = 1
+        while top > 0:
+            top -= 1
+            depth, index = sd[top], si[top]
+            size = np.int64(1) << (L - depth)
+            lo = index * size
+            if lo + size <= first or lo >= last:
+                continue
+            k = 0
+            while k <= n and idx[q, k] <= lo:
+                k += 1
+            if k > n or idx[q, k] >= lo + size:            # within cell k - 1: Chen-multiply it in
+                c = k - 1
+                _reduce_nb(sw[top:top + 1], sG[top:top + 1], Wn, An)
+                for a in range(d):
+                    for b in range(d):
+                        A[q, c, a, b] += An[0, a, b] + 0.5 * (W[q, c, a] * Wn[0, b] - W[q, c, b] * Wn[0, a])
+                for a in range(d):
+                    W[q, c, a] += Wn[0, a]
+                continue
+            r = rows[q]
+            if cidx.shape[0] == 0 or cidx[r, depth] != index:
+                ent[0, m + 1] = keys[q]
+                ent[0, m + 2] = depth
+                ent[0, m + 3] = index >> 32
+                ent[0, m + 4] = index & 0xFFFFFFFF
+                _seed_states(ent, seeds)
+                _pcg64_seed(seeds, states)
+                _pcg64_normals(states, z)
+                _refine_segments_nb(sw[top:top + 1], sG[top:top + 1], span / float(np.int64(1) << depth) / nseg,
+                                    z, fine, GL, GR)
+                if cidx.shape[0] == 0:
+                    sd[top], si[top], sw[top], sG[top] = depth + 1, 2 * index + 1, fine[0, nseg:], GR[0]
+                    sd[top + 1], si[top + 1], sw[top + 1], sG[top + 1] = depth + 1, 2 * index, fine[0, :nseg], GL[0]
+                    top += 2
+                    continue
+                cidx[r, depth] = index
+                cw[r, depth, 0], cw[r, depth, 1], cG[r, depth, 0], cG[r, depth, 1] = \
+                    fine[0, :nseg], fine[0, nseg:], GL[0], GR[0]
+            sd[top], si[top], sw[top], sG[top] = depth + 1, 2 * index + 1, cw[r, depth, 1], cG[r, depth, 1]
+            sd[top + 1], si[top + 1], sw[top + 1], sG[top + 1] = depth + 1, 2 * index, cw[r, depth, 0], cG[r, depth, 0]
+            top += 2
+
+
+def member_cells(tree, rows, idx, tag):
+    """``(W (Q, n, d), A (Q, n, d, d))``: row ``q`` of ``tree`` (flat index ``rows[q]``) on the grid cells
+    ``[idx[q, k], idx[q, k + 1])`` (``idx (Q, n + 1)`` strictly increasing grid indices per row; ``tag`` the
+    tree's split stream tag). Needs the tree's seeded fast path (``tree._prefix``)."""
+    if tree._root_node is None:
+        tree._root_node = tree._root()
+    w, G = tree._root_node
+    Q, n, d = idx.shape[0], idx.shape[1] - 1, tree.dim
+    W, A = np.empty((Q, n, d)), np.empty((Q, n, d, d))
+    rows = np.ascontiguousarray(rows, dtype=np.int64)
+    cache = tree.__dict__.get("_walk_cache")
+    if cache is None:                     # the children of one node per depth and row, if 64 MiB hold them
+        P, D, nseg = tree.n_paths, tree.resolution + 1, w.shape[1]
+        R = P if P * D * (2 * nseg * d + 2 * d * d + 1) * 8.0 <= _WALK_CACHE_BYTES else 0
+        cache = tree._walk_cache = (np.full((R, D), -1, dtype=np.int64), np.empty((R, D, 2, nseg, d)),
+                                    np.empty((R, D, 2, d, d)))
+    _walk_nb(tree._prefix, np.ascontiguousarray(w), np.ascontiguousarray(G), rows, tree._paths[rows],
+             np.ascontiguousarray(idx, dtype=np.int64), tree.resolution, float(tree.t1 - tree.t0), tag,
+             split_width(w.shape[1], d), W, A, *cache)
+    return W, A

@@ -1,0 +1,222 @@
+r"""Step control for :func:`~roughpaths.solve`: the :class:`StepController` contract, :class:`FixedSteps` and :class:`PIController`.
+
+:func:`~roughpaths.solve` runs one time loop: the controller proposes the next step of each *lane* (a
+batch member with steps of its own, or the whole batch when the steps are shared), the driver answers the
+increments and areas of the attempted steps, the solver integrates them, and the controller accepts or
+rejects each lane's attempt and sizes its next step. The controller never sees the solver or the driver:
+only times, step sizes and error ratios, all arrays over lanes (elementwise, so a lane's steps depend on
+its own data only). A controller is any object that follows the numbered contract of :class:`StepController`:
+
+1. ``adaptive`` (bool): whether an attempt needs an error estimate. ``False``: every proposed step is
+   accepted, the solver takes one step per attempt and no error is estimated (a schedule of steps).
+   ``True``: the solver's declared estimate (``Solver.error_estimate``, step doubling by default) is
+   computed and its error ratio passed to ``adapt``.
+2. ``init(t0, t1, lanes, error_order)``: a fresh state (a ``dict``, never stored on the controller, so one
+   controller serves any number of solves) holding at least ``"h"``, the first step of every lane
+   (``(lanes,)`` floats). ``error_order`` is the solver's declared strong order: the error ratio of
+   :meth:`error_ratio` scales as ``h ** error_order``.
+3. ``error_ratio(y, y_new, y_err, h, span)`` (adaptive controllers): the error of each member in units of
+   the tolerance, ``<= 1`` meaning acceptable; ``y``, ``y_new``, ``y_err`` have shape ``(..., e)``,
+   ``h`` broadcasts against the batch, ``span = t1 - t0``. The loop reduces it over a lane's members (one
+   member per lane with per-member steps; the maximum over the batch with shared steps).
+4. ``adapt(state, t, h, r)``: given the attempted steps ``[t, t + h]`` and their error ratios ``r``
+   (``(lanes,)``, ``inf`` for an attempt that became non-finite; ``None`` for a non-adaptive controller),
+   return the boolean ``accept`` per lane and store the next step of every lane in ``state["h"]`` (after an
+   acceptance the step from ``t + h``, after a rejection the retry from ``t``).
+5. ``dt_min(span)``, ``dt_max(span)``, ``max_steps``: the smallest and largest steps and the most attempts
+   per lane. A step at ``dt_min`` whose error ratio exceeds 1 is a failure of its members (by
+   ``on_failure``), never accepted, so an unreachable tolerance fails fast.
+
+The loop owns everything else: snapping step ends to the driver's grid, never stepping over save times,
+the failure policy, the saved states and the statistics.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..validation import check_positive_int, check_positive_real
+
+__all__ = ["StepController", "FixedSteps", "PIController"]
+
+
+class StepController:
+    """Base class of step controllers: the numbered contract of the module docstring (defaults: no adaptivity)."""
+
+    adaptive: bool = False
+    max_steps: int = 100_000
+
+    def init(self, t0, t1, lanes, error_order):  # pragma: no cover - abstract
+        """A fresh state ``{"h": (lanes,) first steps, ...}`` (contract item 2)."""
+        raise NotImplementedError(f"{type(self).__name__} does not define init()")
+
+    def error_ratio(self, y, y_new, y_err, h, span):  # pragma: no cover - abstract
+        """Error per member in units of the tolerance (contract item 3)."""
+        raise NotImplementedError(f"{type(self).__name__} is not adaptive: it defines no error_ratio()")
+
+    def adapt(self, state, t, h, r):  # pragma: no cover - abstract
+        """``accept (lanes,)``; the next steps in ``state["h"]`` (contract item 4)."""
+        raise NotImplementedError(f"{type(self).__name__} does not define adapt()")
+
+    def dt_min(self, span) -> float:
+        """The smallest step (contract item 5; default ``span · 2^-30``)."""
+        return span * 2.0 ** -30
+
+    def dt_max(self, span) -> float:
+        """The largest step (contract item 5; default ``span``)."""
+        return span
+
+
+class FixedSteps(StepController):
+    """Fixed steps: the default controller of :func:`~roughpaths.solve`.
+
+    On a grid driver (a ``RoughPath`` or a lazy ``Driver``) the steps are the grid's. On a driver that answers
+    on any times (a :class:`~roughpaths.BrownianTree`) they are ``dt`` long (the last one shortened to end at
+    ``t1`` or a save time).
+
+    Parameters
+    ----------
+    dt : float, optional
+        The step on a driver without a grid; ``None`` (default) for a grid driver's own steps.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import roughpaths as rp
+    >>> M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+    >>> tree = rp.BrownianTree(2, seed=0, batch_shape=(4,))
+    >>> sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=rp.FixedSteps(0.125))
+    >>> sol.times.shape, bool((sol.times == np.arange(9) / 8).all())      # every path: its own row of times
+    ((4, 9), True)
+    """
+
+    def __init__(self, dt=None):
+        self.dt = None if dt is None else check_positive_real(dt, "dt")
+
+    def __repr__(self) -> str:
+        return f"FixedSteps(dt={self.dt!r})"
+
+    def init(self, t0, t1, lanes, error_order):
+        if self.dt is None:
+            raise ValueError("FixedSteps() takes the driver's grid, but this driver has none (a BrownianTree): pass "
+                             "FixedSteps(dt=...), an adaptive PIController(rtol, atol), or driver=tree.rough_path(times).")
+        return {"h": np.full(lanes, float(self.dt))}
+
+    def adapt(self, state, t, h, r):
+        return np.ones(np.shape(h), dtype=bool)
+
+
+class PIController(StepController):
+    r"""Adaptive step sizes: a proportional–integral controller of the predicted global error.
+
+    Parameters
+    ----------
+    rtol, atol : float
+        Relative and absolute tolerances (``rtol >= 0``, ``atol >= 0``, not both 0). They bound the
+        *predicted global* error (below): the strong error of an order-1 scheme is about proportional to them.
+    dt0 : float, optional
+        First step tried (default ``(t1 - t0) / 64``).
+    dt_min : float, optional
+        Smallest step (default ``(t1 - t0) · 2^-30``). A step at ``dt_min`` whose error still exceeds the
+        tolerance is a failure of the members concerned, counted in ``Solution.stats["at_dt_min"]``: by
+        ``solve(..., on_failure=...)`` it raises a ``ValueError`` at once naming the fix (``"raise"``), or marks
+        those members failed and finishes the others (``"mask"``). An unreachable tolerance thus fails after
+        about ``log(dt0 / dt_min) / log(1 / factor_min)`` attempts.
+    dt_max : float, optional
+        Largest step (default ``t1 - t0``).
+    safety : float
+        Factor applied to the predicted step (default 0.8).
+    factor_min, factor_max : float
+        Bounds on the ratio of consecutive steps (defaults 0.2 and 5).
+    icoeff, pcoeff : float
+        Integral and proportional exponents :math:`\beta_I`, :math:`\beta_P` (defaults 0.7 and 0.3). The
+        error ratio is proportional to ``h ** error_order`` (the solver's strong order), so
+        :math:`\beta_I + \beta_P = 1` is the dead-beat sum; ``icoeff=1, pcoeff=0`` is the plain integral
+        controller (``docs/adaptive-steps.md`` compares them).
+    max_steps : int
+        Most attempts of a lane (accepted plus rejected) before ``solve`` gives up with a ``ValueError``
+        (default 10⁵): a bound on the work of tolerances that can be met (one that cannot fails at ``dt_min``).
+
+    Notes
+    -----
+    The error ratio of a member (:meth:`error_ratio`) is the RMS over its ``e`` components, as in diffrax and
+    scipy, times :math:`\sqrt{T/h}` (random local errors add in mean square, so this is the predicted global
+    error; ``docs/adaptive-steps.md``):
+
+    .. math:: r = \sqrt{\tfrac{T}{h}}\,\Bigl(\tfrac1e\sum_a\Bigl(\frac{\mathrm{err}^a}
+              {\mathrm{atol} + \mathrm{rtol}\max(|y^a|, |y_{\mathrm{new}}^a|)}\Bigr)^2\Bigr)^{1/2}.
+
+    The next step is :math:`h\,\min(f_{\max}, \max(f_{\min}, s\,r_n^{-(\beta_I + \beta_P)/q}\,
+    r_{n-1}^{\beta_P/q}))` with ``q = error_order`` and :math:`f_{\max} = 1` right after a rejection.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import roughpaths as rp
+    >>> M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+    >>> tree = rp.BrownianTree(2, seed=0, batch_shape=(4,))
+    >>> sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(),
+    ...                step_control=rp.PIController(rtol=1e-2, atol=1e-2), save_at="end")
+    >>> sol.final.shape, bool((sol.stats["accepted"] > 0).all()), float(sol.times[-1])
+    ((4, 2), True, 1.0)
+    """
+
+    adaptive = True
+
+    def __init__(self, rtol, atol, dt0=None, *, dt_min=None, dt_max=None, safety=0.8, factor_min=0.2,
+                 factor_max=5.0, icoeff=0.7, pcoeff=0.3, max_steps=100_000):
+        self.rtol = check_positive_real(rtol, "rtol", allow_zero=True)
+        self.atol = check_positive_real(atol, "atol", allow_zero=True)
+        if self.rtol == 0.0 and self.atol == 0.0:
+            raise ValueError("rtol and atol are both 0: no error can be met; give a positive tolerance, e.g. "
+                             "PIController(rtol=1e-3, atol=1e-6).")
+        self.dt0 = None if dt0 is None else check_positive_real(dt0, "dt0")
+        self._dt_min = None if dt_min is None else check_positive_real(dt_min, "dt_min")
+        self._dt_max = None if dt_max is None else check_positive_real(dt_max, "dt_max")
+        if self._dt_min is not None and self._dt_max is not None and self._dt_min > self._dt_max:
+            raise ValueError(f"dt_min={dt_min!r} exceeds dt_max={dt_max!r}; swap them.")
+        self.safety = check_positive_real(safety, "safety")
+        if self.safety > 1.0:
+            raise ValueError(f"safety must lie in (0, 1], got {safety!r}; the default is 0.8.")
+        self.factor_min = check_positive_real(factor_min, "factor_min")
+        self.factor_max = check_positive_real(factor_max, "factor_max")
+        if not self.factor_min < 1.0 < self.factor_max:
+            raise ValueError(f"need factor_min < 1 < factor_max, got factor_min={factor_min!r}, "
+                             f"factor_max={factor_max!r}; the defaults are 0.2 and 5.")
+        self.icoeff = check_positive_real(icoeff, "icoeff")
+        self.pcoeff = check_positive_real(pcoeff, "pcoeff", allow_zero=True)
+        self.max_steps = check_positive_int(max_steps, "max_steps")
+
+    def __repr__(self) -> str:
+        return (f"PIController(rtol={self.rtol!r}, atol={self.atol!r}, dt0={self.dt0!r}, icoeff={self.icoeff!r}, "
+                f"pcoeff={self.pcoeff!r})")
+
+    def dt_min(self, span) -> float:
+        return self._dt_min if self._dt_min is not None else span * 2.0 ** -30
+
+    def dt_max(self, span) -> float:
+        return min(self._dt_max, span) if self._dt_max is not None else span
+
+    def init(self, t0, t1, lanes, error_order):
+        span = t1 - t0
+        h = min(self.dt0 if self.dt0 is not None else span / 64, self.dt_max(span))
+        return {"h": np.full(lanes, h), "r_prev": np.ones(lanes), "rejected": np.zeros(lanes, dtype=bool),
+                "q": float(error_order), "span": span}
+
+    def error_ratio(self, y, y_new, y_err, h, span):
+        scale = self.atol + self.rtol * np.maximum(np.abs(y), np.abs(y_new))
+        return np.sqrt(np.mean((y_err / scale) ** 2, axis=-1)) * np.sqrt(span / h)
+
+    def adapt(self, state, t, h, r):
+        accept = r <= 1.0
+        q = state["q"]
+        rr = np.maximum(np.where(np.isnan(r), np.inf, r), 1e-10)
+        f = self.safety * rr ** (-(self.icoeff + self.pcoeff) / q) * state["r_prev"] ** (self.pcoeff / q)
+        hi = np.where(accept & ~state["rejected"], self.factor_max, 1.0)
+        f = np.minimum(hi, np.maximum(self.factor_min, np.where(np.isfinite(rr), f, self.factor_min)))
+        state["r_prev"] = np.where(accept, rr, state["r_prev"])
+        state["rejected"] = ~accept
+        span = state["span"]
+        state["h"] = np.minimum(self.dt_max(span), np.maximum(self.dt_min(span), h * f))
+        return accept
+

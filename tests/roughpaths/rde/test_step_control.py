@@ -1,0 +1,102 @@
+"""The step-controller contract of ``solve``: a controller written here plugs in; fixed steps are one controller.
+
+Claims: (1) a user-written controller that follows the numbered contract of ``StepController`` (here a step
+schedule refined near t = 1/2, without error estimate) drives ``solve`` on a ``BrownianTree``, and its answer is
+the fixed-step solve on the grid of its own accepted steps (an independent route: ``tree.rough_path``);
+(2) ``FixedSteps(dt)`` on a tree is the fixed-step solve on the uniform grid; (3) adaptive steps are a declared
+capability of the solver (``Solver.error_estimate``), not a type check; (4) objects outside the contract are
+refused by name.
+"""
+
+import numpy as np
+import pytest
+
+import roughpaths as rp
+
+M = 0.3 * np.random.default_rng(3).standard_normal((2, 3, 3))
+Y0 = np.ones(3)
+
+
+class Schedule(rp.StepController):
+    """Steps of length ``h(t) = 1/64 + |t - 1/2| / 8``: short near t = 1/2, no error estimate."""
+
+    def init(self, t0, t1, lanes, error_order):
+        return {"h": np.full(lanes, self.h(t0))}
+
+    @staticmethod
+    def h(t):
+        return 1 / 64 + np.abs(t - 0.5) / 8
+
+    def adapt(self, state, t, h, r):
+        assert r is None                                  # no error estimate is computed for it
+        state["h"] = self.h(t + h)
+        return np.ones(np.shape(h), dtype=bool)
+
+
+def test_a_user_step_schedule_plugs_in_and_is_the_fixed_step_solve_on_its_steps():
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=7, batch_shape=(4,))
+    sol = rp.solve(V, tree, Y0, rp.Davie(), step_control=Schedule(), shared_steps=True)
+    t = sol.times
+    assert t[0] == 0.0 and t[-1] == 1.0 and sol.stats["rejected"] == 0
+    h, mid = np.diff(t), 0.5 * (t[:-1] + t[1:])
+    assert np.all(h <= Schedule.h(t[:-1]) * (1 + 1 / 16) + 1e-12)       # ends snapped by at most 1/16
+    assert h[np.abs(mid - 0.5) < 0.05].max() < 0.5 * h[np.abs(mid - 0.5) > 0.4].min()
+    fixed = rp.solve(V, rp.BrownianTree(2, seed=7, batch_shape=(4,)).rough_path(t), Y0, rp.Davie())
+    np.testing.assert_allclose(sol.states, fixed.states, rtol=0, atol=1e-13)
+    # per member (the default), every member takes the schedule's steps: the same times for all
+    own = rp.solve(V, tree, Y0, rp.Davie(), step_control=Schedule())
+    assert own.times.shape == (4, t.size) and np.array_equal(own.times, np.broadcast_to(t, (4, t.size)))
+    np.testing.assert_allclose(own.states, sol.states, rtol=0, atol=1e-13)
+
+
+def test_fixed_steps_on_a_tree_is_the_uniform_grid_solve():
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=2, batch_shape=(3,))
+    sol = rp.solve(V, tree, Y0, rp.LogODE(), step_control=rp.FixedSteps(1 / 16), save_at="end")
+    ref = rp.solve(V, tree.rough_path(np.linspace(0.0, 1.0, 17)), Y0, rp.LogODE(), save_at="end")
+    np.testing.assert_allclose(sol.final, ref.final, rtol=0, atol=1e-13)
+    assert sol.stats["accepted"].tolist() == [16, 16, 16]
+    # on a grid driver FixedSteps() is the default controller: the grid's own steps, bitwise
+    X = tree.rough_path(np.linspace(0.0, 1.0, 9))
+    a = rp.solve(V, X, Y0, rp.Davie())
+    b = rp.solve(V, X, Y0, rp.Davie(), step_control=rp.FixedSteps())
+    assert np.array_equal(a.states, b.states)
+
+
+def test_adaptive_steps_are_a_declared_capability():
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=0)
+    ctrl = rp.PIController(1e-2, 1e-2)
+
+    class NoEstimate(rp.Davie):
+        error_estimate = None
+
+    class Declared(rp.Solver):                           # a user's order-1 scheme: Davie's step, declared data
+        increment_level, order = 2, 1.0
+        step = rp.Davie.step
+        _linear_step = staticmethod(rp.Davie._linear_step)
+
+    for solver in (rp.Euler(), rp.Heun(), NoEstimate()):
+        with pytest.raises(ValueError, match="error_estimate=None"):
+            rp.solve(V, tree, Y0, solver, step_control=ctrl)
+    assert rp.Heun().error_estimate is None and rp.Davie().error_estimate == "step_doubling"
+    # without an estimate, a schedule still drives a level-1 solver
+    heun = rp.solve(V, tree, Y0, rp.Heun(), step_control=rp.FixedSteps(0.25), save_at="end")
+    assert heun.final.shape == (3,)
+    a = rp.solve(V, tree, Y0, Declared(), step_control=ctrl, save_at="end")
+    b = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, save_at="end")
+    assert np.array_equal(a.final, b.final) and a.stats["accepted"] == b.stats["accepted"]
+
+
+def test_objects_outside_the_contract_are_refused_by_name():
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=0)
+    with pytest.raises(TypeError, match="StepController contract"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=object())
+    with pytest.raises(ValueError, match="FixedSteps\\(dt=...\\)"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=rp.FixedSteps())
+    with pytest.raises(ValueError, match="dt must be"):
+        rp.FixedSteps(-1.0)
+    with pytest.raises(ValueError, match="no grid"):
+        next(tree.blocks())
