@@ -16,7 +16,16 @@ about 42 core-ms per step at N = 128 (0.66 ms at 32, 5.2 ms at 64, 336 ms at 256
 (time.process_time: all threads of this process), so per core; medians of interleaved repeats. The machine
 is shared: the load average is printed with the table.
 
-The strong-order-1 scheme's row (the library's solver with the Lévy area) is added where that solver lands.
+* ``LieHeun (solve)``: the library's strong-order-1 scheme with the Lévy area, one step of
+  ``roughpaths.solve(zeitlin_system(N, s=...), X, W0, mechanics.LieHeun())`` on one Brownian rough path with its
+  areas (three non-commuting SALT modes, ``s^{12} = 1``): two drift evaluations (two Laplacian solves, four
+  products), the noise and area matrices, one exponential of an N x N skew-Hermitian matrix and the conjugation
+  (O(N^3), BLAS), through the public entry point (validation and coordinate maps included, the driver's
+  sampling excluded). Target (issue 38): N = 128 <= 20 ms per step. The last column is the peak resident
+  memory of the process after the largest N (bounded: the solver holds a few N x N matrices per path,
+  never anything of size dim(su(N))^2).
+
+Beyond the paper: the paper has no fluid model; this is the library's extension to Zeitlin's Euler on the sphere.
 
 Usage: ``python benchmarks/bench_euler_sphere.py [--sizes 32,64,128,256] [--repeats R] [--threads=K]``.
 """
@@ -37,7 +46,11 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 
-from mechanics.sphere import coefficients_to_matrix, hbar, inverse_laplacian, laplacian  # noqa: E402
+import resource  # noqa: E402
+
+import mechanics  # noqa: E402
+import roughpaths  # noqa: E402
+from mechanics.sphere import coefficients_to_matrix, hbar, inverse_laplacian, laplacian, zeitlin_system  # noqa: E402
 
 ANCHOR_CORE_SECONDS_4096 = 0.55 * 2500  # core-seconds per step at N = 4096 (published figures)
 
@@ -72,6 +85,14 @@ def midpoint_step(W: np.ndarray, h: float, kappa: float, tol: float = 1e-12, max
     return Wt + 0.5 * h * (BW - Wt @ B) - 0.25 * h * h * (BW @ B), it
 
 
+def heun_setup(N: int, W: np.ndarray, steps: int, h: float, seed: int = 38):
+    """The system with the Lévy-area correction, the state as coordinates and one Brownian rough path."""
+    system = zeitlin_system(N, amplitudes=0.1, s=np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]))
+    y0 = system.algebra.matrix_to_dual(W)
+    X = roughpaths.brownian_rough_path(np.linspace(0.0, steps * h, steps + 1), 3, np.random.default_rng(seed))
+    return system, y0, X
+
+
 def cpu_median(fn, repeats: int) -> float:
     times = []
     for _ in range(repeats):
@@ -98,7 +119,11 @@ def main(argv=None) -> None:
         h = 0.25 / norm_b
         states[N] = (W, kappa, h)
         inverse_laplacian(W), laplacian(W), midpoint_step(W, h, kappa)  # warm caches (factors, BLAS)
-    rows = {N: {"solve": [], "lap": [], "step": [], "iters": []} for N in sizes}
+    heun = {N: heun_setup(N, states[N][0], args.steps, states[N][2]) for N in sizes}
+    for N in sizes:
+        system, y0, X = heun[N]
+        roughpaths.solve(system, X, y0, mechanics.LieHeun(), save_at="end")     # warm (first-call costs)
+    rows = {N: {"solve": [], "lap": [], "step": [], "iters": [], "heun": []} for N in sizes}
     for _ in range(args.repeats):  # interleaved: one round over every size per repeat
         for N in sizes:
             W, kappa, h = states[N]
@@ -114,20 +139,26 @@ def main(argv=None) -> None:
 
             rows[N]["step"].append(cpu_median(run, 1) / args.steps)
             rows[N]["iters"].append(float(np.mean(iters)))
+            system, y0, X = heun[N]
+            rows[N]["heun"].append(cpu_median(lambda: roughpaths.solve(system, X, y0, mechanics.LieHeun(),
+                                                                         save_at="end"), 1) / args.steps)
     load = os.getloadavg()
     print(f"# Zeitlin's Euler on the sphere, one path, CPU time per call (median of {args.repeats} interleaved "
           f"repeats); load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; BLAS threads "
           f"{os.environ.get('OPENBLAS_NUM_THREADS')}")
-    print("| N | inverse_laplacian | laplacian | midpoint step | iterations/step | per iteration | "
-          "anchor (core-ms/step, N^3-scaled) | step / anchor |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| N | inverse_laplacian | laplacian | midpoint step (plain numpy) | iterations/step | per iteration | "
+          "LieHeun with area (solve) | anchor (core-ms/step, N^3-scaled) | midpoint / anchor | LieHeun / anchor |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for N in sizes:
         r = rows[N]
         solve, lap, step = (statistics.median(r[k]) for k in ("solve", "lap", "step"))
         iters = statistics.median(r["iters"])
+        heun_step = statistics.median(r["heun"])
         anchor = ANCHOR_CORE_SECONDS_4096 * (N / 4096.0) ** 3
         print(f"| {N} | {solve * 1e3:.3f} ms | {lap * 1e3:.3f} ms | {step * 1e3:.2f} ms | {iters:.1f} | "
-              f"{step / (iters + 1) * 1e3:.2f} ms | {anchor * 1e3:.2f} | {step / anchor:.2f} |")
+              f"{step / (iters + 1) * 1e3:.2f} ms | {heun_step * 1e3:.2f} ms | {anchor * 1e3:.2f} | "
+              f"{step / anchor:.2f} | {heun_step / anchor:.2f} |")
+    print(f"# peak resident memory of the process: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
 
 
 if __name__ == "__main__":

@@ -44,6 +44,13 @@ _GROWTH = {
     "coloured_area_rate": (lambda s: 500 * s["n_paths"], lambda s: 500 * s["n_paths"]),
     "wong_zakai": (lambda s: s["n_paths"] * _coloured_steps(2.0, s["eps"]), lambda s: s["n_paths"]),
     "chaos": (lambda s: s["n_paths"] * s["n_steps"], lambda s: s["n_paths"] * s["n_steps"]),
+    # beyond the paper: Euler on the sphere (O(N^3) per step; the stored states O(N^2) each)
+    "sphere_euler": (lambda s: s["N"] ** 3 * s["n_steps"], lambda s: s["N"] ** 2),
+    "sphere_casimirs": (lambda s: s["N"] ** 3 * s["n_steps"], lambda s: s["N"] ** 2 * s["n_steps"]),
+    "sphere_friz_oberhauser": (lambda s: s["n_paths"], lambda s: s["n_paths"]),
+    "sphere_convergence": (lambda s: s["n_ref"] ** 3, lambda s: s["n_ref"] ** 2),
+    "sphere_strong_order": (lambda s: s["n_paths"], lambda s: s["n_paths"]),
+    "sphere_levy_drift": (lambda s: s["n_paths"], lambda s: s["n_paths"]),
 }
 
 #: Measured cost coefficients ``{task: (s0, s1, b0, b1)}``: CPU seconds ``s0 + s1 · work`` and peak
@@ -79,6 +86,14 @@ _COST: dict = {
     "wong_zakai": (3.52, 5.96e-07, 8.0e+07, 3.57e+04),
     "planar_constant": (0.000496, 0.0, 0.0, 0.0),
     "chaos": (1.51, 8.17e-06, 4.45e+07, 146.0),
+    # beyond the paper: fitted through --tiny and --full runs of each (6 December 2026, load about 10, one BLAS
+    # thread; sphere_strong_order's tiny point at 4 paths)
+    "sphere_euler": (2.43, 1.08e-08, 7.16e+07, 8940.0),
+    "sphere_casimirs": (0.094, 2.4e-08, 1.0e+06, 100.0),
+    "sphere_friz_oberhauser": (0.084, 0.008, 0.0, 2.0e+05),
+    "sphere_convergence": (0.19, 2.4e-07, 0.0, 1930.0),
+    "sphere_strong_order": (0.44, 0.042, 5.0e+06, 0.0),
+    "sphere_levy_drift": (0.0, 7.85e-05, 0.0, 4580.0),
 }
 #: Resident memory of the process once every kind of figure and check has run (bytes: the end of a
 #: ``--tiny`` run, 364 MiB), and the CPU time to start, import and write the report (seconds: a run of

@@ -35,6 +35,7 @@ from .plotting import (
     plot_trajectory_3d,
 )
 from .report import FigureResult
+from .sphere_figure import SPHERE_FIGURE_CAPTION, SPHERE_FIGURE_TITLE, sphere_euler
 from .tasks import registry_decorator
 
 __all__ = ["FIGURES"]
@@ -347,3 +348,10 @@ def fig5(ctx) -> FigureResult:
                                             limit_xi=run["wz"].limit_xi, density_limit=H1, density_no_torque=H2,
                                             density_x_edges=edges[0], density_y_edges=edges[1],
                                             fraction_near_e2_limit=f1, fraction_near_e2_no_torque=f2))
+
+
+# beyond the paper (module sphere_figure): SALT Euler on the sphere, reported in a section of its own
+@register("sphere_euler", SPHERE_FIGURE_TITLE, SPHERE_FIGURE_CAPTION)
+def sphere_euler_figure(ctx) -> FigureResult:
+    fig, data = sphere_euler(ctx)
+    return _result(ctx, "sphere_euler", fig, data)

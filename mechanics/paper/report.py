@@ -15,6 +15,10 @@ Python dependencies only) the formulas are plain HTML with sub- and superscripts
 raw TeX is never shown.
 ``report.md`` keeps the claims as the checks write them.
 
+Checks and figures whose names start with ``sphere_`` (:data:`mechanics.paper.beyond.BEYOND_THE_PAPER_PREFIX`: Zeitlin's model of
+Euler on the sphere, modules ``sphere_checks`` and ``sphere_figure``) are not the paper's: they are reported in a
+section of their own, "Beyond the paper: Euler on the sphere", after the paper's checks and figures.
+
 The three files depend only on the results and the options, never on the clock or the output
 folder's name: the same run gives the same bytes (wall times and dates are in ``manifest.json``).
 """
@@ -38,6 +42,7 @@ import roughpaths
 
 from ._html_katex import KATEX_DIR, KatexUnavailable, load_katex
 from ._html_markup import markup
+from .beyond import BEYOND_NOTE as _BEYOND_NOTE, BEYOND_TITLE as _BEYOND_TITLE, beyond_the_paper
 
 __all__ = [
     "CheckResult", "FigureResult", "RunMetadata", "format_value", "write_report", "versions",
@@ -46,6 +51,9 @@ __all__ = [
 
 #: status strings of a check or figure
 PASS, FAIL, ERROR = "pass", "FAIL", "error"
+
+def _split(items):
+    return [x for x in items if not beyond_the_paper(x.name)], [x for x in items if beyond_the_paper(x.name)]
 
 
 @dataclass
@@ -227,6 +235,39 @@ def levy_area_text(method: str) -> str:
 _TIMING_NOTE = "Wall times and dates are in manifest.json (the report depends only on the results)."
 
 
+def _md_checks(checks: list[CheckResult], level: str = "###") -> list[str]:
+    lines = ["| check | claim | predicted | measured | tolerance | result |", "|---|---|---|---|---|---|"]
+    for c in checks:
+        lines.append(
+            f"| `{c.name}` | {_md_escape(c.statement)} | {_md_escape(format_value(c.predicted))} | "
+            f"{_md_escape(format_value(c.measured))} | {_md_escape(c.tolerance)} | **{c.status}** |"
+        )
+    notes = [c for c in checks if c.details]
+    if notes:
+        lines += ["", f"{level} Details", ""]
+        for c in notes:
+            detail = c.details.strip()
+            if "\n" in detail:
+                lines += [f"- `{c.name}`:", "", "```text", detail, "```", ""]
+            else:
+                lines.append(f"- `{c.name}`: {detail}")
+    return lines + [""]
+
+
+def _md_figures(figures: list[FigureResult], level: str = "###") -> list[str]:
+    lines = []
+    for f in figures:
+        lines += [f"{level} {f.title} (`{f.name}`)", ""]
+        if f.png is not None and f.status == PASS:
+            lines += [f"![{f.title}]({f.png})", ""]
+            if f.npz is not None:
+                lines += [f"Data: `{f.npz}`", ""]
+        else:
+            lines += [f"*{f.status}*: {_md_escape(f.details.strip().splitlines()[-1] if f.details else '')}", ""]
+        lines += [f.caption, ""]
+    return lines
+
+
 def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult]) -> str:
     """The Markdown report (figures referenced by file name, relative to the output folder)."""
     counts = _summary(checks)
@@ -243,35 +284,16 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
         "",
         _CONVENTION_NOTE,
         "",
-        "## Theorem and proposition checks",
-        "",
-        "| check | claim | predicted | measured | tolerance | result |",
-        "|---|---|---|---|---|---|",
     ]
-    for c in checks:
-        lines.append(
-            f"| `{c.name}` | {_md_escape(c.statement)} | {_md_escape(format_value(c.predicted))} | "
-            f"{_md_escape(format_value(c.measured))} | {_md_escape(c.tolerance)} | **{c.status}** |"
-        )
-    notes = [c for c in checks if c.details]
-    if notes:
-        lines += ["", "### Details", ""]
-        for c in notes:
-            detail = c.details.strip()
-            if "\n" in detail:
-                lines += [f"- `{c.name}`:", "", "```text", detail, "```", ""]
-            else:
-                lines.append(f"- `{c.name}`: {detail}")
-    lines += ["", "## Figures", ""]
-    for f in figures:
-        lines += [f"### {f.title} (`{f.name}`)", ""]
-        if f.png is not None and f.status == PASS:
-            lines += [f"![{f.title}]({f.png})", ""]
-            if f.npz is not None:
-                lines += [f"Data: `{f.npz}`", ""]
-        else:
-            lines += [f"*{f.status}*: {_md_escape(f.details.strip().splitlines()[-1] if f.details else '')}", ""]
-        lines += [f.caption, ""]
+    (paper_checks, beyond_checks), (paper_figures, beyond_figures) = _split(checks), _split(figures)
+    lines += ["## Theorem and proposition checks", ""] + _md_checks(paper_checks) + ["## Figures", ""]
+    lines += _md_figures(paper_figures)
+    if beyond_checks or beyond_figures:
+        lines += [f"## {_BEYOND_TITLE}", "", _BEYOND_NOTE, ""]
+        if beyond_checks:
+            lines += ["### Checks", ""] + _md_checks(beyond_checks, "####")
+        if beyond_figures:
+            lines += ["### Figures", ""] + _md_figures(beyond_figures, "####")
     lines += ["## Run metadata", "", f"- command: `{meta.command}`", f"- seed: {meta.seed}",
               f"- convention: {meta.convention}", f"- Lévy areas: {levy_area_text(meta.levy_area)}",
               f"- sizes: {meta.scale}", f"- {_TIMING_NOTE}", ""]
@@ -321,6 +343,43 @@ def _formula_note(katex, reason: str | None) -> str:
                 f"JavaScript is off they are shown as plain text with sub- and superscripts.")
     return (f"Formulas are shown as plain text with sub- and superscripts: {reason}. Run tools/vendor_katex.sh "
             f"(or ./test.sh) in the source tree before the main job to have them typeset.")
+
+
+def _html_checks(checks: list[CheckResult], m, level: str = "h3") -> list[str]:
+    e = html.escape
+    parts = ["<table><tr><th>check</th><th>claim</th><th>predicted</th><th>measured</th><th>tolerance</th>"
+             "<th>result</th></tr>"]
+    for c in checks:
+        parts.append(
+            f"<tr><td class='name'><code>{e(c.name)}</code></td><td>{m(c.statement)}</td>"
+            f"<td>{m(format_value(c.predicted))}</td><td>{m(format_value(c.measured))}</td>"
+            f"<td>{m(c.tolerance)}</td><td class='{e(c.status)}'>{e(c.status)}</td></tr>"
+        )
+    parts.append("</table>")
+    notes = [c for c in checks if c.details]
+    if notes:
+        parts.append(f"<{level}>Details</{level}><ul>")
+        for c in notes:
+            # a traceback is shown as it is; notes are prose with formulas, wrapped (no horizontal scrolling)
+            body = (f"<pre>{e(c.details.strip())}</pre>" if c.status == ERROR
+                    else f"<div class='details'>{m(c.details.strip())}</div>")
+            parts.append(f"<li><code>{e(c.name)}</code>: {body}</li>")
+        parts.append("</ul>")
+    return parts
+
+
+def _html_figures(figures: list[FigureResult], m, read_file, level: str = "h3") -> list[str]:
+    e = html.escape
+    parts = []
+    for f in figures:
+        parts.append(f"<figure id='{e(f.name)}'><{level}>{m(f.title)} (<code>{e(f.name)}</code>)</{level}>")
+        if f.png is not None and f.status == PASS:
+            data = base64.b64encode(read_file(f.png)).decode("ascii")
+            parts.append(f"<img alt='{e(f.title)}' src='data:image/png;base64,{data}'>")
+        else:
+            parts.append(f"<p><b>{e(f.status)}</b></p><pre>{e(f.details.strip())}</pre>")
+        parts.append(f"<figcaption>{m(f.caption)}</figcaption></figure>")
+    return parts
 
 
 def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[FigureResult], read_file,
@@ -379,35 +438,17 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
         f"{counts[ERROR]} errors.</p>",
         f"<p>{m(_CONVENTION_NOTE)}</p>",
         f"<p class='note'>{e(_formula_note(katex, reason))}</p>",
-        "<h2>Theorem and proposition checks</h2>",
-        "<table><tr><th>check</th><th>claim</th><th>predicted</th><th>measured</th><th>tolerance</th>"
-        "<th>result</th></tr>",
     ]
-    for c in checks:
-        parts.append(
-            f"<tr><td class='name'><code>{e(c.name)}</code></td><td>{m(c.statement)}</td>"
-            f"<td>{m(format_value(c.predicted))}</td><td>{m(format_value(c.measured))}</td>"
-            f"<td>{m(c.tolerance)}</td><td class='{e(c.status)}'>{e(c.status)}</td></tr>"
-        )
-    parts.append("</table>")
-    notes = [c for c in checks if c.details]
-    if notes:
-        parts.append("<h3>Details</h3><ul>")
-        for c in notes:
-            # a traceback is shown as it is; notes are prose with formulas, wrapped (no horizontal scrolling)
-            body = (f"<pre>{e(c.details.strip())}</pre>" if c.status == ERROR
-                    else f"<div class='details'>{m(c.details.strip())}</div>")
-            parts.append(f"<li><code>{e(c.name)}</code>: {body}</li>")
-        parts.append("</ul>")
-    parts.append("<h2>Figures</h2>")
-    for f in figures:
-        parts.append(f"<figure id='{e(f.name)}'><h3>{m(f.title)} (<code>{e(f.name)}</code>)</h3>")
-        if f.png is not None and f.status == PASS:
-            data = base64.b64encode(read_file(f.png)).decode("ascii")
-            parts.append(f"<img alt='{e(f.title)}' src='data:image/png;base64,{data}'>")
-        else:
-            parts.append(f"<p><b>{e(f.status)}</b></p><pre>{e(f.details.strip())}</pre>")
-        parts.append(f"<figcaption>{m(f.caption)}</figcaption></figure>")
+    (paper_checks, beyond_checks), (paper_figures, beyond_figures) = _split(checks), _split(figures)
+    parts += ["<h2>Theorem and proposition checks</h2>"] + _html_checks(paper_checks, m) + ["<h2>Figures</h2>"]
+    parts += _html_figures(paper_figures, m, read_file)
+    if beyond_checks or beyond_figures:
+        parts += [f"<section id='beyond-the-paper'><h2>{e(_BEYOND_TITLE)}</h2>", f"<p>{m(_BEYOND_NOTE)}</p>"]
+        if beyond_checks:
+            parts += ["<h3>Checks</h3>"] + _html_checks(beyond_checks, m, "h4")
+        if beyond_figures:
+            parts += ["<h3>Figures</h3>"] + _html_figures(beyond_figures, m, read_file, "h4")
+        parts.append("</section>")
     parts += ["<h2>Run metadata</h2><table>",
               f"<tr><th>command</th><td><code>{e(meta.command)}</code></td></tr>",
               f"<tr><th>seed</th><td>{meta.seed}</td></tr>",

@@ -70,13 +70,18 @@ def _eps(tiny, default, full):
                 "ε²/(2‖A‖))", 0.0)
 
 
+def _matrix(tiny, default, full, meaning, minimum):
+    return Size(tiny, default, full, "count", "other", meaning, minimum)
+
+
 _LEVELS = Size(8, 18, 24, "count", "other", "level sets drawn")
 _FINEST = "steps of the finest grid on [0, 1]; the check halves the step down to 1/n_steps"
 
 #: The sizes of every figure and check: ``{task name: {word: Size}}``, in report order. A size is set on
 #: the command line as ``--set TASK.WORD=VALUE``; the words are ``n_paths`` (number of independent paths),
 #: ``n_steps`` (number of time steps), ``T`` (horizon), ``dt`` (step), ``eps`` (ε of the coloured noise),
-#: ``levels`` (level sets of a phase portrait) and ``n_paths_wrong_models``. A task absent here has no
+#: ``levels`` (level sets of a phase portrait), ``n_paths_wrong_models``, and beyond the paper ``N`` and ``n_ref``
+#: (matrix sizes of Zeitlin's model of Euler on the sphere). A task absent here has no
 #: sizes (its numbers are fixed by the claim it checks).
 SIZES: dict = {
     "fig1": {"T": _horizon(20.0, 2_000.0, 20_000.0, 0.1), "dt": _dt(0.01, 0.005, 0.001)},
@@ -88,6 +93,9 @@ SIZES: dict = {
     "surf5": {"levels": _LEVELS},
     "fig4": {"eps": _eps(0.05, 0.01, 0.005), "T": _horizon(10.0, 200.0, 500.0, 0.1)},
     "fig5": {"eps": _eps(0.05, 0.01, 0.005), "T": _horizon(10.0, 200.0, 500.0, 0.1)},
+    # beyond the paper: Euler on the sphere (mechanics.paper.sphere_figure)
+    "sphere_euler": {"N": _matrix(32, 64, 128, "matrix size N of Zeitlin's model (degrees l < N)", 8),
+                     "n_steps": _steps(50, 100, 400, "LieHeun steps on [0, 2]", minimum=10)},
     "chen": {"n_steps": _steps(200, 10_000, 100_000, "steps on [0, 1]", minimum=3),
              "n_paths": _paths(4, 64, 256)},
     "levy_log": {"n_steps": _steps(100, 2_000, 20_000, "steps on [0, 1] (32 paths)")},
@@ -109,6 +117,15 @@ SIZES: dict = {
                    "eps": _eps(0.02, 0.02, 0.01)},
     "chaos": {"n_paths": _paths(300, 6_000, 20_000, "cat-map orbits (Lorenz: a third, at least 200)", minimum=2),
               "n_steps": _steps(40, 200, 1_000, "fast steps per unit time (Lorenz: twice as many)")},
+    # beyond the paper: Euler on the sphere (mechanics.paper.sphere_checks)
+    "sphere_casimirs": {"N": _matrix(32, 64, 128, "matrix size N of Zeitlin's model", 4),
+                        "n_steps": _steps(20, 40, 200, "LieHeun steps on [0, 0.5]", minimum=2)},
+    "sphere_friz_oberhauser": {"n_paths": _paths(2, 8, 32)},
+    "sphere_convergence": {"n_ref": _matrix(64, 128, 256, "N of the reference (compared: N = 8, 16, ... <= n_ref/4)",
+                                            64)},
+    "sphere_strong_order": {"n_paths": _paths(8, 16, 64, "paths (N = 16, 2⁹ fine steps)", minimum=2)},
+    "sphere_levy_drift": {"n_paths": _paths(1_000, 4_000, 100_000, "paths from one W₀ (su(4), h = 0.1)",
+                                            minimum=2)},
 }
 
 

@@ -15,7 +15,9 @@ on pages served from 127.0.0.1:
   ``.arithmatex`` holds a ``.katex``, the KaTeX fonts loaded, no ``_{``/``^{`` left in the visible
   text: where KaTeX is not vendored, outside CI, the formulas are checked in their plain-HTML form
   instead), and nothing needs horizontal scrolling (the page, the Details notes, the tables).
-  Screenshots of the page and of Figures 1, 4 and 5 as the reader sees them are kept.
+  Screenshots of the page and of Figures 1, 4 and 5 as the reader sees them are kept, and of the section
+  "Beyond the paper: Euler on the sphere" (present, after the paper's results) and its figure
+  ``sphere_euler`` (the vorticity in two projections, the enstrophy spectrum, the Casimir drift).
 
 Screenshots are kept in ``test-artifacts/browser/`` (gitignored). Skipped when Chromium is missing,
 except under ``CI=true``, where that is a failure.
@@ -161,7 +163,7 @@ def test_report_html_in_browser(tiny_paper_run, chromium):
         page.screenshot(ARTIFACTS / "report.png")
         page.screenshot(ARTIFACTS / "report-full.png", full_page=True)
         # the figures as the reader sees them (look at them: the legends, markers and colour bars)
-        for name in ("fig1", "fig4", "fig5"):
+        for name in ("fig1", "fig4", "fig5", "beyond-the-paper", "sphere_euler"):
             if page.evaluate(f"(() => {{ const f = document.getElementById('{name}'); if (!f) return false;"
                              f" f.scrollIntoView({{block: 'start'}}); return true; }})()"):
                 page.screenshot(ARTIFACTS / f"report-{name}.png")
@@ -170,6 +172,9 @@ def test_report_html_in_browser(tiny_paper_run, chromium):
     errors = [e for e in errors if "favicon.ico" not in e]  # the browser asks for one; the report has none
     assert not errors, f"report.html: console/network errors: {errors}"
     assert figures_run >= 1 and len(s["images"]) == figures_run
+    # the section beyond the paper comes after the paper's figures, and holds its own figure
+    assert page_text.index("<h2>Figures</h2>") < page_text.index("id='beyond-the-paper'") < \
+        page_text.index("id='sphere_euler'")
     bad = [i for i in s["images"] if i["width"] == 0]
     assert not bad, f"report.html: figures that did not decode: {bad}"
     assert not s["raw"], f"report.html: raw TeX/RST in the text: {s['raw']}"

@@ -138,3 +138,67 @@ def rotated(func, R):
 def fitted_slope(ns, errors):
     """Least-squares slope of log(error) against log(n)."""
     return float(np.polyfit(np.log(ns), np.log(errors), 1)[0])
+
+
+def smooth_coefficients(rng, lmax, decay=1.0):
+    """Flat coefficients (length (lmax+1)**2) of a random real field of degrees 1..lmax, |omega_lm| ~ l^-decay."""
+    L = lmax + 1
+    omega = np.zeros(L * L, dtype=complex)
+    for l in range(1, L):
+        omega[l * (l + 1)] = rng.standard_normal() / l ** decay
+        for m in range(1, l + 1):
+            c = (rng.standard_normal() + 1j * rng.standard_normal()) / (np.sqrt(2.0) * l ** decay)
+            omega[l * (l + 1) + m] = c
+            omega[l * (l + 1) - m] = (-1) ** m * np.conj(c)
+    return omega
+
+
+def power_traces(W, orders=(2, 3, 4, 5, 6)):
+    """tr((iW)^k) from the eigenvalues of the Hermitian iW (numpy's eigvalsh), and sum |lambda|^k."""
+    lam = np.linalg.eigvalsh(1j * W)
+    return (np.array([np.sum(lam ** k) for k in orders]), np.array([np.sum(np.abs(lam) ** k) for k in orders]))
+
+
+class SpectralEuler:
+    """A naive pseudo-spectral Galerkin solver of Euler on the sphere, omega_t = {omega, psi}, degrees < L.
+
+    Coefficients omega[l*(l+1)+m]; the bracket (omega_theta psi_phi - omega_phi psi_theta)/sin(theta) is formed on a
+    Gauss-Legendre x uniform grid fine enough that the projection of the (band-limited, degree < 2L) bracket
+    back onto degrees < L is exact (no aliasing); classical RK4 in time. Harmonics and their theta-derivatives
+    from scipy (the identity of dtheta_Y). Independent of mechanics.sphere.
+    """
+    def __init__(self, L):
+        self.L = L
+        n_lat = (3 * L) // 2 + 2
+        self.n_lon = n_lon = 3 * L
+        x, w = np.polynomial.legendre.leggauss(n_lat)
+        th = np.arccos(x)
+        ls = np.concatenate([[l] * (2 * l + 1) for l in range(L)])
+        ms = np.concatenate([np.arange(-l, l + 1) for l in range(L)])
+        self.ls, self.ms = ls, ms
+        P = sp.sph_harm_y(ls[None, :], ms[None, :], th[:, None], 0.0)           # Pbar_lm(theta_i)
+        up = np.where(ms + 1 <= ls, sp.sph_harm_y(ls[None, :], np.minimum(ms + 1, ls)[None, :], th[:, None], 0.0), 0.0)
+        dP = ms / np.tan(th)[:, None] * P + np.sqrt(np.maximum((ls - ms) * (ls + ms + 1), 0))[None, :] * up
+        self.P, self.dP, self.w, self.sin = P, dP, w, np.sin(th)
+        self.col = np.mod(ms, n_lon)
+        self.onehot = np.zeros((L * L, n_lon)); self.onehot[np.arange(L * L), self.col] = 1.0
+        lap = -(ls * (ls + 1.0)); lap[0] = 1.0
+        self.inv_lap = np.where(ls > 0, 1.0 / lap, 0.0)
+    def synth(self, c, B):
+        F = (B * c[None, :]) @ self.onehot
+        return np.fft.ifft(F, axis=1).real * self.n_lon  # real fields
+    def analyse(self, f):
+        G = np.fft.fft(f, axis=1)[:, self.col] / self.n_lon
+        return 2 * np.pi * np.einsum("i,il,il->l", self.w, np.conj(self.P), G)
+    def rhs(self, om):
+        psi = om * self.inv_lap
+        om_t, om_p = self.synth(om, self.dP), self.synth(1j * self.ms * om, self.P)
+        ps_t, ps_p = self.synth(psi, self.dP), self.synth(1j * self.ms * psi, self.P)
+        return self.analyse((om_t * ps_p - om_p * ps_t) / self.sin[:, None])
+    def solve(self, om0, T, n):
+        om = np.zeros(self.L ** 2, complex); om[:om0.size] = om0
+        h = T / n
+        for _ in range(n):
+            k1 = self.rhs(om); k2 = self.rhs(om + h / 2 * k1); k3 = self.rhs(om + h / 2 * k2); k4 = self.rhs(om + h * k3)
+            om = om + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        return om
