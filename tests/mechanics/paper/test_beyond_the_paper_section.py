@@ -37,6 +37,7 @@ def test_markdown_puts_sphere_results_in_their_own_section_after_the_paper():
     assert "`chen`" in paper and "Figure 1" in paper and "sphere_" not in paper
     assert "`sphere_casimirs`" in beyond and "Sphere figure" in beyond and "`chen`" not in beyond
     assert beyond.index("sphere note") < beyond.index("Sphere figure") < beyond.index("## Run metadata")
+    assert "Checks: **2 passed**, 0 failed, 0 errors. (1 of them beyond the paper, in their own section.)" in paper
 
 
 def test_html_puts_sphere_results_in_their_own_section_after_the_paper():
