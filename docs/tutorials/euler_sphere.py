@@ -97,7 +97,7 @@ for row, (field, label) in enumerate(zip(fields, labels)):
     plot_field_hemisphere(fig.add_subplot(grid[row, 1]), theta, phi, field, "south", vmin=-lim, vmax=lim,
                           title=f"{label}: south")
     plot_field_latlon(fig.add_subplot(grid[row, 2]), theta, phi, field, vmin=-lim, vmax=lim, title=label)
-fig.savefig(OUT / "euler_sphere_fields.png", dpi=70)
+fig.savefig(OUT / "euler_sphere_fields.png", dpi=60)
 
 fig = new_figure(figsize=(11, 3.6), layout="constrained")
 axes = fig.subplots(1, 2)

@@ -15,10 +15,11 @@ BEYOND_THE_PAPER_PREFIX = "sphere_"
 BEYOND_TITLE = "Beyond the paper: Euler on the sphere"
 #: the paragraph that opens it
 BEYOND_NOTE = (
-    "Not in the paper. The paper's theory (SALT noise, the Lévy-area correction ℓ = ½ sᶦʲ[ξᵢ, ξⱼ], Friz–Oberhauser, "
-    "the isospectral schemes of strong order 1) run on Zeitlin's model of 2-D incompressible Euler on the unit "
-    "sphere, a Lie–Poisson system on su(N) whose Casimirs tr((iW)ᵏ) are the discrete enstrophies and which "
-    "converges to the Euler equations as N grows (mechanics.sphere; tutorial docs/tutorials/euler-sphere.md)."
+    "Not in the paper. The paper's theory (SALT noise, the Lévy-area correction ℓ = ½ sᶦʲ[ξᵢ, ξⱼ], "
+    "Friz–Oberhauser, the isospectral schemes of strong order 1) run on Zeitlin's model of the incompressible "
+    "Euler equations on the unit sphere (two-dimensional), a Lie–Poisson system on su(N) whose Casimirs "
+    "tr((iW)ᵏ) are the discrete enstrophies and which converges to the Euler equations as N grows "
+    "(mechanics.sphere; tutorial docs/tutorials/euler-sphere.md)."
 )
 
 

@@ -52,6 +52,11 @@ __all__ = [
 #: status strings of a check or figure
 PASS, FAIL, ERROR = "pass", "FAIL", "error"
 
+def _beyond_count(checks) -> str:
+    n = sum(beyond_the_paper(c.name) for c in checks)
+    return f" ({n} of them beyond the paper, in their own section.)" if n else ""
+
+
 def _split(items):
     return [x for x in items if not beyond_the_paper(x.name)], [x for x in items if beyond_the_paper(x.name)]
 
@@ -280,7 +285,7 @@ def render_markdown(meta: RunMetadata, checks: list[CheckResult], figures: list[
         f"Lévy areas: **{meta.levy_area}** ({_LEVY_AREA_TEXT.get(meta.levy_area, meta.levy_area)}). "
         + _LEVY_AREA_NOTE,
         "",
-        f"Checks: **{counts[PASS]} passed**, {counts[FAIL]} failed, {counts[ERROR]} errors.",
+        f"Checks: **{counts[PASS]} passed**, {counts[FAIL]} failed, {counts[ERROR]} errors.{_beyond_count(checks)}",
         "",
         _CONVENTION_NOTE,
         "",
@@ -435,7 +440,7 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
         f"<p>Lévy areas: <b>{e(meta.levy_area)}</b> ({m(_LEVY_AREA_TEXT.get(meta.levy_area, meta.levy_area))}). "
         f"{m(_LEVY_AREA_NOTE)}</p>",
         f"<p class='summary'>Checks: <b>{counts[PASS]} passed</b>, {counts[FAIL]} failed, "
-        f"{counts[ERROR]} errors.</p>",
+        f"{counts[ERROR]} errors.{html.escape(_beyond_count(checks))}</p>",
         f"<p>{m(_CONVENTION_NOTE)}</p>",
         f"<p class='note'>{e(_formula_note(katex, reason))}</p>",
     ]

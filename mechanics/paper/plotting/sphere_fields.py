@@ -50,6 +50,15 @@ def _grid(theta, phi, values):
     return theta, np.append(phi, phi[0] + 2.0 * np.pi), np.concatenate([values, values[:, :1]], axis=1)
 
 
+def _with_poles(th, val):
+    """Close the caps at the poles with the mean of the nearest ring (the grid's colatitudes avoid the poles)."""
+    if th[0] > 0.0:
+        th, val = np.append(0.0, th), np.concatenate([np.full((1, val.shape[1]), val[0].mean()), val])
+    if th[-1] < np.pi:
+        th, val = np.append(th, np.pi), np.concatenate([val, np.full((1, val.shape[1]), val[-1].mean())])
+    return th, val
+
+
 def plot_field_hemisphere(ax, theta, phi, values, view: str = "north", *, vmin=None, vmax=None, cmap="RdBu_r",
                           title: str | None = None):
     """An orthographic view of one hemisphere of a field on the sphere; returns the ``QuadMesh``.
@@ -70,15 +79,11 @@ def plot_field_hemisphere(ax, theta, phi, values, view: str = "north", *, vmin=N
     if view not in _VIEWS:
         raise ValueError(f"view must be 'north' or 'south', got {view!r}.")
     th, ph, val = _grid(theta, phi, values)
+    th, val = _with_poles(th, val)
     keep = th <= np.pi / 2 if view == "north" else th >= np.pi / 2
-    if not np.any(keep):
+    if np.count_nonzero(keep) < 2:
         raise ValueError(f"the grid has no colatitude in the {view}ern hemisphere.")
     th, val = th[keep], val[keep]
-    # close the cap at the pole with the mean of the nearest ring (the grid's colatitudes avoid the poles)
-    if view == "north" and th[0] > 0.0:
-        th, val = np.append(0.0, th), np.concatenate([np.full((1, val.shape[1]), val[0].mean()), val])
-    if view == "south" and th[-1] < np.pi:
-        th, val = np.append(th, np.pi), np.concatenate([val, np.full((1, val.shape[1]), val[-1].mean())])
     T, P = np.meshgrid(th, ph, indexing="ij")
     x, y = np.sin(T) * np.cos(P), np.sin(T) * np.sin(P)
     if view == "south":
@@ -103,6 +108,7 @@ def plot_field_latlon(ax, theta, phi, values, *, vmin=None, vmax=None, cmap="RdB
     Parameters as for :func:`plot_field_hemisphere`.
     """
     th, ph, val = _grid(theta, phi, values)
+    th, val = _with_poles(th, val)
     lim = float(np.max(np.abs(val))) or 1.0
     mesh = ax.pcolormesh(np.degrees(ph), 90.0 - np.degrees(th), val, shading="gouraud", cmap=cmap,
                          vmin=-lim if vmin is None else vmin, vmax=lim if vmax is None else vmax)
