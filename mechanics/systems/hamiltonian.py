@@ -166,6 +166,8 @@ class MatrixHamiltonian(Hamiltonian):
         ``M (..., N, N) -> (..., N, N)``: :math:`\nabla h` as an element of the algebra (a matrix), defined by
         :math:`dh = B(dM, \nabla h)` for the trace form ``B``; the Lie–Poisson drift is then :math:`[M, \nabla h]`.
 
+    Notes
+    -----
     The isospectral solvers call :meth:`gradient_matrix` directly (no coordinates: e.g. the Zeitlin model's
     inverse Laplacian on su(N)); :meth:`value` and :meth:`gradient` in coordinates go through the algebra's
     ``O(N²)`` maps, for everything else (energies, the coordinate schemes, checks). The Hessian, where a
