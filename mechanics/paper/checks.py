@@ -26,7 +26,7 @@ import mechanics
 import roughpaths
 
 from .model import INERTIA, PI0, SIGMA, THETA, hemisphere_mean, paper_body, s_matrix, standard_error
-from . import chaos, section2
+from . import chaos, matrix_algebras, section2
 from .report import CheckResult
 from .tasks import registry_decorator
 
@@ -495,3 +495,5 @@ def check_planar(ctx) -> CheckResult:
 # the conclusion's question (module chaos): fast chaotic dynamics homogenise to a limit with a Lévy-area drift
 register("chaos", "Deterministic chaos: the fast–slow limit carries the Lévy-area drift Alt(E), neither Itô nor "
          "Stratonovich")(chaos.check_chaos)
+for _name, _title, _check in matrix_algebras.MATRIX_CHECKS:    # beyond the rigid body: su(3), so(5)
+    register(_name, _title)(_check)
