@@ -273,13 +273,25 @@ class OrbitGibbsMeasure:
         r""":math:`E[f(\mu)]` with its standard error; ``f`` maps ``(k, n)`` to ``(k,)`` or ``(k, p)`` (default
         :func:`mechanics.moment_observable`: the means and second moments, in the order of
         :func:`mechanics.run_ensemble`'s statistics)."""
-        vals = np.asarray(f(self.samples), dtype=np.float64)
-        if vals.shape[:1] != (self.n_samples,):
-            raise ValueError(f"f must map mu of shape (k, n) to (k,) or (k, p), got shape {vals.shape} for "
-                             f"k = {self.n_samples}.")
-        w = self._weights.reshape((-1,) + (1,) * (vals.ndim - 1))
-        mean = np.sum(w * vals, axis=0)
-        se = np.sqrt(np.sum(w ** 2 * (vals - mean) ** 2, axis=0))
+        # one pass over chunks of samples (f's values are never all held), sums of w (f - c), w² (f - c), w² (f - c)²
+        # about c = the first chunk's weighted mean (so the variance sum does not cancel)
+        sums, c = None, None
+        for k in range(0, self.n_samples, _CHUNK):
+            x = self.samples[k:k + _CHUNK]
+            vals = np.asarray(f(x), dtype=np.float64)
+            if vals.shape[:1] != (x.shape[0],) or vals.ndim > 2:
+                raise ValueError(f"f must map mu of shape (k, n) to (k,) or (k, p), got shape {vals.shape} for "
+                                 f"k = {x.shape[0]}.")
+            w = self._weights[k:k + _CHUNK].reshape((-1,) + (1,) * (vals.ndim - 1))
+            if c is None:
+                c = np.sum(w * vals, axis=0) / max(float(np.sum(w)), 1e-300)
+            d = vals - c
+            part = (np.sum(w * d, axis=0), np.sum(w * w * d, axis=0), np.sum(w * w * d * d, axis=0))
+            sums = part if sums is None else tuple(a + b for a, b in zip(sums, part))
+        s1, s2, s3 = sums
+        w2 = float(np.sum(self._weights ** 2))
+        mean = c + s1                                   # the weights sum to 1
+        se = np.sqrt(np.maximum(s3 - 2.0 * s1 * s2 + s1 * s1 * w2, 0.0))
         return OrbitExpectation(mean=mean, standard_error=se, effective_sample_size=self.effective_sample_size,
                                 n_samples=self.n_samples)
 

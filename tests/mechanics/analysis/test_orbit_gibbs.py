@@ -122,3 +122,19 @@ def test_bad_input_is_refused():
     gm = mechanics.OrbitGibbsMeasure(g, mu0, lambda m: m[..., 0], beta=1.0, n_samples=10, rng=rng)
     with pytest.raises(ValueError, match="f must map"):
         gm.expectation(lambda m: m[0])
+
+
+def test_chunked_expectation_equals_the_direct_formula():
+    """Over several chunks of samples, the one-pass sums give Σ w f and (Σ w² (f − f̂)²)^½ of the normalised weights."""
+    g = mechanics.so(4)
+    mu0 = g.matrix_to_dual(np.array([[0, 1.0, 0, 0], [-1.0, 0, 0, 0], [0, 0, 0, 0.3], [0, 0, -0.3, 0]]))
+    gm = mechanics.OrbitGibbsMeasure(g, mu0, lambda m: m @ np.arange(6.0) + 50.0, beta=0.7, n_samples=45_000,
+                                     rng=np.random.default_rng(2))
+    est = gm.expectation()
+    f = mechanics.moment_observable(gm.samples)
+    w = gm.weights
+    mean = w @ f
+    se = np.sqrt((w ** 2) @ (f - mean) ** 2)
+    np.testing.assert_allclose(est.mean, mean, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(est.standard_error, se, rtol=1e-9)
+    assert est.effective_sample_size == pytest.approx(1.0 / np.sum(w ** 2), rel=1e-12)

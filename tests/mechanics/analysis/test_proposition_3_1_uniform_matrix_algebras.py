@@ -51,7 +51,7 @@ def _system(g, sigma, theta):
 
 def _evolve(system, start, *, T, dt, seed):
     return mechanics.run_ensemble(system, start, dt=dt, n_steps=int(round(T / dt)), n_paths=start.shape[0], seed=seed,
-                                  keep_final=True, chunk_size=start.shape[0])
+                                  keep_final=True, chunk_size=min(start.shape[0], 2000))
 
 
 def _compare(system, final, fresh):
@@ -81,8 +81,8 @@ def _run_case(name, *, P, T, dt, sigma=0.6):
     assert np.linalg.norm(system.levy_velocity) > 0.5           # a large correction, and still uniform
     res = _evolve(system, start, T=T, dt=dt, seed=7)
     final = res.final_states
-    np.testing.assert_allclose(g.casimirs(final), np.broadcast_to(g.casimirs(mu0), (P, len(g.casimirs(mu0)))),
-                               rtol=0, atol=1e-11 * float(mu0 @ mu0) ** 2 * 4)
+    drift = np.abs(g.casimirs(final) - g.casimirs(mu0)) / g.casimir_scale(g.dual_to_matrix(mu0))
+    assert np.max(drift) <= 1e-12                                   # every path stayed on the orbit
     zmax, p = _compare(system, final, fresh)
     corr = float(np.mean(np.sum(start * final, axis=-1)) / (mu0 @ mu0))
     print(f"{name}: max |z| = {zmax:.2f} over {len(exact)} features, KS p(h) = {p:.3g}, E[μ0·μT]/|μ|² = {corr:.3f}, "
