@@ -16,7 +16,8 @@ is the across-path standard deviation over √P (independent paths: honest whate
 Thresholds, fixed before running: every feature within 4 combined SE of the prediction (44 features on su(3), 65
 on so(5)), and the final states (independent samples of nearly the invariant law) too; the Gibbs predictions of
 the paper's printed sign (``h − ⟨μ, ℓ⟩``) and of the missing ½ (``h + 2⟨μ, ℓ⟩``) at least 15 SE away (their
-distances in SE are printed); the uncorrected ``h`` too. Slow version: more paths, a finer step, su(4), and the
+distances in SE are printed); the uncorrected ``h`` too; and the laws with β doubled or halved at least 10 SE away
+(the derived β = 2θ/σ² is pinned down, not only the sign of ℓ). Slow version: more paths, a finer step, su(4), and the
 printed-sign *dynamics* (``convention="paper"``) rejected against the right prediction.
 """
 
@@ -73,7 +74,9 @@ def _run_case(name, *, P, T, dt, burn, n_samples, paper_dynamics=False):
     preds = {"Gibbs of h̃ = h + <μ, ℓ>": gibbs.expectation(),
              "printed sign h − <μ, ℓ>": gibbs.reweighted(_energy(system, -ell)).expectation(),
              "missing ½: h + 2<μ, ℓ>": gibbs.reweighted(_energy(system, 2 * ell)).expectation(),
-             "uncorrected h": gibbs.reweighted(system.energy).expectation()}
+             "uncorrected h": gibbs.reweighted(system.energy).expectation(),
+             "β = 4θ/σ² (twice)": gibbs.reweighted(beta=2 * gibbs.beta).expectation(),
+             "β = θ/σ² (half)": gibbs.reweighted(beta=0.5 * gibbs.beta).expectation()}
     right = preds["Gibbs of h̃ = h + <μ, ℓ>"]
     start = g.sample_orbit(mu0, P, np.random.default_rng(9))
     res = mechanics.run_ensemble(system, start, dt=dt, n_steps=int(round(T / dt)), n_paths=P, seed=17,
@@ -96,6 +99,7 @@ def _run_case(name, *, P, T, dt, burn, n_samples, paper_dynamics=False):
     assert dist["printed sign h − <μ, ℓ>"] > 15.0
     assert dist["missing ½: h + 2<μ, ℓ>"] > 15.0
     assert dist["uncorrected h"] > 15.0
+    assert min(dist["β = 4θ/σ² (twice)"], dist["β = θ/σ² (half)"]) > 10.0     # the temperature is pinned down too
     # the start (uniform) is itself far from the prediction: the run had to relax to it
     u = gibbs.reweighted(beta=0.0).expectation()
     zu = (u.mean - right.mean) / np.sqrt(u.standard_error ** 2 + right.standard_error ** 2)
