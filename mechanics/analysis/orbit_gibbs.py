@@ -34,10 +34,10 @@ Fokker–Planck operator for a density :math:`p` w.r.t. :math:`\nu` is therefore
 :math:`\tilde h = h - \langle\mu, \tfrac12\mathsf s^{ij}[\xi_i,\xi_j]\rangle` of the paper has the wrong sign
 (``docs/conventions.md``).
 
-The oracle (:class:`OrbitGibbsMeasure`)
-----------------------------------------
-Expectations under :math:`p\,\nu` are estimated by self-normalised importance sampling from exact samples of
-:math:`\nu` (:meth:`MatrixLieAlgebra.sample_orbit`: :math:`UMU^{-1}` with Haar :math:`U`), weights
+The importance-sampling oracle
+------------------------------
+:class:`OrbitGibbsMeasure` estimates expectations under :math:`p\,\nu` by self-normalised importance sampling
+from exact samples of :math:`\nu` (:meth:`MatrixLieAlgebra.sample_orbit`: :math:`UMU^{-1}` with Haar :math:`U`), weights
 :math:`w_k\propto e^{-\beta\tilde h(\mu_k)}`. The estimate :math:`\hat f = \sum_k w_kf(\mu_k)/\sum_k w_k` has the
 delta-method standard error :math:`\big(\sum_k w_k^2(f(\mu_k) - \hat f)^2\big)^{1/2}/\sum_k w_k` and effective
 sample size :math:`(\sum_k w_k)^2/\sum_k w_k^2`; both are reported. This is independent of any SDE solver: it
@@ -88,7 +88,7 @@ class OrbitExpectation:
 
 
 def isotropic_sigma(xi) -> float:
-    r"""The amplitude :math:`\sigma > 0` of isotropic noise, :math:`\sum_i\xi_i\xi_i^T = \sigma^2 I`; ``ValueError`` otherwise.
+    r"""The amplitude :math:`\sigma > 0` of isotropic noise, :math:`\sum_i\xi_i\xi_i^T = \sigma^2 I` (else ``ValueError``).
 
     Parameters
     ----------

@@ -96,15 +96,16 @@ def check_matrix_prop21(ctx) -> CheckResult:
             a = roughpaths.solve(plain, X.perturb(s), mu0, mechanics.LieHeun()).states
             b = roughpaths.solve(corrected(1.0), X, mu0, mechanics.LieHeun()).states
             gap = float(np.max(np.abs(a - b))) / scale
-            w = {f: float(np.max(np.abs(roughpaths.solve(corrected(f), X, mu0, mechanics.LieHeun()).states - a))) / scale
-                 for f in (-1.0, 2.0)}
+            w = {f: float(np.max(np.abs(roughpaths.solve(corrected(f), X, mu0, mechanics.LieHeun()).states - a)))
+                 / scale for f in (-1.0, 2.0)}
             lam0 = _spectrum(g, mu0)
             d = float(np.max(np.abs(_spectrum(g, b) - lam0))) / float(np.max(np.abs(lam0)))
             gaps.append(gap)
             wrong.append(min(w.values()))
             drift.append(d)
+            ell = float(np.linalg.norm(corrected(1.0).levy_velocity))
             lines.append(f"{label}, θ = {theta:g}: gap {gap:.2e}; printed sign (−s) {w[-1.0]:.3g}, missing ½ (2s) "
-                         f"{w[2.0]:.3g}; spectrum drift {d:.1e}; |ℓ| = {np.linalg.norm(corrected(1.0).levy_velocity):.3f}")
+                         f"{w[2.0]:.3g}; spectrum drift {d:.1e}; |ℓ| = {ell:.3f}")
     tol = 1e-10
     passed = max(gaps) <= tol and min(wrong) >= 1e-3 and max(drift) <= 1e-12
     return CheckResult(
@@ -181,7 +182,8 @@ def check_matrix_gibbs(ctx) -> CheckResult:
             bar.update(1)
 
         def zmax(pred):
-            return float(np.max(np.abs(ta.mean - pred.mean) / np.sqrt(ta.standard_error ** 2 + pred.standard_error ** 2)))
+            se = np.sqrt(ta.standard_error ** 2 + pred.standard_error ** 2)
+            return float(np.max(np.abs(ta.mean - pred.mean) / se))
 
         z = zmax(right)
         zw = {k: zmax(v) for k, v in wrong.items()}
@@ -203,8 +205,9 @@ def check_matrix_gibbs(ctx) -> CheckResult:
         "(mechanics.OrbitGibbsMeasure).",
         predicted=np.concatenate(preds), measured=np.concatenate(meas),
         tolerance="every feature within 4 combined SE; the printed sign and the missing ½ at least 6 SE away",
-        passed=bool(ok), details=f"{P} paths x T = {T:g}, dt = {dt:g}, burn-in {burn:g}; {n_samples} orbit samples "
-                                 "per algebra\n" + "\n".join(lines))
+        passed=bool(ok),
+        details=f"{P} paths x T = {T:g}, dt = {dt:g}, burn-in {burn:g}; {n_samples} orbit samples per algebra\n"
+                + "\n".join(lines))
 
 
 class _Shifted:

@@ -1,4 +1,5 @@
-"""Proposition 2.1 (Friz–Oberhauser form, sign of docs/conventions.md) beyond the rigid body: su(3), su(4), so(4), so(5).
+"""Proposition 2.1 (Friz–Oberhauser form, sign of docs/conventions.md) beyond the rigid body: su(3), su(4), so(4),
+so(5).
 
 Claim (Proposition 2.1): for every geometric rough path X and antisymmetric s, the Lie–Poisson RDE
 ``dμ = ad*_{∇h} μ dt + θ ad*_{(ad*_{∇h} μ)♯} μ dt + ad*_{ξ_i} μ dX̃^i`` driven by ``X̃ = X.perturb(s)`` (area
@@ -18,8 +19,8 @@ vectors (m = 4 of them) and a random s:
 * across solver families: the coadjoint scheme (corrected, X) against Davie on the fields (uncorrected,
   X.perturb(s)) on a fine grid;
 * the orbit: along the corrected solution the spectrum of ``iM`` (numpy's ``eigvalsh``, not the library's
-  Casimirs) and every Casimir ``tr((iM)^k)`` are constant to ≤ 1e-12 relative over 1000 steps (slow: 10⁴), while the same
-  equation integrated by a scheme that is not coadjoint (Davie in coordinates) leaves the orbit measurably.
+  Casimirs) and every Casimir ``tr((iM)^k)`` are constant to ≤ 1e-12 relative over 1000 steps (slow: 10⁴), while
+  the same equation integrated by a scheme that is not coadjoint (Davie in coordinates) leaves the orbit measurably.
 """
 
 import numpy as np
@@ -130,8 +131,8 @@ def test_coadjoint_scheme_agrees_with_davie_on_the_perturbed_driver(rng):
     a = solve(plain.vector_fields(), X.perturb(s), mu0, Davie()).final
     b = solve(_corrected(g, inertia, xi, s, 0.0), X, mu0, LieHeun(), save_at="end").final
     err = np.max(np.abs(a - b))
-    gaps = [np.max(np.abs(a - solve(_corrected(g, inertia, xi, f * s, 0.0), X, mu0, LieHeun(), save_at="end").final))
-            for f in (-1.0, 2.0)]
+    gaps = [np.max(np.abs(a - solve(_corrected(g, inertia, xi, f * s, 0.0), X, mu0, LieHeun(),
+                                    save_at="end").final)) for f in (-1.0, 2.0)]
     print(f"Lie-Heun (corrected, X) vs Davie (uncorrected, X.perturb(s)): {err:.3g}; wrong variants {gaps}")
     assert err < 0.1, err
     assert min(gaps) > 10 * err, (err, gaps)
