@@ -22,11 +22,15 @@ from .analysis import (
     Equilibrium,
     GibbsMeasure,
     LevelSets,
+    OrbitExpectation,
+    OrbitGibbsMeasure,
     gibbs_beta,
     gibbs_moments,
     isotropic_levy_shift,
+    isotropic_sigma,
     lagrange_top_sleeping_stability,
     modified_hamiltonian,
+    orbit_gibbs_beta,
     rigid_body_equilibria,
     rigid_body_level_sets,
     rigid_body_vector_field,
@@ -101,6 +105,8 @@ __all__ = [
     "Equilibrium", "LevelSets", "rigid_body_equilibria", "rigid_body_level_sets", "isotropic_levy_shift",
     "modified_hamiltonian", "rigid_body_vector_field", "lagrange_top_sleeping_stability",
     "GibbsMeasure", "gibbs_beta", "gibbs_moments",
+    # Theorem 3.1's Gibbs measure on the orbits of compact matrix algebras
+    "OrbitGibbsMeasure", "OrbitExpectation", "orbit_gibbs_beta", "isotropic_sigma",
     # ensembles
     "run_ensemble", "EnsembleResult", "RunningMoments", "moment_observable", "split_moment_features",
     # coloured noise and the Wong–Zakai anomaly

@@ -26,7 +26,7 @@ import mechanics
 import roughpaths
 
 from .model import INERTIA, PI0, SIGMA, THETA, hemisphere_mean, paper_body, s_matrix, standard_error
-from . import chaos, section2, sphere_checks
+from . import chaos, matrix_algebras, section2, sphere_checks
 from .report import CheckResult
 from .tasks import registry_decorator
 
@@ -495,5 +495,6 @@ def check_planar(ctx) -> CheckResult:
 # the conclusion's question (module chaos): fast chaotic dynamics homogenise to a limit with a Lévy-area drift
 register("chaos", "Deterministic chaos: the fast–slow limit carries the Lévy-area drift Alt(E), neither Itô nor "
          "Stratonovich")(chaos.check_chaos)
-for _name, (_title, _check) in sphere_checks.SPHERE_CHECKS.items():   # beyond the paper: Euler on the sphere
+for _name, _title, _check in [*matrix_algebras.MATRIX_CHECKS,      # beyond the rigid body, then beyond the paper
+                              *((n, *tc) for n, tc in sphere_checks.SPHERE_CHECKS.items())]:
     register(_name, _title)(_check)

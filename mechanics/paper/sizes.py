@@ -117,6 +117,14 @@ SIZES: dict = {
                    "eps": _eps(0.02, 0.02, 0.01)},
     "chaos": {"n_paths": _paths(300, 6_000, 20_000, "cat-map orbits (Lorenz: a third, at least 200)", minimum=2),
               "n_steps": _steps(40, 200, 1_000, "fast steps per unit time (Lorenz: twice as many)")},
+    "matrix_prop21": {"n_paths": _paths(2, 8, 32, "paths per algebra (su(3), so(5))"),
+                      "n_steps": _steps(100, 400, 4_000, "steps on [0, 1]")},
+    "matrix_uniform": {"n_paths": _paths(200, 1_500, 20_000, "paths and fresh orbit samples per algebra (T = 1.5, "
+                                         "dt = 0.025)", minimum=2)},
+    "matrix_gibbs": {"n_paths": _paths(100, 600, 6_000, "paths per algebra (su(3), so(5))", minimum=2),
+                     "n_samples": Size(10_000, 50_000, 400_000, "count", "other", "exact orbit samples of the "
+                                       "importance-sampling oracle, per algebra", 2),
+                     "T": _horizon(3.0, 4.0, 12.0, 2.0), "dt": _dt(0.02, 0.02, 0.01)},
     # beyond the paper: Euler on the sphere (mechanics.paper.sphere_checks)
     "sphere_casimirs": {"N": _matrix(32, 64, 128, "matrix size N of Zeitlin's model", 4),
                         "n_steps": _steps(20, 40, 200, "LieHeun steps on [0, 0.5]", minimum=2)},
