@@ -362,6 +362,8 @@ def render_html(meta: RunMetadata, checks: list[CheckResult], figures: list[Figu
     counts = _summary(checks)
     head = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
             "<meta name='viewport' content='width=device-width, initial-scale=1'>",
+            # an empty icon: without one the browser fetches /favicon.ico beside the file (one file, nothing else)
+            "<link rel='icon' href='data:,'>",
             "<title>Verification report: Lévy area correction</title>"]
     if katex is not None:
         head.append(f"<style>/* KaTeX {katex.version}\n{katex.licence}\n*/\n{katex.css}</style>")
