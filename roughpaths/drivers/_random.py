@@ -308,8 +308,8 @@ def _fast_streams_ok() -> bool:
                     ss = np.random.SeedSequence(ent, spawn_key=base)
                     keys = [(0, 0), (1, 1), (2**33 + 5, 0)]
                     s = PathStreams(ss, keys, _force_numpy=False)
-                    # two contiguous blocks (the layout every caller passes: a strided one would
-                    # compile a second specialisation of the kernels, ~15 s of CPU, for this check alone)
+                    # two contiguous blocks (fill copies a strided block into a contiguous one, so that
+                    # no layout compiles a second specialisation of the kernels, ~15 s of CPU)
                     first, rest = np.empty((len(keys), 1000)), np.empty((len(keys), 2000))
                     s.fill(first)
                     s.fill(rest)
@@ -386,7 +386,12 @@ class PathStreams:
         if out.shape[0] != self.n_streams or out.ndim != 2 or out.dtype != np.float64:
             raise ValueError(f"out must be float64 of shape ({self.n_streams}, n), got {out.dtype} {out.shape}.")
         if self._fast:
-            _pcg64_normals(self.states, out)
+            if out.flags.c_contiguous:
+                _pcg64_normals(self.states, out)
+            else:                       # a strided block (e.g. a column slice) would compile every stream kernel
+                block = np.empty(out.shape)     # again for its layout (about 15 s of CPU): fill a copy instead
+                _pcg64_normals(self.states, block)
+                out[...] = block
         else:
             for p, g in enumerate(self._gens):
                 row = out[p]
