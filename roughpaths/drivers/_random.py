@@ -225,7 +225,8 @@ def _pcg64_fill(states, p, out, words):
     needed), then :func:`_ziggurat_fill` turns them into normals. Both passes are tight loops
     without calls (one call per normal measured ~2x slower).
     """
-    sh, sl = _pcg64_rounds(states[p, 0], states[p, 1], states[p, 2], states[p, 3], out, words, 0, 0)
+    zero = np.int64(0)                   # not the literal 0, which numba compiles as a variant of its own
+    sh, sl = _pcg64_rounds(states[p, 0], states[p, 1], states[p, 2], states[p, 3], out, words, zero, zero)
     states[p, 0] = sh
     states[p, 1] = sl
 
@@ -245,11 +246,11 @@ def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
         words_p[j] = _xsl_rr(ph, pl)
         qh, ql = _lcg(qh, ql, qih, qil)
         words_q[j] = _xsl_rr(qh, ql)
-    used, i = _ziggurat_fill(words_p[:n], out_p, 0, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+    used, i = _ziggurat_fill(words_p[:n], out_p, np.int64(0), _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
     for j in range(n - used):
         words_p[j] = words_p[used + j]
     states[p, 0], states[p, 1] = _pcg64_rounds(ph, pl, pih, pil, out_p, words_p, n - used, i)
-    used, i = _ziggurat_fill(words_q[:n], out_q, 0, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+    used, i = _ziggurat_fill(words_q[:n], out_q, np.int64(0), _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
     for j in range(n - used):
         words_q[j] = words_q[used + j]
     states[q, 0], states[q, 1] = _pcg64_rounds(qh, ql, qih, qil, out_q, words_q, n - used, i)
