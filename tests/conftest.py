@@ -85,12 +85,95 @@ def tiny_paper_run(tmp_path_factory):
 
 
 # ------------------------------------------------------------------ two workers (pytest-xdist)
-#: Session fixtures that cost seconds to build: every test that uses one runs on the same worker
-#: (``--dist loadgroup``), so each is built once per run, not once per worker (a test may use both).
-_SHARED_BUILDS = ("docs_site", "tiny_paper_run")
+#: Session fixtures that cost seconds to build, each with its xdist group: every test that uses one runs on
+#: the same worker (``--dist loadgroup``), so each is built once per run, not once per worker. One group per
+#: build, so the docs site and the tiny main-job run are built on two workers at once rather than one after
+#: the other on one. A test that uses both joins the group of the first (the other is then built on its
+#: worker too: correct, only slower; no test does today).
+_SHARED_BUILDS = {"docs_site": "docs-site", "tiny_paper_run": "tiny-paper-run"}
 
 
+@pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config, items):
+    """Mark the tests of a shared build with its ``xdist_group``; then make every group take effect.
+
+    A group takes effect through the suffix ``@group`` of the test's id, by which the controller's
+    ``loadgroup`` scheduler sends the group to one worker. pytest-xdist's worker adds it itself by setting
+    ``item._nodeid``, which pytest 9.2 no longer reads (a node's id is ``item._id``, a ``NodeId``): with
+    pytest 9.2 and pytest-xdist 3.8 every group was spread over both workers, so the docs site and the tiny
+    main-job run were each built twice, once per worker, and the fuzz module was split. Here the suffix is
+    added (last, after xdist's own hook) through whichever attribute the installed pytest reads, and only
+    where it is missing.
+    """
     for item in items:
-        if any(name in getattr(item, "fixturenames", ()) for name in _SHARED_BUILDS):
-            item.add_marker(pytest.mark.xdist_group("shared-builds"))
+        names = getattr(item, "fixturenames", ())
+        group = next((g for fixture, g in _SHARED_BUILDS.items() if fixture in names), None)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
+    if not getattr(config.option, "loadgroup", False):     # set by xdist's worker under --dist loadgroup
+        return
+    for item in items:
+        groups = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                         for m in item.iter_markers("xdist_group")})
+        if not groups or "@" in item.nodeid.rsplit("]", 1)[-1]:
+            continue
+        tagged = f"{item.nodeid}@{'_'.join(groups)}"
+        if isinstance(getattr(item, "_id", None), str) or not hasattr(item, "_id"):
+            item._nodeid = tagged
+        else:
+            from _pytest.nodeid import NodeId          # pytest >= 9.2
+            item._id = NodeId.parse(tagged)
+        assert item.nodeid == tagged, (item.nodeid, tagged)
+
+
+# ------------------------------------------------------------------ where the suite's time goes (opt-in)
+#: ``SUITE_PROFILE=FILE`` writes, per test, its wall and CPU time and the numba compile time it paid
+#: (outermost compiles only, so a kernel that compiles its callees is counted once), one JSON line per test,
+#: appended by every xdist worker; ``python tools/suite_profile.py FILE`` summarises it.
+_PROFILE = os.environ.get("SUITE_PROFILE")
+if _PROFILE:
+    import json
+    import time
+
+    from numba.core import event as _numba_event
+
+    class _CompileClock(_numba_event.Listener):
+        depth = 0
+        start = 0.0
+        total = 0.0
+        kernels: list = []
+
+        def on_start(self, event):
+            if self.depth == 0:
+                self.start = time.perf_counter()
+            self.depth += 1
+
+        def on_end(self, event):
+            self.depth -= 1
+            if self.depth == 0:
+                t = time.perf_counter() - self.start
+                self.total += t
+                f = getattr(event.data.get("dispatcher"), "py_func", None)
+                self.kernels.append((f"{getattr(f, '__module__', '?')}.{getattr(f, '__qualname__', '?')}",
+                                     str(event.data.get("args"))[:200], round(t, 3)))
+
+    def _children_cpu():
+        import resource
+        r = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return r.ru_utime + r.ru_stime
+
+    _CLOCK = _CompileClock()
+    _numba_event.register("numba:compile", _CLOCK)
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_protocol(item, nextitem):
+        _CLOCK.total, _CLOCK.kernels = 0.0, []
+        w0, c0, k0 = time.perf_counter(), time.process_time(), _children_cpu()
+        yield
+        rec = dict(test=item.nodeid, worker=os.environ.get("PYTEST_XDIST_WORKER", "main"),
+                   group=next((m.args[0] for m in item.iter_markers("xdist_group")), None),
+                   start=w0, wall=time.perf_counter() - w0, cpu=time.process_time() - c0,
+                   children_cpu=_children_cpu() - k0,
+                   compile=_CLOCK.total, kernels=_CLOCK.kernels)
+        with open(_PROFILE, "a") as fh:
+            fh.write(json.dumps(rec) + "\n")

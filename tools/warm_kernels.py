@@ -15,8 +15,11 @@ alphabet sizes, lone or long chunked paths, Lie–Euler and the implicit midpoin
 variant on a user's first call, a few seconds each (``benchmarks/bench_first_call.py``).
 
 ``--more`` adds what the test suite reaches besides (lone, wide and long chunked paths, the rough-path
-signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule): ``tools/setup_env.sh`` passes
-it when it installs the test extra, so those compiles happen at set-up on both cores, not inside the tests.
+signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule, the coadjoint schemes on rough
+paths built from arrays, the midpoint rule in six dimensions): ``tools/setup_env.sh`` passes it when it
+installs the test extra, so those compiles happen at set-up on both cores, not inside the tests (where both
+xdist workers may compile the same kernel). ``SUITE_PROFILE`` (``tests/conftest.py``) and
+``tools/suite_profile.py`` list what the suite still compiles.
 
 Usage: ``python tools/warm_kernels.py [--part roughpaths|mechanics] [--more]`` (prints the time each family
 took).
@@ -83,16 +86,34 @@ def warm_more_signatures() -> None:
 
 def warm_more_coadjoint() -> None:
     """For the test suite (``--more``): Lie–Euler and the implicit midpoint rule on so(3), se(3) and a user
-    algebra."""
-    from mechanics import ImplicitMidpoint, LieEuler, LiePoissonSystem, heavy_top, rigid_body
-    from mechanics.systems.lie_algebra import su2
-    from roughpaths import BrownianDriver, solve
+    algebra; every scheme on the rough paths a user builds (a level-1 path, increments with areas, a path's
+    lift), whose arrays reach the so(3) and se(3) kernels writeable or read-only in other combinations than
+    a driver's (each combination is a specialisation of its own, 6-8 s of CPU); the midpoint rule's
+    six-dimensional variant of the generic kernel (se(3) from its constants, so(4))."""
+    from mechanics import ImplicitMidpoint, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body
+    from mechanics.systems.lie_algebra import LieAlgebra, se3, su2
+    from roughpaths import BrownianDriver, RoughPath, solve
 
-    for system in (LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1), rigid_body([1.0, 2.0, 3.0], sigma=0.1),
-                   heavy_top([1.0, 2.0, 3.0], chi=[0.0, 0.0, 1.0], sigma=0.1)):
+    rigid, top = rigid_body([1.0, 2.0, 3.0], sigma=0.1), heavy_top([1.0, 2.0, 3.0], chi=[0.0, 0.0, 1.0], sigma=0.1)
+    for system in (LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1), rigid, top):
         X = BrownianDriver(system.n_noise, seed=0, dt=0.01, n_steps=2, batch_shape=(2,))
         for method in (LieEuler(), ImplicitMidpoint()):
             solve(system, X, np.ones((2, system.dim)), method)
+    rng = np.random.default_rng(0)
+    times = np.linspace(0.0, 0.02, 3)
+    for system in (rigid, top):
+        dw = 0.1 * rng.standard_normal((2, 2, system.n_noise))
+        sym = 0.5 * dw[..., :, None] * dw[..., None, :]
+        lift = RoughPath.from_path(np.concatenate([np.zeros((2, 1, system.n_noise)), np.cumsum(dw, 1)], 1),
+                                   times=times)
+        paths = (RoughPath.from_increments(dw, times=times), RoughPath.from_increments(dw, sym, times=times), lift,
+                 RoughPath(lift.increments, sym - lift.step_levy_areas, times=times), lift.restrict(times[::2]))
+        for X in paths:
+            for method in (LieEuler(), LieHeun(), ImplicitMidpoint()):
+                solve(system, X, np.ones((2, system.dim)), method)
+    se3c = LiePoissonSystem(LieAlgebra(se3().structure_constants, name="se3 (constants)"), np.diag(np.arange(1.0, 7.0)),
+                            0.3 * rng.standard_normal((3, 6)), theta=0.1)
+    solve(se3c, BrownianDriver(3, seed=0, dt=0.01, n_steps=2, batch_shape=(2,)), np.ones((2, 6)), ImplicitMidpoint())
 
 
 def warm_signature_kernels() -> None:

@@ -351,9 +351,9 @@ def _exact_areas_d2(dW, h, states, table, step, n_terms, t1, t2, ito, out):
             w0 = dW[p, r, 0]
             w1 = dW[p, r, 1]
             mu = (w0 * w0 + w1 * w1) / hr
-            if table.shape[1] == 0:
-                a, sh, sl = _series_area(mu, n_terms, t1, t2, sh, sl, ih, il)
-            else:
+            a = 0.0
+            series = table.shape[1] == 0
+            if not series:
                 z, sh, sl = _pcg64_normal(sh, sl, ih, il)
                 s = np.sqrt(mu)
                 if s <= top and abs(z) <= top:
@@ -361,7 +361,9 @@ def _exact_areas_d2(dW, h, states, table, step, n_terms, t1, t2, ito, out):
                     if z < 0.0:
                         a = -a
                 else:
-                    a, sh, sl = _series_area(mu, n_terms, t1, t2, sh, sl, ih, il)
+                    series = True
+            if series:          # one call site: _series_area is inlined once, not twice (compile time)
+                a, sh, sl = _series_area(mu, n_terms, t1, t2, sh, sl, ih, il)
             A = hr * a
             sym = 0.5 * w0 * w1
             out[p, r, 0, 0] = 0.5 * w0 * w0 - (0.5 * hr if ito else 0.0)

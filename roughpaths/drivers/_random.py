@@ -225,7 +225,8 @@ def _pcg64_fill(states, p, out, words):
     needed), then :func:`_ziggurat_fill` turns them into normals. Both passes are tight loops
     without calls (one call per normal measured ~2x slower).
     """
-    sh, sl = _pcg64_rounds(states[p, 0], states[p, 1], states[p, 2], states[p, 3], out, words, 0, 0)
+    zero = np.int64(0)                   # not the literal 0, which numba compiles as a variant of its own
+    sh, sl = _pcg64_rounds(states[p, 0], states[p, 1], states[p, 2], states[p, 3], out, words, zero, zero)
     states[p, 0] = sh
     states[p, 1] = sl
 
@@ -245,11 +246,11 @@ def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
         words_p[j] = _xsl_rr(ph, pl)
         qh, ql = _lcg(qh, ql, qih, qil)
         words_q[j] = _xsl_rr(qh, ql)
-    used, i = _ziggurat_fill(words_p[:n], out_p, 0, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+    used, i = _ziggurat_fill(words_p[:n], out_p, np.int64(0), _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
     for j in range(n - used):
         words_p[j] = words_p[used + j]
     states[p, 0], states[p, 1] = _pcg64_rounds(ph, pl, pih, pil, out_p, words_p, n - used, i)
-    used, i = _ziggurat_fill(words_q[:n], out_q, 0, _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
+    used, i = _ziggurat_fill(words_q[:n], out_q, np.int64(0), _ZIG_K, _ZIG_W, _ZIG_F, _ZIG_R, _ZIG_INV_R)
     for j in range(n - used):
         words_q[j] = words_q[used + j]
     states[q, 0], states[q, 1] = _pcg64_rounds(qh, ql, qih, qil, out_q, words_q, n - used, i)
@@ -308,8 +309,8 @@ def _fast_streams_ok() -> bool:
                     ss = np.random.SeedSequence(ent, spawn_key=base)
                     keys = [(0, 0), (1, 1), (2**33 + 5, 0)]
                     s = PathStreams(ss, keys, _force_numpy=False)
-                    # two contiguous blocks (the layout every caller passes: a strided one would
-                    # compile a second specialisation of the kernels, ~15 s of CPU, for this check alone)
+                    # two contiguous blocks (fill copies a strided block into a contiguous one, so that
+                    # no layout compiles a second specialisation of the kernels, ~15 s of CPU)
                     first, rest = np.empty((len(keys), 1000)), np.empty((len(keys), 2000))
                     s.fill(first)
                     s.fill(rest)
@@ -386,7 +387,12 @@ class PathStreams:
         if out.shape[0] != self.n_streams or out.ndim != 2 or out.dtype != np.float64:
             raise ValueError(f"out must be float64 of shape ({self.n_streams}, n), got {out.dtype} {out.shape}.")
         if self._fast:
-            _pcg64_normals(self.states, out)
+            if out.flags.c_contiguous:
+                _pcg64_normals(self.states, out)
+            else:                       # a strided block (e.g. a column slice) would compile every stream kernel
+                block = np.empty(out.shape)     # again for its layout (about 15 s of CPU): fill a copy instead
+                _pcg64_normals(self.states, block)
+                out[...] = block
         else:
             for p, g in enumerate(self._gens):
                 row = out[p]

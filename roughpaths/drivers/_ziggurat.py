@@ -115,7 +115,7 @@ def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
     """
     n = out.size
     nr = raw.size
-    pos, i = _ziggurat_run(raw, 0, out, start, ki, wi)
+    pos, i = _ziggurat_run(raw, np.int64(0), out, start, ki, wi)    # int64, not the literal 0: one variant
     while i < n and pos < nr:                  # raw[pos] was rejected by the box test
         idx, rabs, neg = _split_word(raw[pos])
         v, nxt, status = _ziggurat_slow(raw, pos + 1, idx, rabs, _abscissa(idx, rabs, neg, wi), ki, wi, fi,
