@@ -11,8 +11,11 @@ The driver generates per-path seeded increments and areas block by block; the so
 structure-of-arrays numba kernel (SIMD over paths, trig-free Rodrigues). The driver alone is timed
 too: with the area it is most of the cost. Two rows answer the issue "One engine": the same problem
 through ``run_ensemble`` (target ≤ 1.3x the direct solve) and the heavy top on se(3)* with the same
-inertia, noise and θ (target ≤ 3x the rigid body per path-step; its column shows ``||Γ(T)| - 1|``,
-a Casimir). Peers (where installed, in the
+inertia, noise and θ and the same driver, Davie's areas (target ≤ 3x the rigid body per path-step; its column
+shows ``||Γ(T)| - 1|``, a Casimir; until the driver's default became the error-controlled areas this row took
+the default, so it compared two drivers: 2.5x before that change, 5.2x after, in the same interleaved run;
+``benchmarks/bench_coadjoint_kernels.py --ratio-only`` has the table by scheme and thread count). Peers (where
+installed, in the
 same run): diffrax Heun on a batched (3, N) state (jit), torchsde Heun (noise_type="general",
 sde_type="stratonovich"), sdeint stratHeun (no batching: fewer paths, time scaled per path-step).
 Reported: median wall time and median process CPU time (all threads) of ``--repeats`` runs (after a
@@ -87,7 +90,8 @@ def bench_driver_only(n_paths, n_steps, repeats):
 
 
 def bench_heavy_top(n_paths, n_steps, repeats):
-    """The heavy top on se(3)* (same inertia, θ, σ e_i rotational noise, χ = e3), LieHeun + Davie area."""
+    """The heavy top on se(3)* (same inertia, θ, σ e_i rotational noise, χ = e3), LieHeun + Davie area (the rigid
+    body's driver)."""
     from mechanics import LieHeun, heavy_top
     from roughpaths import BrownianDriver, solve
 
@@ -95,7 +99,7 @@ def bench_heavy_top(n_paths, n_steps, repeats):
     mu0 = np.array([0.0, 0.0, 1.0, 0.0, 0.6, 0.8])
 
     def run(n, p, seed):
-        drv = BrownianDriver(3, seed=seed, dt=DT, n_steps=n, batch_shape=(p,))
+        drv = BrownianDriver(3, seed=seed, dt=DT, n_steps=n, batch_shape=(p,), levy_area="davie")
         return solve(top, drv, mu0, LieHeun(), save_at="end").final[..., 3:]   # Γ: |Γ| = 1 is a Casimir
 
     run(10, 2, 0)

@@ -27,7 +27,12 @@ The coadjoint action :math:`e^{\mathrm{ad}^*_\sigma}\mu`, per member
   \mathrm{ad}^*_\sigma/2^s` with :math:`\theta/2^s\le\tfrac12`, Taylor of the degree of the table, then
   ``s`` squarings, times ``μ``.
 
-Layout: a block of up to :data:`BLOCK` members lives as ``(n, BLOCK)`` rows (structure of arrays);
+se(3) (the heavy top): Lie–Euler and Lie–Heun with three noise fields run :mod:`._se3_block`, the same
+numbers bit for bit with se(3)'s structure constants written out (chosen by the table of non-zeros, so se(3)
+given by its constants takes it too).
+
+Layout: a block of up to :data:`BLOCK` members lives as ``(n, BLOCK)`` rows (structure of arrays, the row
+operations of :mod:`._soa_rows`);
 each operation is a loop over the members of the block, pure arithmetic, so LLVM vectorises it
 (no fast-math: vector and scalar loops round alike). Blocks run in parallel (:func:`roughpaths.validation.parallel_ranges`, numba's
 number of threads: ``numba.set_num_threads`` / ``NUMBA_NUM_THREADS``); a member's result does not depend
@@ -44,159 +49,13 @@ import numba
 import numpy as np
 
 from roughpaths.validation import parallel_ranges
+from . import _se3_block
 from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1
+from ._soa_rows import (CHORD_FAILED, NON_FINITE, OK, STEPS, ad_star_rows, algebra_tables, eta_rows,
+                        sparse_rows, velocity_rows)
 
-OK, NON_FINITE, CHORD_FAILED = 0, 1, 2
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
 BLOCK = 128
-def algebra_tables(c):
-    """Non-zero structure constants ``(ti, tj, tk, tv)`` grouped by ``tj`` (row ``j``'s terms are
-    ``start[j] .. start[j+1]``), ``start`` and ``cnorm (n,)`` of ``c (n, n, n)``."""
-    c = np.asarray(c, dtype=np.float64)
-    n = c.shape[0]
-    ti, tj, tk = np.nonzero(c)
-    order = np.lexsort((tk, ti, tj))                           # grouped by output component j
-    ti, tj, tk = ti[order], tj[order], tk[order]
-    tv = np.ascontiguousarray(c[ti, tj, tk])
-    start = np.searchsorted(tj, np.arange(n + 1)).astype(np.int64)
-    cnorm = np.ascontiguousarray(np.max(np.sum(np.abs(c), axis=2), axis=1))
-    return ti.astype(np.int64), tj.astype(np.int64), tk.astype(np.int64), tv, start, cnorm
-
-
-def sparse_rows(m):
-    """Non-zeros of ``m (n, n)`` by rows: ``(cols, vals, start)`` (row ``i``: ``start[i] .. start[i+1]``)."""
-    m = np.asarray(m, dtype=np.float64)
-    rows, cols = np.nonzero(m)
-    start = np.searchsorted(rows, np.arange(m.shape[0] + 1)).astype(np.int64)
-    return cols.astype(np.int64), np.ascontiguousarray(m[rows, cols]), start
-
-
-# ---------------------------------------------------------------------- block (structure-of-arrays) operations
-# Every output row is written in passes over the block's members (measured: one non-zero per pass is
-# faster than two per pass here: 2.7 against 4.6 ns per member for so(3)'s ad*, 3.7 with a zeroing pass).
-@numba.njit(cache=True)
-def _ad_star_rows(x, mu, out, ti, tk, tv, start, bc):
-    """out[j, p] = (ad*_{x[:, p]} mu[:, p])_j for p < bc (terms grouped by j: ``start[j] .. start[j+1]``;
-    one pass per non-zero, the first one of a row writing it)."""
-    for j in range(out.shape[0]):
-        o = out[j]
-        a, b = start[j], start[j + 1]
-        if a == b:
-            for p in range(bc):
-                o[p] = 0.0
-        for t in range(a, b):
-            xa, ma, va = x[ti[t]], mu[tk[t]], tv[t]
-            if t == a:
-                for p in range(bc):
-                    o[p] = va * xa[p] * ma[p]
-            else:
-                for p in range(bc):
-                    o[p] += va * xa[p] * ma[p]
-
-
-@numba.njit(cache=True)
-def _affine_rows(base, const, cols, vals, start, x, out, bc, use_base):
-    """out[i, p] = ((base[i, p] if use_base) + const[i]) + Σ_t vals[t] x[cols[t], p] over the row's non-zeros
-    (one pass per non-zero; the first also writes the constant)."""
-    for i in range(out.shape[0]):
-        o = out[i]
-        c = const[i]
-        bi = base[i]
-        a, b = start[i], start[i + 1]
-        if a == b:
-            if use_base:
-                for p in range(bc):
-                    o[p] = bi[p] + c
-            else:
-                for p in range(bc):
-                    o[p] = c
-        for t in range(a, b):
-            xa, va = x[cols[t]], vals[t]
-            if t == a and use_base:
-                for p in range(bc):
-                    o[p] = (bi[p] + c) + va * xa[p]
-            elif t == a:
-                for p in range(bc):
-                    o[p] = c + va * xa[p]
-            else:
-                for p in range(bc):
-                    o[p] += va * xa[p]
-
-
-@numba.njit(cache=True)
-def _velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv, start, bc):
-    """out = w(mu) = g + θ M⁻¹ ad*_{g+f} mu, g = Q mu + lin; ``qs``, ``mts``: the non-zeros of Q and θ M⁻¹."""
-    _affine_rows(g, lin, qs[0], qs[1], qs[2], mu, g, bc, False)
-    if theta == 0.0:
-        for i in range(mu.shape[0]):
-            o, gi = out[i], g[i]
-            for p in range(bc):
-                o[p] = gi[p]
-        return
-    if has_f:
-        for i in range(mu.shape[0]):
-            fi = f[i]
-            o, gi = t1[i], g[i]
-            for p in range(bc):
-                o[p] = gi[p] + fi
-        _ad_star_rows(t1, mu, t2, ti, tk, tv, start, bc)
-    else:
-        _ad_star_rows(g, mu, t2, ti, tk, tv, start, bc)
-    _affine_rows(g, mts[3], mts[0], mts[1], mts[2], t2, out, bc, True)
-
-
-@numba.njit(cache=True)
-def _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
-    """:func:`_eta_rows` for three noise components: the same sums in the same order (the same bits), the
-    loops over the components and pairs written out."""
-    n = e.shape[1]
-    for p in range(bc):
-        for kk in range(kc):
-            k = k0 + kk
-            x0 = dX[lo + p, k, 0]
-            x1 = dX[lo + p, k, 1]
-            x2 = dX[lo + p, k, 2]
-            if area:
-                a0 = 0.5 * (dXX[lo + p, k, 0, 1] - dXX[lo + p, k, 1, 0])
-                a1 = 0.5 * (dXX[lo + p, k, 0, 2] - dXX[lo + p, k, 2, 0])
-                a2 = 0.5 * (dXX[lo + p, k, 1, 2] - dXX[lo + p, k, 2, 1])
-            for i in range(n):
-                acc = 0.0 + x0 * xi[0, i]
-                acc += x1 * xi[1, i]
-                acc += x2 * xi[2, i]
-                if area:
-                    acc += a0 * brk[0, i]
-                    acc += a1 * brk[1, i]
-                    acc += a2 * brk[2, i]
-                e[kk, i, p] = acc
-
-
-@numba.njit(cache=True)
-def _eta_rows(dX, dXX, area, lo, bc, k0, kc, xi, brk, pi, pj, e):
-    """e[kk, :, p] = Σ_r dX_r ξ_r + Σ_{i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for members lo .. lo+bc-1 and
-    steps k0 .. k0+kc-1 (member by member, so each member's increments are read in order)."""
-    n = e.shape[1]
-    nm = dX.shape[2]
-    if nm == 3 and (not area or pi.shape[0] == 3):
-        _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e)
-        return
-    for p in range(bc):
-        for kk in range(kc):
-            k = k0 + kk
-            for i in range(n):
-                acc = 0.0
-                for r in range(nm):
-                    acc += dX[lo + p, k, r] * xi[r, i]
-                e[kk, i, p] = acc
-            if area:
-                for r in range(pi.shape[0]):
-                    a = 0.5 * (dXX[lo + p, k, pi[r], pj[r]] - dXX[lo + p, k, pj[r], pi[r]])
-                    for i in range(n):
-                        e[kk, i, p] += a * brk[r, i]
-
-
-#: Steps whose stochastic velocities are formed at once (a (STEPS, n, BLOCK) buffer per block).
-STEPS = 16
 
 
 @lru_cache(maxsize=None)
@@ -236,7 +95,7 @@ def _block_kernel(C: int, N: int):
             dt = dts[k]
             kk = k % STEPS
             if kk == 0:
-                _eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
+                eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
             e = ebuf[kk]
             nbig = 0
             if C == 2:
@@ -244,20 +103,20 @@ def _block_kernel(C: int, N: int):
                     big[p] = True
                 nbig = bc
             else:
-                _velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, w0, ti, tk, tv, start, bc)
+                velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, w0, ti, tk, tv, start, bc)
                 for i in range(n):
                     si, wi, ei = s[i], w0[i], e[i]
                     for p in range(bc):
                         si[p] = wi[p] * dt + ei[p]
                 if C == 1:
                     # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
-                    _ad_star_rows(s, mu, a1, ti, tk, tv, start, bc)
-                    _ad_star_rows(s, a1, a2, ti, tk, tv, start, bc)
+                    ad_star_rows(s, mu, a1, ti, tk, tv, start, bc)
+                    ad_star_rows(s, a1, a2, ti, tk, tv, start, bc)
                     for i in range(n):
                         pr, mi, b1, b2 = pred[i], mu[i], a1[i], a2[i]
                         for p in range(bc):
                             pr[p] = mi[p] + b1[p] + 0.5 * b2[p]
-                    _velocity_rows(pred, lin, f, has_f, theta, qs, mts, g, t1, t2, w1, ti, tk, tv, start, bc)
+                    velocity_rows(pred, lin, f, has_f, theta, qs, mts, g, t1, t2, w1, ti, tk, tv, start, bc)
                     for i in range(n):
                         si, wi, vi, ei = s[i], w0[i], w1[i], e[i]
                         for p in range(bc):
@@ -279,7 +138,7 @@ def _block_kernel(C: int, N: int):
                         thmax = max(thmax, th[p])
                 r = 1
                 while thmax > degth[r - 1]:                # a1: the sum, term: the current term
-                    _ad_star_rows(s, mu if r == 1 else term, term2, ti, tk, tv, start, bc)
+                    ad_star_rows(s, mu if r == 1 else term, term2, ti, tk, tv, start, bc)
                     inv = 1.0 / r
                     lev = degth[r - 1]
                     for i in range(n):
@@ -363,6 +222,9 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
 
     Returns ``(y, saved (B, S, n), first_bad (B,), reason (B,))``. Blocks of :data:`BLOCK` members run in
     parallel on numba's threads (``numba.set_num_threads``); the result does not depend on their number.
+    Lie–Euler and Lie–Heun on se(3) with three noise fields (the structure constants' non-zeros those of
+    se(3): the heavy top) run :mod:`._se3_block`'s kernel, which computes the same numbers with less memory
+    traffic.
     """
     data = system.quadratic_velocity_data()
     ti, tj, tk, tv, start, cnorm = algebra_tables(system.algebra.structure_constants)
@@ -386,6 +248,9 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
             bool(stop_on_failure))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
-    kernel = _block_kernel(int(code), n if code == 2 and n in (3, 6) else 0)
-    parallel_ranges(lambda lo, hi: kernel(*args, lo, hi, *tail), nb, BLOCK)
+    if code != 2 and nm == 3 and _se3_block.has_se3_table(ti, tj, tk, tv):   # the same numbers, written out
+        kernel, block = _se3_block.block_kernel(int(code)), _se3_block.B
+    else:
+        kernel, block = _block_kernel(int(code), n if code == 2 and n in (3, 6) else 0), BLOCK
+    parallel_ranges(lambda lo, hi: kernel(*args, lo, hi, *tail), nb, block)
     return y, out, first_bad, reason

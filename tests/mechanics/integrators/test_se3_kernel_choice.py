@@ -1,6 +1,6 @@
-"""The heavy top (se(3)*): Lie–Euler and Lie–Heun run the generic kernel, the implicit midpoint rule the
-hand-written one; each agrees with the numpy scheme (``Solver.integrate``'s step loop) and keeps both
-Casimirs, |Γ|² and Π·Γ."""
+"""The heavy top (se(3)*): Lie–Euler and Lie–Heun run the generic kernel's entry point (which runs its se(3)
+block kernel, ``test_se3_block_kernel.py``), the implicit midpoint rule the hand-written one; each agrees with
+the numpy scheme (``Solver.integrate``'s step loop) and keeps both Casimirs, |Γ|² and Π·Γ."""
 
 import numpy as np
 import pytest
