@@ -38,6 +38,8 @@ import numpy as np
 from roughpaths import expm_batched
 from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_rng
 
+from ._matrix_exp import conjugate_members, one_norms
+
 __all__ = ["MatrixLieAlgebra", "haar_matrices"]
 
 #: Draws of the random closure check of a user basis, from a fixed seed (the verdict is reproducible).
@@ -336,15 +338,21 @@ class MatrixLieAlgebra:
 
     def conjugate(self, sigma_matrix, M) -> np.ndarray:
         r""":math:`e^{-\sigma} M e^{\sigma}` for matrices ``(..., N, N)`` (the coadjoint flow on matrices):
-        ``Q M Q^H`` with ``Q = expm(-σ)`` on compact algebras (``Q`` unitary), ``Q M Q^{-1}`` otherwise; the
-        result is projected back onto the algebra (the round-off that leaves it)."""
-        Q = expm_batched(-np.asarray(sigma_matrix))
-        QM = Q @ M
-        if self.compact:
-            out = QM @ np.conj(np.swapaxes(Q, -1, -2))
+        ``Q M Q^H`` with ``Q = expm(-σ)`` on compact algebras (``Q`` unitary), ``Q M Q^{-1}`` otherwise, each member
+        on its own (:mod:`mechanics.systems._matrix_exp`); the result is projected back onto the algebra (the
+        round-off that leaves it). A member with a non-finite ``σ`` gives NaN."""
+        S, M = np.broadcast_arrays(np.asarray(sigma_matrix), np.asarray(M))
+        shape = S.shape
+        S, M = S.reshape((-1,) + shape[-2:]), M.reshape((-1,) + shape[-2:])
+        with np.errstate(over="ignore", invalid="ignore"):
+            norms = one_norms(S)
+        ok = np.isfinite(norms)
+        if np.all(ok):
+            out = conjugate_members(S, M, self.compact, norms)
         else:
-            out = np.swapaxes(np.linalg.solve(np.swapaxes(Q, -1, -2), np.swapaxes(QM, -1, -2)), -1, -2)
-        return self._project(out)
+            out = np.full(S.shape, np.nan, dtype=np.result_type(S, M))
+            out[ok] = conjugate_members(S[ok], M[ok], self.compact, norms[ok])
+        return self._project(out).reshape(shape)
 
     def _project(self, X):
         """A projection onto the algebra (the identity on its elements): for the built-in algebras the defining
@@ -367,8 +375,10 @@ class MatrixLieAlgebra:
                                    np.concatenate([Xt[..., :h, h:], -Xt[..., :h, :h]], -1)], -2)
             X = 0.5 * (X + JXtJ)
         if kind in ("skew_traceless", "traceless"):
-            tr = np.trace(X, axis1=-2, axis2=-1) / N
-            X = X - tr[..., None, None] * np.eye(N)
+            if kind == "traceless":
+                X = np.array(X, dtype=np.result_type(X, np.float64))      # a fresh copy, updated in place
+            flat = X.reshape(-1, N * N)                                   # a view of the fresh array
+            flat[:, :: N + 1] -= (np.trace(X, axis1=-2, axis2=-1) / N).reshape(-1, 1)
         return X
 
     # ------------------------------------------------------------------ invariants

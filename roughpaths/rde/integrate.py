@@ -221,7 +221,8 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     check_memory(8.0 * members * idx.size * e, f"the saved states ({members:.0f} member(s) x {idx.size} "
                  f"time(s) x {e})", "save fewer times (save_at='end' or a coarser array of grid times) or "
                  "solve the batch in parts")
-    work, blocks_what = _working_bytes(driver, block_steps, members, e, level, int(idx.size))
+    work, blocks_what = _working_bytes(driver, block_steps, members, e, level, int(idx.size),
+                                       solver.step_nbytes(fields) if hasattr(solver, "step_nbytes") else None)
     check_memory(work, f"the solver's working arrays ({members:.0f} member(s): {blocks_what}, the states saved "
                        f"per block and one step's temporaries)",
                  "pass a smaller block_steps, or solve the batch in parts (driver.select(...), or executor=...)")
@@ -271,7 +272,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     return Solution(times=times[idx].copy(), states=out, failed_step=failed_step, stats=stats)
 
 
-def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_saved: int):
+def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_saved: int, step_bytes=None):
     """Bytes a fixed-step :func:`solve` holds besides its saved states, and what holds them (for the message).
 
     With ``M`` members, ``N`` steps, blocks of ``K`` steps, ``d`` noise and ``e`` state dimensions:
@@ -283,7 +284,8 @@ def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_sa
     * one step's temporaries, per member: the slice of the area (d²) and of level 3 (d³) the step is given,
       the fields' values and their product with the area (2 e d), their Jacobians (d e²), the linear
       generators (2 e²) with a log-ODE step's matrix exponential (up to 14 e², scaling and squaring) and up to
-      eight state-sized sums (8 e), 8 bytes each.
+      eight state-sized sums (8 e), 8 bytes each; or, besides the areas, what the solver states
+      (``step_bytes``, contract item 9 of :class:`~roughpaths.Solver`).
     """
     N, d = driver.n_steps, driver.dim
     if isinstance(driver, Driver):
@@ -297,6 +299,8 @@ def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_sa
         K, blocks, what = N, 0.0, "the path read in place"
     d3 = float(d) ** 3 if level >= 3 else 0.0
     step = float(d) ** 2 + d3 + 2.0 * e * d + float(d) * e * e + 16.0 * e * e + 8.0 * e
+    if step_bytes is not None:
+        step = float(d) ** 2 + d3 + float(step_bytes) / 8.0
     return (blocks + 8.0 * members * (min(K, n_saved) * e + 2 * e + 1 + step) + 4096.0), what
 
 
