@@ -139,3 +139,31 @@ def test_su64_hundred_paths_thousand_steps_bounded_memory():
     assert drift <= 1e-12, drift
     assert peak < 400 * 2 ** 20                                          # bounded: ~0.25 GiB of state and blocks
     assert np.all(np.isfinite(final))
+
+
+def test_dispatch_by_cost_same_equations_either_way():
+    """The cost model (integrators/_dispatch.py) runs a small matrix algebra with small steps on the compiled
+    constants kernel and a structure-constant algebra with a matrix basis and large steps on the matrix path;
+    the choice ignores the batch, and both representations give the same solution (to round-off)."""
+    from mechanics.integrators._dispatch import choose
+
+    small, rng = _system(mechanics.su(3), amp=0.01)
+    dts = np.full(5, 0.01)
+    twin, on_matrix = choose(small, dts)
+    assert not on_matrix and isinstance(twin.algebra, LieAlgebra)
+    g = mechanics.so(8)
+    consts = LieAlgebra.from_matrix_basis(g.basis, name="so8 from its basis")
+    big = LiePoissonSystem(consts, np.diag(np.linspace(1.0, 2.0, 28)), 1.7 * rng.standard_normal((3, 28)), theta=0.3)
+    twin, on_matrix = choose(big, dts)
+    assert on_matrix and isinstance(twin.algebra, MatrixLieAlgebra)
+    mu0 = rng.standard_normal((3, 28)) / 3.0
+    X = BrownianDriver(3, seed=4, dt=0.01, n_steps=10, batch_shape=(3,)).rough_path()
+    dispatched = solve(big, X, mu0, LieHeun()).states
+    coadjoint_base_choose = coadjoint_base.choose
+    try:
+        coadjoint_base.choose = lambda system, dts: (system, False)        # the constants kernel, forced
+        kernel = solve(big, X, mu0, LieHeun()).states
+    finally:
+        coadjoint_base.choose = coadjoint_base_choose
+    assert np.max(np.abs(dispatched - kernel)) <= 1e-12 * np.max(np.abs(kernel))
+    assert np.array_equal(solve(big, X[1:2], mu0[1:2], LieHeun()).states, dispatched[1:2])
