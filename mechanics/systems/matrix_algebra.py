@@ -110,6 +110,7 @@ class MatrixLieAlgebra:
         if defect > atol * max(1.0, scale) ** 2:
             raise ValueError(f"the span of basis is not closed under the commutator (the bracket of two random "
                              f"elements leaves the span by {defect:.3g}); it is not a Lie algebra basis.")
+        self._structure = _whole_algebra(b, scale)        # all of so(N), u(N) or su(N): project entrywise
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -456,6 +457,21 @@ def _rebuild(name, N, coo, dtype, signs, compact, degrees, structure):
     basis = np.zeros((int(coo.row.max()) + 1, N * N), dtype=np.dtype(dtype))
     basis[coo.row, coo.col] = coo.data
     return MatrixLieAlgebra(basis.reshape(-1, N, N), name=name, compact=compact, casimir_degrees=degrees)
+
+
+def _whole_algebra(b, scale):
+    """``"skew"`` / ``"skew_traceless"`` when a user basis ``b (n, N, N)`` spans all of so(N) (a real basis), u(N) or
+    su(N): there the entrywise projection of :meth:`MatrixLieAlgebra._project` is the trace-form one (the
+    complement is the (Hermitian) symmetric matrices, and ``iℝ·I`` for su(N)); otherwise ``None``."""
+    n, N = b.shape[0], b.shape[1]
+    if np.max(np.abs(b + np.conj(np.swapaxes(b, 1, 2)))) > 1e-14 * scale:
+        return None
+    if b.dtype.kind != "c":
+        return "skew" if n == N * (N - 1) // 2 else None
+    if n == N * N:
+        return "skew"
+    traceless = np.max(np.abs(np.trace(b, axis1=1, axis2=2))) <= 1e-14 * scale * N
+    return "skew_traceless" if traceless and n == N * N - 1 else None
 
 
 def _closure_defect(alg: MatrixLieAlgebra) -> float:

@@ -167,3 +167,19 @@ def test_dispatch_by_cost_same_equations_either_way():
         coadjoint_base.choose = coadjoint_base_choose
     assert np.max(np.abs(dispatched - kernel)) <= 1e-12 * np.max(np.abs(kernel))
     assert np.array_equal(solve(big, X[1:2], mu0[1:2], LieHeun()).states, dispatched[1:2])
+
+
+def test_user_basis_of_a_whole_algebra_projects_entrywise():
+    """A user basis spanning all of su(3) (a random recombination of the built-in one) projects entrywise, and that
+    equals the trace-form projection through the coordinates; a basis of so(3) held as complex matrices (a
+    subalgebra of u(3)) keeps the projection through the coordinates."""
+    rng = np.random.default_rng(2)
+    E = mechanics.su(3).basis
+    mix = rng.standard_normal((8, 8))
+    user = MatrixLieAlgebra(np.einsum("ij,jab->iab", mix, E))
+    X = rng.standard_normal((5, 3, 3)) + 1j * rng.standard_normal((5, 3, 3))
+    through_coordinates = user.to_matrix(user.from_matrix(X))
+    assert user._structure == "skew_traceless"
+    np.testing.assert_allclose(user._project(X), through_coordinates, atol=1e-13)
+    sub = MatrixLieAlgebra(mechanics.so(3).basis.astype(complex))
+    assert sub._structure is None
