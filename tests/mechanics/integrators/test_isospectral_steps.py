@@ -183,3 +183,20 @@ def test_user_basis_of_a_whole_algebra_projects_entrywise():
     np.testing.assert_allclose(user._project(X), through_coordinates, atol=1e-13)
     sub = MatrixLieAlgebra(mechanics.so(3).basis.astype(complex))
     assert sub._structure is None
+
+
+def test_casimirs_kept_with_large_steps(matrix_path):
+    """Steps whose exponential needs several squarings (su(16), noise 1.0 per component: ||σ||₁ ~ 30): the
+    squarings multiply Q's unitarity defect, which the Newton–Schulz step of _matrix_exp restores (without it:
+    3.8e-11 here, measured)."""
+    from mechanics.systems._matrix_exp import one_norms as norms
+
+    alg = mechanics.su(16)
+    system, rng = _system(alg, amp=1.0)
+    mu0 = rng.standard_normal((4, alg.dim)) / 4.0
+    X = BrownianDriver(3, seed=3, dt=0.01, n_steps=100, batch_shape=(4,)).rough_path()
+    eta = system.stochastic_velocity_matrix(X.increments[:, 0], 0.5 * (X.areas[:, 0] - np.swapaxes(X.areas[:, 0], 1, 2)))
+    assert np.min(norms(eta)) > 8 * 0.82                                # at least 3 squarings on every member
+    final = solve(system, X, mu0, LieHeun(), save_at="end").final
+    drift = _casimir_drift(alg, alg.dual_to_matrix(mu0), final)
+    assert drift <= 1e-13, drift
