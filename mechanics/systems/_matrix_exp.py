@@ -12,8 +12,10 @@ The coadjoint flow of a :class:`~mechanics.systems.matrix_algebra.MatrixLieAlgeb
   rounding would depend on the batch size) and every other operation elementwise, so a member's bits never
   depend on the batch (the members of one degree are evaluated together; a batch of one degree and one
   number of squarings, the common case, is never gathered or scattered);
-* the conjugation :math:`QMQ^H` where :math:`Q` is unitary (compact algebras), :math:`QMQ^{-1}` by a solve
-  otherwise.
+* the conjugation :math:`QMQ^H` where :math:`Q` is unitary (compact algebras), after one Newton–Schulz step
+  towards unitarity on the members whose exponential took :data:`POLAR_FROM` squarings or more (each squaring
+  doubles the defect of :math:`Q^HQ = I`, and that defect is the step's Casimir drift); :math:`QMQ^{-1}` by a
+  solve otherwise.
 
 Why Taylor and not the diagonal Padé approximant of :func:`roughpaths.expm_batched`: the Padé approximant needs
 a linear solve per member, and LAPACK's solve of a small matrix costs 4 to 8 products
