@@ -22,9 +22,9 @@ Columns (CPU time per path-step, medians of ``--repeats`` interleaved runs, one 
 Ratios: ``(b)/(c)`` (target ≤ 1.5 at every size and noise), ``(a)/(b)`` (dispatched: target ≤ 1). Then memory
 (tracemalloc peak of one solve of the batch), construction time (``LieAlgebra(c)`` with its checks against the
 ``so``/``su`` constructor), the largest difference (b) − (c) and the Casimir drift of (b); then one thread
-against two on the matrix path (wall, CPU, bitwise).
+against two on the matrix path (four blocks of members; wall, CPU, bitwise).
 
-Usage: ``python benchmarks/bench_lie_algebras.py [--quick] [--repeats R] [--max-constants-dim n]``.
+Usage: ``python benchmarks/bench_lie_algebras.py [--quick] [--repeats R] [--max-constants-dim n] [--threads-only]``.
 """
 
 from __future__ import annotations
@@ -170,6 +170,52 @@ def _batch(N, quick):
     return (max(8, paths // 4), max(4, steps // 2)) if quick else (paths, steps)
 
 
+def threads_table(sizes, repeats, quick):
+    """The matrix path on 1 thread and on 2 (``numba.set_num_threads``; the members run in blocks shared by the
+    threads): four blocks of members, a = 0.3, wall and CPU per path-step, and a bitwise check."""
+    import mechanics
+    import mechanics.integrators.base as coadjoint_base
+    from mechanics import LieHeun, LiePoissonSystem, MatrixLieAlgebra
+    from mechanics.integrators._isospectral import block_members
+    from roughpaths import BrownianDriver, solve
+
+    dispatch = coadjoint_base.choose
+    coadjoint_base.choose = lambda system, dts: (system, isinstance(system.algebra, MatrixLieAlgebra))
+    print(f"\nthe matrix path, 1 thread against 2 (numba.set_num_threads), four blocks of members, a = 0.3: per "
+          f"path-step (us) wall and CPU, medians of {repeats} interleaved runs, and a bitwise check; "
+          f"load {os.getloadavg()[0]:.1f} (on a busy machine the wall ratio is what the second core was free for)")
+    print(f"{'algebra':8s} {'paths':>6s} {'wall 1':>9s} {'wall 2':>9s} {'wall 2/1':>9s} {'cpu 1':>9s} {'cpu 2':>9s} "
+          f"{'bitwise':>8s}")
+    try:
+        for kind, N in sizes:
+            if N < 8:
+                continue
+            alg = getattr(mechanics, kind)(N)
+            P = min(512, 4 * block_members(alg, 10 ** 6))
+            K = int(np.clip(2 ** 22 // (P * N ** 3), 2, 16)) // (2 if quick else 1) or 1
+            rng = np.random.default_rng(N)
+            system = LiePoissonSystem(alg, 1.0 + rng.random(alg.dim),
+                                      0.3 / np.sqrt(M_NOISE * DT) * rng.standard_normal((M_NOISE, alg.dim)), theta=THETA)
+            mu0 = rng.standard_normal((P, alg.dim)) / np.sqrt(N)
+            X = BrownianDriver(M_NOISE, seed=1, dt=DT, n_steps=K, batch_shape=(P,)).rough_path()
+            walls, cpus, outs = {1: [], 2: []}, {1: [], 2: []}, {}
+            for r in range(repeats + 1):
+                for t in (1, 2):
+                    numba.set_num_threads(t)
+                    w0, c0 = time.perf_counter(), time.process_time()
+                    outs[t] = solve(system, X, mu0, LieHeun(), save_at="end").final
+                    if r:                                                   # the first round warms up
+                        walls[t].append(time.perf_counter() - w0)
+                        cpus[t].append(time.process_time() - c0)
+            numba.set_num_threads(1)
+            w1, w2 = (1e6 * statistics.median(walls[t]) / (P * K) for t in (1, 2))
+            c1, c2 = (1e6 * statistics.median(cpus[t]) / (P * K) for t in (1, 2))
+            print(f"{alg.name:8s} {P:6d} {w1:9.2f} {w2:9.2f} {w2 / w1:9.2f} {c1:9.2f} {c2:9.2f} "
+                  f"{str(bool(np.array_equal(outs[1], outs[2]))):>8s}", flush=True)
+    finally:
+        coadjoint_base.choose = dispatch
+
+
 def main():
     import mechanics
     import mechanics.integrators.base as coadjoint_base
@@ -180,9 +226,12 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--max-constants-dim", type=int, default=66)
+    ap.add_argument("--threads-only", action="store_true")
     a = ap.parse_args()
-    all_threads = numba.get_num_threads()
     numba.set_num_threads(1)
+    if a.threads_only:
+        threads_table(_sizes(a.quick), a.repeats, a.quick)
+        return
     dispatch = coadjoint_base.choose
 
     def forced_matrix(system, dts):
@@ -194,7 +243,7 @@ def main():
             f"{'(b)matrix':>10s} {'(b)solve':>9s} {'(c)numpy':>9s} {'b/c':>6s} {'a/b':>6s} {'akern/b':>8s} "
             f"{'|b-c|':>8s} {'Cas.drift':>9s}")
     print(head)
-    rows, mem_rows, threads_rows = [], [], []
+    rows, mem_rows = [], []
     for kind, N in _sizes(a.quick):
         t0 = time.process_time()
         alg = getattr(mechanics, kind)(N)
@@ -258,31 +307,13 @@ def main():
                 mem_c = _peak(fns["c_numpy"])
                 mem_rows.append((alg.name, n, P, mem_b, mem_c, t_matrix_build,
                                  t_const_build if use_constants else None))
-                if N >= 8:
-                    threads_rows.append((alg.name, P, K, matrix_forced))
     print("\nmemory (tracemalloc peak of one solve of the batch, a = 0.3) and construction time (CPU)")
     print(f"{'algebra':8s} {'n':>5s} {'paths':>6s} {'(b) peak MiB':>13s} {'(c) peak MiB':>13s} "
           f"{'so/su() ms':>11s} {'LieAlgebra(c) ms':>17s}")
     for name, n, P, mb, mc, tb, tc in mem_rows:
         tcs = f"{1e3 * tc:17.1f}" if tc is not None else f"{'skipped':>17s}"
         print(f"{name:8s} {n:5d} {P:6d} {mb / 2 ** 20:13.1f} {mc / 2 ** 20:13.1f} {1e3 * tb:11.1f} {tcs}")
-    print(f"\nthe matrix path, 1 thread against {max(2, all_threads)} (numba.set_num_threads), a = 0.3: per path-step "
-          f"(us) wall and CPU, medians of {a.repeats} interleaved runs, and a bitwise check")
-    print(f"{'algebra':8s} {'wall 1':>9s} {'wall 2':>9s} {'wall 2/1':>9s} {'cpu 1':>9s} {'cpu 2':>9s} {'bitwise':>8s}")
-    for name, P, K, fn in threads_rows:
-        walls, cpus, outs = {1: [], 2: []}, {1: [], 2: []}, {}
-        for _ in range(a.repeats):
-            for t in (1, 2):
-                numba.set_num_threads(min(t, max(2, all_threads)))
-                w0, c0 = time.perf_counter(), time.process_time()
-                outs[t] = fn()
-                walls[t].append(time.perf_counter() - w0)
-                cpus[t].append(time.process_time() - c0)
-        numba.set_num_threads(1)
-        w1, w2 = (1e6 * statistics.median(walls[t]) / (P * K) for t in (1, 2))
-        c1, c2 = (1e6 * statistics.median(cpus[t]) / (P * K) for t in (1, 2))
-        print(f"{name:8s} {w1:9.2f} {w2:9.2f} {w2 / w1:9.2f} {c1:9.2f} {c2:9.2f} "
-              f"{str(bool(np.array_equal(outs[1], outs[2]))):>8s}")
+    threads_table(_sizes(a.quick), a.repeats, a.quick)
     print(f"load {os.getloadavg()[0]:.1f}")
 
 
