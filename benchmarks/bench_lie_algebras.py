@@ -24,7 +24,7 @@ Ratios: ``(b)/(c)`` (target ≤ 1.5 at every size and noise), ``(a)/(b)`` (dispa
 ``so``/``su`` constructor), the largest difference (b) − (c) and the Casimir drift of (b); then one thread
 against two on the matrix path (four blocks of members; wall, CPU, bitwise).
 
-Usage: ``python benchmarks/bench_lie_algebras.py [--quick] [--repeats R] [--max-constants-dim n] [--threads-only]``.
+Usage: ``python benchmarks/bench_lie_algebras.py [--quick] [--repeats R] [--max-constants-dim n] [--threads-only] [--only so16,su16]``.
 """
 
 from __future__ import annotations
@@ -227,6 +227,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--max-constants-dim", type=int, default=66)
     ap.add_argument("--threads-only", action="store_true")
+    ap.add_argument("--only", default="", help="comma-separated algebras, e.g. so16,su16 (default: all)")
     a = ap.parse_args()
     numba.set_num_threads(1)
     if a.threads_only:
@@ -244,7 +245,10 @@ def main():
             f"{'|b-c|':>8s} {'Cas.drift':>9s}")
     print(head)
     rows, mem_rows = [], []
+    only = {x.strip() for x in a.only.split(",") if x.strip()}
     for kind, N in _sizes(a.quick):
+        if only and f"{kind}{N}" not in only:
+            continue
         t0 = time.process_time()
         alg = getattr(mechanics, kind)(N)
         t_matrix_build = time.process_time() - t0
@@ -313,7 +317,7 @@ def main():
     for name, n, P, mb, mc, tb, tc in mem_rows:
         tcs = f"{1e3 * tc:17.1f}" if tc is not None else f"{'skipped':>17s}"
         print(f"{name:8s} {n:5d} {P:6d} {mb / 2 ** 20:13.1f} {mc / 2 ** 20:13.1f} {1e3 * tb:11.1f} {tcs}")
-    threads_table(_sizes(a.quick), a.repeats, a.quick)
+    threads_table([(k, N) for k, N in _sizes(a.quick) if not only or f"{k}{N}" in only], a.repeats, a.quick)
     print(f"load {os.getloadavg()[0]:.1f}")
 
 

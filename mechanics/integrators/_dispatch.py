@@ -35,6 +35,7 @@ import weakref
 
 import numpy as np
 
+from ..systems.hamiltonian import QuadraticHamiltonian
 from ..systems.lie_algebra import LieAlgebra
 from ..systems.lie_poisson import LiePoissonSystem
 from ..systems.matrix_algebra import MatrixLieAlgebra
@@ -52,7 +53,10 @@ _TWINS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def _twin(system, algebra):
-    new = LiePoissonSystem(algebra, system.hamiltonian, system.xi, system.s, system.theta, system.convention,
+    h = system.hamiltonian
+    if isinstance(h, QuadraticHamiltonian) and h.q_diagonal is None and not np.any(h.q - np.diag(np.diagonal(h.q))):
+        h = QuadraticHamiltonian(np.array(np.diagonal(h.q)), h.linear)    # a diagonal Q as its vector: O(n) gradient
+    new = LiePoissonSystem(algebra, h, system.xi, system.s, system.theta, system.convention,
                            levy_in_dissipation=system.levy_in_dissipation)
     new._metric_inv = system._metric_inv
     return new
