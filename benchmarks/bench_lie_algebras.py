@@ -164,9 +164,9 @@ def _sizes(quick):
 
 
 def _batch(N, quick):
-    """(paths, steps) for an algebra on N x N matrices: ~1e7 product flops per timed run, at least 8 paths."""
+    """(paths, steps) for an algebra on N x N matrices: ~1e7 product flops per timed run (N > 8), at least 8 paths."""
     paths = int(np.clip(2 ** 17 // N ** 3, 8, 512))
-    steps = int(np.clip(2 ** 21 // (paths * N ** 3), 4, 40))
+    steps = int(np.clip(2 ** 23 // (paths * N ** 3), 4, 40))
     return (max(8, paths // 4), max(4, steps // 2)) if quick else (paths, steps)
 
 

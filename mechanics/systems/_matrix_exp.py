@@ -106,17 +106,22 @@ def _taylor(A, m, p):
 
 
 def _square(R, s):
-    """``R^(2^s)`` per member (``s (b,)``): all members together while they all need it."""
-    top = int(s.max(initial=0))
-    if top == 0:
+    """``R^(2^s)`` per member (``s (b,)``): all members together up to the smallest ``s``, then the members that
+    need more as one shrinking subset, each written back once when done (no gather per round)."""
+    top, low = int(s.max(initial=0)), int(s.min(initial=0))
+    for _ in range(low):
+        R = R @ R
+    if top == low:
         return R
-    if np.all(s == top):
-        for _ in range(top):
-            R = R @ R
-        return R
-    for r in range(1, top + 1):
-        act = np.flatnonzero(s >= r)
-        R[act] = R[act] @ R[act]
+    idx = np.flatnonzero(s > low)
+    sub, left = R[idx], s[idx]
+    for r in range(low + 1, top + 1):
+        sub = sub @ sub
+        done = left == r
+        if done.any():
+            R[idx[done]] = sub[done]
+            keep = ~done
+            idx, sub, left = idx[keep], sub[keep], left[keep]
     return R
 
 
