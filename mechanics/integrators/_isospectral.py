@@ -30,10 +30,10 @@ elementwise or a sparse map per member, so a member's result is bitwise what it 
 in blocks (:func:`block_members`: about :data:`BLOCK_WORK` of product work per step) shared by numba's
 number of Python threads (numpy releases the GIL in its products); the split never changes a result.
 Measured (``benchmarks/bench_lie_algebras.py``, CPU time per path-step, one thread, load 6-8): against a plain
-batched numpy Lie–Heun step (batch-wide Padé), 0.82 to 1.17 times its cost from so(8) to su(64) at noise sizes
-0.3 and 0.01 per component (su(64), a = 0.3: 2.0 ms against 2.1 ms); below so(8) the solver's cost model runs
-the compiled constants kernel instead (:mod:`._dispatch`), where these steps cost 1.1 to 1.5 times the numpy
-step (Python overhead per step on 3 × 3 matrices).
+batched numpy Lie–Heun step (batch-wide Padé), 0.88 to 1.20 times its cost from so(8) to su(64) at noise sizes
+0.3 and 0.01 per component (su(64), a = 0.3: 2.0 ms against 2.1 ms); on so(3) .. su(4) 1.1 to 1.4 times (the
+Python overhead of a step on tiny matrices), where the solver's cost model mostly runs the compiled constants
+kernel instead (:mod:`._dispatch`).
 """
 
 from __future__ import annotations
