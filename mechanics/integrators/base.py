@@ -46,14 +46,20 @@ top) and the implicit midpoint rule that of :mod:`mechanics.integrators._se3_ker
 Lie–Heun on se(3) measured faster in the generic kernel, ``benchmarks/bench_coadjoint_kernels.py``), and
 otherwise the generic kernel of
 :mod:`mechanics.integrators._generic_kernels`, compiled once for all algebras (the structure constants are
-data: su(2), sl(2, R), so(4), semidirect products, a user's basis). Otherwise (forces, a non-quadratic
+data: su(2), sl(2, R), so(4), semidirect products, a user's basis). A system on a
+:class:`~mechanics.MatrixLieAlgebra` runs the isospectral steps of :mod:`mechanics.integrators._isospectral`
+(the state held as a matrix, updated by conjugation); where a quadratic system could run either way (a small
+matrix algebra, or a structure-constant algebra with a matrix basis) a cost model picks the cheaper
+(:mod:`mechanics.integrators._dispatch`; it depends on the system and the step sizes, never on the batch).
+Otherwise (forces, a non-quadratic
 Hamiltonian) a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3), :func:`roughpaths.expm_batched`
 per member otherwise). Either way a batch member's result depends on its own data only; a member that
 fails is reported through ``first_bad`` (contract item 8).
 
 Threads: the compiled kernels split the paths into blocks and run them on numba's threads; set their
 number with ``numba.set_num_threads(k)`` (or the environment variable ``NUMBA_NUM_THREADS`` before the
-first import). The results are bitwise the same for any number of threads.
+first import). The isospectral steps share blocks of members between as many Python threads (numpy releases
+the GIL in its products). The results are bitwise the same for any number of threads.
 
 Forces (``force``, ``noise_forces`` of the system) are added outside the group update, on the numpy
 path, by :mod:`mechanics.integrators._forced` (orders and Casimirs stated there); the compiled
@@ -74,6 +80,7 @@ from ..systems.lie_poisson import LiePoissonSystem
 from ..systems.matrix_algebra import MatrixLieAlgebra
 from . import _generic_kernels, _isospectral, _se3_kernels, _so3_kernels
 from ._chord import chord_solve
+from ._dispatch import choose
 from ._forced import forced_sigma_and_state
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
@@ -134,15 +141,6 @@ class CoadjointSolver(Solver):
         if level == 2 and kind not in ("geometric", "stratonovich"):
             raise ValueError(f"the driver is a {kind!r} rough path; the coadjoint schemes solve the geometric "
                              f"(Stratonovich-type) RDE. Convert an Itô lift with XX + ½(t-s)I first.")
-
-    def step_bytes(self, fields):
-        """Bytes per batch member of one step's temporaries, for :func:`roughpaths.solve`'s memory check: on a
-        matrix Lie algebra about 40 matrices of ``N × N`` (the state, the increment, the exponential's Padé
-        powers and products, the velocities) and the state's coordinates; ``None`` (the generic estimate) else."""
-        alg = fields.algebra
-        if isinstance(alg, MatrixLieAlgebra):
-            return 40.0 * alg.matrix_size ** 2 * alg.dtype.itemsize + 8.0 * 4 * alg.dim
-        return None
 
     # -------------------------------------------------------------- the scheme
     def _sigma(self, system, mu, dt, eta):
@@ -205,6 +203,14 @@ class CoadjointSolver(Solver):
         areas = None if dXX is None else 0.5 * (dXX - np.swapaxes(dXX, -1, -2))
         return system.stochastic_velocity(dX, areas)
 
+    def step_nbytes(self, fields):
+        """Bytes of one step's temporaries per member (contract item 11): ``N × N`` matrices on a matrix algebra
+        (the state, the step's increment and the exponential's powers), the generic estimate otherwise."""
+        alg = fields.algebra
+        if isinstance(alg, MatrixLieAlgebra):
+            return 24.0 * alg.matrix_size ** 2 * alg.dtype.itemsize + 8.0 * fields.n_noise ** 2
+        return None
+
     def step(self, fields, y, t, dt, dX, dXX):
         """One step (contract item 7); a failed member comes back NaN."""
         if fields.has_forces:
@@ -225,6 +231,8 @@ class CoadjointSolver(Solver):
         nsave = int(np.count_nonzero(save))
         plain = system.hamiltonian.is_quadratic and not system.has_forces      # forces: the numpy path
         matrix = isinstance(system.algebra, MatrixLieAlgebra) and not system.has_forces
+        if plain and not isinstance(system.algebra, (SO3Algebra, SE3Algebra)):
+            system, matrix = choose(system, dts)     # constants or matrices, by a cost model (._dispatch)
         if matrix:                      # the state held as a matrix, updated by conjugation (._isospectral)
             nb = int(np.prod(batch, dtype=np.int64))
             d = dX.shape[-1]

@@ -38,6 +38,8 @@ import numpy as np
 from roughpaths import expm_batched
 from roughpaths.validation import as_float_array, check_memory, check_positive_int, check_rng
 
+from ._matrix_exp import conjugate_members, one_norms
+
 __all__ = ["MatrixLieAlgebra", "haar_matrices"]
 
 #: Draws of the random closure check of a user basis, from a fixed seed (the verdict is reproducible).
@@ -108,6 +110,7 @@ class MatrixLieAlgebra:
         if defect > atol * max(1.0, scale) ** 2:
             raise ValueError(f"the span of basis is not closed under the commutator (the bracket of two random "
                              f"elements leaves the span by {defect:.3g}); it is not a Lie algebra basis.")
+        self._structure = _whole_algebra(b, scale)        # all of so(N), u(N) or su(N): project entrywise
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -336,15 +339,21 @@ class MatrixLieAlgebra:
 
     def conjugate(self, sigma_matrix, M) -> np.ndarray:
         r""":math:`e^{-\sigma} M e^{\sigma}` for matrices ``(..., N, N)`` (the coadjoint flow on matrices):
-        ``Q M Q^H`` with ``Q = expm(-σ)`` on compact algebras (``Q`` unitary), ``Q M Q^{-1}`` otherwise; the
-        result is projected back onto the algebra (the round-off that leaves it)."""
-        Q = expm_batched(-np.asarray(sigma_matrix))
-        QM = Q @ M
-        if self.compact:
-            out = QM @ np.conj(np.swapaxes(Q, -1, -2))
+        ``Q M Q^H`` with ``Q = expm(-σ)`` on compact algebras (``Q`` unitary), ``Q M Q^{-1}`` otherwise, each member
+        on its own (:mod:`mechanics.systems._matrix_exp`); the result is projected back onto the algebra (the
+        round-off that leaves it). A member with a non-finite ``σ`` gives NaN."""
+        S, M = np.broadcast_arrays(np.asarray(sigma_matrix), np.asarray(M))
+        shape = S.shape
+        S, M = S.reshape((-1,) + shape[-2:]), M.reshape((-1,) + shape[-2:])
+        with np.errstate(over="ignore", invalid="ignore"):
+            norms = one_norms(S)
+        ok = np.isfinite(norms)
+        if np.all(ok):
+            out = conjugate_members(S, M, self.compact, norms)
         else:
-            out = np.swapaxes(np.linalg.solve(np.swapaxes(Q, -1, -2), np.swapaxes(QM, -1, -2)), -1, -2)
-        return self._project(out)
+            out = np.full(S.shape, np.nan, dtype=np.result_type(S, M))
+            out[ok] = conjugate_members(S[ok], M[ok], self.compact, norms[ok])
+        return self._project(out).reshape(shape)
 
     def _project(self, X):
         """A projection onto the algebra (the identity on its elements): for the built-in algebras the defining
@@ -367,8 +376,10 @@ class MatrixLieAlgebra:
                                    np.concatenate([Xt[..., :h, h:], -Xt[..., :h, :h]], -1)], -2)
             X = 0.5 * (X + JXtJ)
         if kind in ("skew_traceless", "traceless"):
-            tr = np.trace(X, axis1=-2, axis2=-1) / N
-            X = X - tr[..., None, None] * np.eye(N)
+            if kind == "traceless":
+                X = np.array(X, dtype=np.result_type(X, np.float64))      # a fresh copy, updated in place
+            flat = X.reshape(-1, N * N)                                   # a view of the fresh array
+            flat[:, :: N + 1] -= (np.trace(X, axis1=-2, axis2=-1) / N).reshape(-1, 1)
         return X
 
     # ------------------------------------------------------------------ invariants
@@ -446,6 +457,21 @@ def _rebuild(name, N, coo, dtype, signs, compact, degrees, structure):
     basis = np.zeros((int(coo.row.max()) + 1, N * N), dtype=np.dtype(dtype))
     basis[coo.row, coo.col] = coo.data
     return MatrixLieAlgebra(basis.reshape(-1, N, N), name=name, compact=compact, casimir_degrees=degrees)
+
+
+def _whole_algebra(b, scale):
+    """``"skew"`` / ``"skew_traceless"`` when a user basis ``b (n, N, N)`` spans all of so(N) (a real basis), u(N) or
+    su(N): there the entrywise projection of :meth:`MatrixLieAlgebra._project` is the trace-form one (the
+    complement is the (Hermitian) symmetric matrices, and ``iℝ·I`` for su(N)); otherwise ``None``."""
+    n, N = b.shape[0], b.shape[1]
+    if np.max(np.abs(b + np.conj(np.swapaxes(b, 1, 2)))) > 1e-14 * scale:
+        return None
+    if b.dtype.kind != "c":
+        return "skew" if n == N * (N - 1) // 2 else None
+    if n == N * N:
+        return "skew"
+    traceless = np.max(np.abs(np.trace(b, axis1=1, axis2=2))) <= 1e-14 * scale * N
+    return "skew_traceless" if traceless and n == N * N - 1 else None
 
 
 def _closure_defect(alg: MatrixLieAlgebra) -> float:

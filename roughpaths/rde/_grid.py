@@ -89,7 +89,8 @@ def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_sa
       the fields' values and their product with the area (2 e d), their Jacobians (d e²), the linear
       generators (2 e²) with a log-ODE step's matrix exponential (up to 14 e², scaling and squaring) and up to
       eight state-sized sums (8 e), 8 bytes each; or what the solver states for itself (``step_bytes``, from
-      ``solver.step_bytes(fields)`` where it defines the method: the coadjoint solvers on a matrix Lie algebra
+      ``solver.step_nbytes(fields)``, contract item 11 of :class:`~roughpaths.Solver`: the coadjoint solvers on a
+      matrix Lie algebra
       hold ``N × N`` matrices, not ``e × e`` generators).
     """
     N, d = driver.n_steps, driver.dim
@@ -104,7 +105,7 @@ def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_sa
         K, blocks, what = N, 0.0, "the path read in place"
     d3 = float(d) ** 3 if level >= 3 else 0.0
     step = float(d) ** 2 + d3 + 2.0 * e * d + float(d) * e * e + 16.0 * e * e + 8.0 * e
-    if step_bytes is not None:                  # what the solver states for itself (solver.step_bytes(fields))
+    if step_bytes is not None:                  # what the solver states for itself (solver.step_nbytes(fields))
         step = float(d) ** 2 + d3 + step_bytes / 8.0
     return (blocks + 8.0 * members * (min(K, n_saved) * e + 2 * e + 1 + step) + 4096.0), what
 

@@ -85,6 +85,10 @@ class Solver:
         ``(..., K + 1)`` with the batch axes of ``y``, each member on its own steps (adaptive steps per member);
         :meth:`step` then gets ``t`` and ``dt`` of shape ``(..., 1)``. ``solve`` uses it for fields that do not
         depend on time; otherwise it calls ``integrate`` once per group of members on the same steps.
+    11. ``step_nbytes(fields)``: bytes of one step's temporaries per batch member, for the memory check of
+        :func:`~roughpaths.solve`; ``None`` (the default) means the generic estimate in the state dimension
+        ``e`` (Jacobians and matrix exponentials of ``e × e``). A solver whose steps never form ``e × e``
+        arrays (the isospectral steps of :mod:`mechanics` on ``N × N`` matrices, ``e = N² - 1``) states its own.
     """
 
     increment_level: int = 1
@@ -120,6 +124,10 @@ class Solver:
                              f"this scheme would drop; use a level-3 solver (LogODE3(), Davie3() from "
                              f"roughpaths), or pass driver.to_rough_path() (its level-2 truncation) if the path "
                              f"is p-rough with p < 3 and dropping level 3 is intended.")
+
+    def step_nbytes(self, fields):
+        """Bytes of one step's temporaries per batch member, or ``None`` for the generic estimate (contract item 11)."""
+        return None
 
     def step(self, fields, y, t, dt, dX, dXX):  # pragma: no cover - abstract
         """One step (contract item 7)."""

@@ -215,7 +215,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     run = _Run(y, batch, on_failure, getattr(driver, "any_times", False))
     steps = (_TreeSteps(run, driver, control, solver, save_at, shared_steps, fields) if run.flat else
              _GridSteps(run, driver, save_at, block_steps, level,
-                        getattr(solver, "step_bytes", lambda f: None)(fields)))
+                        solver.step_nbytes(fields) if hasattr(solver, "step_nbytes") else None))
     total, desc, unit = steps.progress_total
     report = run.report = progress_reporter(progress, total, desc=desc, unit=unit)
     t_start = _time.perf_counter()
