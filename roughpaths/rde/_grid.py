@@ -90,8 +90,7 @@ def _working_bytes(driver, block_steps, members: float, e: int, level: int, n_sa
       generators (2 e²) with a log-ODE step's matrix exponential (up to 14 e², scaling and squaring) and up to
       eight state-sized sums (8 e), 8 bytes each; or what the solver states for itself (``step_bytes``, from
       ``solver.step_nbytes(fields)``, contract item 11 of :class:`~roughpaths.Solver`: the coadjoint solvers on a
-      matrix Lie algebra
-      hold ``N × N`` matrices, not ``e × e`` generators).
+      matrix Lie algebra hold ``N × N`` matrices, not ``e × e`` generators).
     """
     N, d = driver.n_steps, driver.dim
     if isinstance(driver, Driver):
