@@ -84,6 +84,19 @@ def warm_more_signatures() -> None:
     rp.p_variation(lone, 2.5)
 
 
+def warm_more_gradients() -> None:
+    """For the test suite (``--more``): the backward kernels of lone paths at d = 4 and d = 1, and of wide
+    alphabets cut into blocks (d = 20). Each is one variant of 15-25 s of CPU (a lone d = 1 gradient: 25 s,
+    load ~8), which the suite otherwise compiles inside its tests. Run in the other process than
+    :func:`warm_more_signatures` (balance)."""
+    import roughpaths as rp
+
+    rng = np.random.default_rng(0)
+    for shape in ((9, 4), (6, 1), (2, 37, 20)):
+        x = np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
+        rp.signature_vjp(x, 3, np.ones(shape[:-2] + (rp.sigdim(shape[-1], 3),)))
+
+
 def warm_more_coadjoint() -> None:
     """For the test suite (``--more``): Lie–Euler and the implicit midpoint rule on so(3), se(3) and a user
     algebra; every scheme on the rough paths a user builds (a level-1 path, increments with areas, a path's
@@ -157,7 +170,7 @@ PARTS = {
 }
 #: with ``--more`` (``tools/setup_env.sh`` when it installs the test extra): what the test suite reaches besides
 MORE = {"roughpaths": (("more signatures", warm_more_signatures),),
-        "mechanics": (("more coadjoint schemes", warm_more_coadjoint),)}
+        "mechanics": (("more coadjoint schemes", warm_more_coadjoint), ("more signature gradients", warm_more_gradients))}
 
 
 def main() -> None:

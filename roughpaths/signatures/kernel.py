@@ -153,6 +153,14 @@ def _finite_or_raise(values: np.ndarray, X, Y, ia, ib, rbf: bool, what: str) -> 
                      f"{fix}.")
 
 
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """A read-only view: the Goursat kernels compile one specialisation whether the caller's paths are
+    writeable or not (JAX hands read-only arrays; each combination of flags compiled anew, 7-14 s of CPU)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, rbf: bool, order: int) -> np.ndarray:
     """Kernels of the pairs ``(X[ia[k]], Y[ib[k]])`` of validated, scaled ``(A, n, d)``, ``(B, m, d)`` arrays."""
     npairs, n, m = ia.shape[0], X.shape[1], Y.shape[1]
@@ -163,6 +171,7 @@ def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, 
     ia, ib = _padded(ia), _padded(ib)
     ngroups = ia.shape[0] // _goursat.LANES
     per_group = _work(_goursat.LANES, n, m, order) * 4
+    X, Y = _readonly(X), _readonly(Y)
     _threads.run(lambda lo, hi: _goursat.kernel_groups(X, Y, ia, ib, rbf, order, lo, hi, out),
                  _threads.ranges(ngroups, per_group))
     _finite_or_raise(out, X, Y, ia, ib, rbf, "kernel")
@@ -177,7 +186,7 @@ def _pairs_vjp(X, Y, ia, ib, rbf: bool, order: int, gout: np.ndarray) -> tuple:
         return gx, gy
     _check_size(npairs, n, m, order, d, True)
     ia, ib = _padded(ia), _padded(ib)
-    gout = np.ascontiguousarray(gout, dtype=np.float64)
+    X, Y, gout = _readonly(X), _readonly(Y), _readonly(np.ascontiguousarray(gout, dtype=np.float64))
     ngroups = ia.shape[0] // _goursat.LANES
     per_group = _work(_goursat.LANES, n, m, order) * 16
     _threads.run(lambda lo, hi: _goursat.vjp_groups(X, Y, ia, ib, rbf, order, gout, lo, hi, gx, gy),
