@@ -48,8 +48,8 @@ def has_se3_table(ti, tj, tk, tv) -> bool:
 
 #: Members per block: the length of a row of the work buffer (a compile-time constant, see the module docstring).
 B = 128
-# rows of the work buffer (each B floats): the state, the drift velocities, σ, the Taylor sum and term, the
-# predictor, the velocity's work rows, the stochastic velocity, and θ
+# rows of the work buffer (each B floats): the state μ, the drift velocities w(μ), w(μ*), σ, the Taylor sum (μ at
+# the start of a step, then μ*, then exp(ad*_σ) μ) and term, the velocity's work rows, the stochastic velocity, θ
 _MU, _W0, _W1, _S, _A1, _TERM, _G, _T2, _E = (6 * r * B for r in range(9))
 _TH = 54 * B
 _NROW = 55
