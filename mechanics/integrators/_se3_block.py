@@ -24,7 +24,6 @@ runs at load 8-11, each against the generic kernel's in the run before it): Lie�
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numba
 import numpy as np
@@ -251,98 +250,93 @@ def _taylor_degrees(wb, inv1, inv2, two, l1, l2, bc):
         _set6(wb, _A1, p, (m0, m1, m2, m3, m4, m5))
 
 
-@lru_cache(maxsize=None)
-def block_kernel(C: int):
-    """The compiled se(3) block kernel for scheme ``C`` (0 Lie–Euler, 1 Lie–Heun), with the signature of
-    :func:`._generic_kernels._block_kernel`'s (compiled on first use and cached).
+@numba.njit(cache=True, nogil=True)
+def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
+              degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
+    """Members lo .. hi-1 (at most :data:`B`) over every step of the block by Lie–Euler (``code`` 0) or Lie–Heun
+    (``code`` 1), with the signature of :func:`._generic_kernels._block_kernel`'s kernels; returns the number of
+    members that failed.
 
-    Compile cost: the heavy top's first Lie–Heun solve with an empty numba cache takes 7.8 s of CPU (its
-    kernel and the passes it calls; the generic kernel it replaces: 8.3 s), Lie–Euler 6.8 s (7.3 s); minima of
-    3 fresh processes at load 10. The passes are compiled functions of their own (shared by both schemes),
-    called with flags as values rather than literals, which numba would compile once per literal.
+    One compiled kernel for both schemes (the scheme is a value: Lie–Euler merely skips the predictor), so the
+    heavy top's second scheme compiles nothing. Compile cost: the heavy top's first Lie–Heun solve with an empty
+    numba cache takes 7.8 s of CPU (this kernel and the passes it calls; the generic kernel it replaces: 8.3 s),
+    its first Lie–Euler solve 6.8 s (7.3 s); minima of 3 fresh processes at load 10. The passes are compiled
+    functions of their own, called with flags as values rather than literals (numba would compile a variant
+    per literal).
     """
-    if C not in (0, 1):
-        raise ValueError(f"the se(3) block kernel runs Lie-Euler (0) and Lie-Heun (1), got scheme {C}.")
-
-    @numba.njit(cache=True, nogil=True)
-    def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
-                  degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
-        """Members lo .. hi-1 (at most :data:`B`) over every step of the block; returns the number that failed."""
-        n = 6
-        bc = hi - lo
-        nk = dX.shape[1]
-        area = dXX.shape[0] > 0
-        c = (cnorm[0], cnorm[1], cnorm[2], cnorm[3], cnorm[4], cnorm[5])
-        wb = np.empty(_NROW * B)
-        xt = np.zeros((STEPS, 6, B))               # without the area its rows 3-5 stay 0 (see _eta3)
-        # flags as values, not literals (numba would compile a variant of the callee per literal True / False)
-        heun = C == 1
-        pred = nk >= 0
-        w0, w1 = _rows(wb, _W0), _rows(wb, _W1)
-        big = np.empty(bc, dtype=np.bool_)
-        work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
-        vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
-        lim = degth[degth.shape[0] - 1]
-        for p in range(bc):
-            for i in range(n):
-                wb[_MU + i * B + p] = y[lo + p, i]
-                wb[_A1 + i * B + p] = y[lo + p, i]         # rows _A1 hold μ at the start of every step
-        nfail = 0
-        slot = 0
-        for k in range(nk):
-            dt = dts[k]
-            kk = k % STEPS
-            if kk == 0:
-                _tile3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xt)
-            _eta3(xt[kk], wb, bc, xi, brk)
-            _velocity(wb, w0, lin, f, theta, qs, mts, bc, pred)
-            if C == 1:
-                # the predictor μ* = (μ + ad*_σ* μ) + ½ ad*_σ*(ad*_σ* μ), σ* = w(μ) dt + e: Taylor degrees 1 and 2 of
-                # exp(ad*_σ*) μ, every member adding both (θ row +inf), in rows _A1; then w(μ*)
-                _sigma(wb, not heun, pred, dt, c, 0.0, 0.0, bc)
-                _velocity(wb, w1, lin, f, theta, qs, mts, bc, pred)
-            _sigma(wb, heun, not pred, dt, c, degth[0], degth[1], bc)
-            # exp(ad*_σ) μ: the Taylor sum to the degree of the block's largest θ (each member adds its own degrees)
-            nbig, thmax = _theta_max(wb, lim, big, bc)
-            r = 3
-            while thmax > degth[r - 1]:
-                two = thmax > degth[r]
-                _taylor_degrees(wb, 1.0 / r, 1.0 / (r + 1), two, degth[r - 1], degth[r], bc)
-                r += 2 if two else 1
-            if thmax > degth[0]:
-                _accept(wb, big, bc)
-            if nbig > 0:
-                for p in range(bc):
-                    if not big[p]:
-                        continue
-                    finite_in = True
-                    for i in range(n):
-                        vm[i] = wb[_MU + i * B + p]
-                        vs[i] = wb[_S + i * B + p]
-                        if not (math.isfinite(vm[i]) and math.isfinite(wb[_E + i * B + p])):
-                            finite_in = False
-                    ok = False
-                    if finite_in:
-                        ok = exp1(vs, vm, vo, work[0], work[1], work[2], work[3][0], work[3][1], ti, tj, tk, tv, cnorm,
-                                  degth)
-                    for i in range(n):
-                        wb[_MU + i * B + p] = vo[i] if ok else np.nan
-                        wb[_A1 + i * B + p] = wb[_MU + i * B + p]
-                    if not ok:
-                        if first_bad[lo + p] < 0:
-                            first_bad[lo + p] = k
-                            reason[lo + p] = NON_FINITE
-                            nfail += 1
-            if save[k]:
-                for p in range(bc):
-                    for i in range(n):
-                        out[lo + p, slot, i] = wb[_MU + i * B + p]
-                slot += 1
-            if stop and nfail > 0:
-                break
-        for p in range(bc):
-            for i in range(n):
-                y[lo + p, i] = wb[_MU + i * B + p]
-        return nfail
-
-    return run_block
+    n = 6
+    bc = hi - lo
+    nk = dX.shape[1]
+    area = dXX.shape[0] > 0
+    c = (cnorm[0], cnorm[1], cnorm[2], cnorm[3], cnorm[4], cnorm[5])
+    wb = np.empty(_NROW * B)
+    xt = np.zeros((STEPS, 6, B))               # without the area its rows 3-5 stay 0 (see _eta3)
+    # flags as values, not literals (numba would compile a variant of the callee per literal True / False)
+    heun = code == 1
+    pred = nk >= 0
+    w0, w1 = _rows(wb, _W0), _rows(wb, _W1)
+    big = np.empty(bc, dtype=np.bool_)
+    work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
+    vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
+    lim = degth[degth.shape[0] - 1]
+    for p in range(bc):
+        for i in range(n):
+            wb[_MU + i * B + p] = y[lo + p, i]
+            wb[_A1 + i * B + p] = y[lo + p, i]         # rows _A1 hold μ at the start of every step
+    nfail = 0
+    slot = 0
+    for k in range(nk):
+        dt = dts[k]
+        kk = k % STEPS
+        if kk == 0:
+            _tile3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xt)
+        _eta3(xt[kk], wb, bc, xi, brk)
+        _velocity(wb, w0, lin, f, theta, qs, mts, bc, pred)
+        if heun:
+            # the predictor μ* = (μ + ad*_σ* μ) + ½ ad*_σ*(ad*_σ* μ), σ* = w(μ) dt + e: Taylor degrees 1 and 2 of
+            # exp(ad*_σ*) μ, every member adding both (θ row +inf), in rows _A1; then w(μ*)
+            _sigma(wb, not heun, pred, dt, c, 0.0, 0.0, bc)
+            _velocity(wb, w1, lin, f, theta, qs, mts, bc, pred)
+        _sigma(wb, heun, not pred, dt, c, degth[0], degth[1], bc)
+        # exp(ad*_σ) μ: the Taylor sum to the degree of the block's largest θ (each member adds its own degrees)
+        nbig, thmax = _theta_max(wb, lim, big, bc)
+        r = 3
+        while thmax > degth[r - 1]:
+            two = thmax > degth[r]
+            _taylor_degrees(wb, 1.0 / r, 1.0 / (r + 1), two, degth[r - 1], degth[r], bc)
+            r += 2 if two else 1
+        if thmax > degth[0]:
+            _accept(wb, big, bc)
+        if nbig > 0:
+            for p in range(bc):
+                if not big[p]:
+                    continue
+                finite_in = True
+                for i in range(n):
+                    vm[i] = wb[_MU + i * B + p]
+                    vs[i] = wb[_S + i * B + p]
+                    if not (math.isfinite(vm[i]) and math.isfinite(wb[_E + i * B + p])):
+                        finite_in = False
+                ok = False
+                if finite_in:
+                    ok = exp1(vs, vm, vo, work[0], work[1], work[2], work[3][0], work[3][1], ti, tj, tk, tv, cnorm,
+                              degth)
+                for i in range(n):
+                    wb[_MU + i * B + p] = vo[i] if ok else np.nan
+                    wb[_A1 + i * B + p] = wb[_MU + i * B + p]
+                if not ok:
+                    if first_bad[lo + p] < 0:
+                        first_bad[lo + p] = k
+                        reason[lo + p] = NON_FINITE
+                        nfail += 1
+        if save[k]:
+            for p in range(bc):
+                for i in range(n):
+                    out[lo + p, slot, i] = wb[_MU + i * B + p]
+            slot += 1
+        if stop and nfail > 0:
+            break
+    for p in range(bc):
+        for i in range(n):
+            y[lo + p, i] = wb[_MU + i * B + p]
+    return nfail
