@@ -249,7 +249,7 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             bool(stop_on_failure))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
     if code != 2 and nm == 3 and _se3_block.has_se3_table(ti, tj, tk, tv):   # the same numbers, written out
-        kernel, block = _se3_block.block_kernel(int(code)), _se3_block.B
+        kernel, block = _se3_block.run_block, _se3_block.B
     else:
         kernel, block = _block_kernel(int(code), n if code == 2 and n in (3, 6) else 0), BLOCK
     parallel_ranges(lambda lo, hi: kernel(*args, lo, hi, *tail), nb, block)

@@ -14,14 +14,16 @@ passes over the block for one ``ad*``); here one pass over the block's members c
 of ``ad*`` in registers, and one pass does two Taylor degrees. Every row lives in one flat buffer at a
 distance that is a compile-time constant (:data:`B` members a row), so LLVM proves the passes free of
 aliasing and vectorises them without run-time checks (two separate arrays, or an offset known only at
-run time, left some of them scalar). Measured (``benchmarks/bench_coadjoint_kernels.py``, heavy top,
-1 thread, CPU time): Lie–Heun ... ns per path-step against ... for the generic kernel.
+run time, left some of them scalar). Measured (``benchmarks/bench_coadjoint_kernels.py --ratio-only``, the
+heavy top of ``bench_rigid_body.py``, 1000 paths x 500 steps, default areas, the solver alone, CPU time, two
+runs at load 8-11, each against the generic kernel's in the run before it): Lie–Heun 42-49 ns per path-step
+(the generic kernel: 75-98), 2.1-2.3x the rigid body's on one thread, 1.9-2.3x on two (was 3.8-4.2x,
+3.7-3.8x); Lie–Euler 36-37 ns (60-61), 2.0-2.1x (3.6-3.7x).
 """
 
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numba
 import numpy as np
@@ -45,8 +47,8 @@ def has_se3_table(ti, tj, tk, tv) -> bool:
 
 #: Members per block: the length of a row of the work buffer (a compile-time constant, see the module docstring).
 B = 128
-# rows of the work buffer (each B floats): the state, the drift velocities, σ, the Taylor sum and term, the
-# predictor, the velocity's work rows, the stochastic velocity, and θ
+# rows of the work buffer (each B floats): the state μ, the drift velocities w(μ), w(μ*), σ, the Taylor sum (μ at
+# the start of a step, then μ*, then exp(ad*_σ) μ) and term, the velocity's work rows, the stochastic velocity, θ
 _MU, _W0, _W1, _S, _A1, _TERM, _G, _T2, _E = (6 * r * B for r in range(9))
 _TH = 54 * B
 _NROW = 55
@@ -248,92 +250,95 @@ def _taylor_degrees(wb, inv1, inv2, two, l1, l2, bc):
         _set6(wb, _A1, p, (m0, m1, m2, m3, m4, m5))
 
 
-@lru_cache(maxsize=None)
-def block_kernel(C: int):
-    """The compiled se(3) block kernel for scheme ``C`` (0 Lie–Euler, 1 Lie–Heun), with the signature of
-    :func:`._generic_kernels._block_kernel`'s (compiled on first use and cached)."""
-    if C not in (0, 1):
-        raise ValueError(f"the se(3) block kernel runs Lie-Euler (0) and Lie-Heun (1), got scheme {C}.")
+@numba.njit(cache=True, nogil=True)
+def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
+              degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
+    """Members lo .. hi-1 (at most :data:`B`) over every step of the block by Lie–Euler (``code`` 0) or Lie–Heun
+    (``code`` 1), with the signature of :func:`._generic_kernels._block_kernel`'s kernels; returns the number of
+    members that failed.
 
-    @numba.njit(cache=True, nogil=True)
-    def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
-                  degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
-        """Members lo .. hi-1 (at most :data:`B`) over every step of the block; returns the number that failed."""
-        n = 6
-        bc = hi - lo
-        nk = dX.shape[1]
-        area = dXX.shape[0] > 0
-        c = (cnorm[0], cnorm[1], cnorm[2], cnorm[3], cnorm[4], cnorm[5])
-        wb = np.empty(_NROW * B)
-        xt = np.zeros((STEPS, 6, B))               # without the area its rows 3-5 stay 0 (see _eta3)
-        # flags as values, not literals (numba would compile a variant of the callee per literal True / False)
-        heun = C == 1
-        pred = nk >= 0
-        w0, w1 = _rows(wb, _W0), _rows(wb, _W1)
-        big = np.empty(bc, dtype=np.bool_)
-        work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
-        vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
-        lim = degth[degth.shape[0] - 1]
-        for p in range(bc):
-            for i in range(n):
-                wb[_MU + i * B + p] = y[lo + p, i]
-                wb[_A1 + i * B + p] = y[lo + p, i]         # rows _A1 hold μ at the start of every step
-        nfail = 0
-        slot = 0
-        for k in range(nk):
-            dt = dts[k]
-            kk = k % STEPS
-            if kk == 0:
-                _tile3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xt)
-            _eta3(xt[kk], wb, bc, xi, brk)
-            _velocity(wb, w0, lin, f, theta, qs, mts, bc, pred)
-            if C == 1:
-                # the predictor μ* = (μ + ad*_σ* μ) + ½ ad*_σ*(ad*_σ* μ), σ* = w(μ) dt + e: Taylor degrees 1 and 2 of
-                # exp(ad*_σ*) μ, every member adding both (θ row +inf), in rows _A1; then w(μ*)
-                _sigma(wb, not heun, pred, dt, c, 0.0, 0.0, bc)
-                _velocity(wb, w1, lin, f, theta, qs, mts, bc, pred)
-            _sigma(wb, heun, not pred, dt, c, degth[0], degth[1], bc)
-            # exp(ad*_σ) μ: the Taylor sum to the degree of the block's largest θ (each member adds its own degrees)
-            nbig, thmax = _theta_max(wb, lim, big, bc)
-            r = 3
-            while thmax > degth[r - 1]:
-                two = thmax > degth[r]
-                _taylor_degrees(wb, 1.0 / r, 1.0 / (r + 1), two, degth[r - 1], degth[r], bc)
-                r += 2 if two else 1
-            if thmax > degth[0]:
-                _accept(wb, big, bc)
-            if nbig > 0:
-                for p in range(bc):
-                    if not big[p]:
-                        continue
-                    finite_in = True
-                    for i in range(n):
-                        vm[i] = wb[_MU + i * B + p]
-                        vs[i] = wb[_S + i * B + p]
-                        if not (math.isfinite(vm[i]) and math.isfinite(wb[_E + i * B + p])):
-                            finite_in = False
-                    ok = False
-                    if finite_in:
-                        ok = exp1(vs, vm, vo, work[0], work[1], work[2], work[3][0], work[3][1], ti, tj, tk, tv, cnorm,
-                                  degth)
-                    for i in range(n):
-                        wb[_MU + i * B + p] = vo[i] if ok else np.nan
-                        wb[_A1 + i * B + p] = wb[_MU + i * B + p]
-                    if not ok:
-                        if first_bad[lo + p] < 0:
-                            first_bad[lo + p] = k
-                            reason[lo + p] = NON_FINITE
-                            nfail += 1
-            if save[k]:
-                for p in range(bc):
-                    for i in range(n):
-                        out[lo + p, slot, i] = wb[_MU + i * B + p]
-                slot += 1
-            if stop and nfail > 0:
-                break
-        for p in range(bc):
-            for i in range(n):
-                y[lo + p, i] = wb[_MU + i * B + p]
-        return nfail
-
-    return run_block
+    One compiled kernel for both schemes (the scheme is a value: Lie–Euler merely skips the predictor), so the
+    heavy top's second scheme compiles nothing. Compile cost: the heavy top's first Lie–Heun solve with an empty
+    numba cache takes 6.5 s of CPU (this kernel and the passes it calls; with the generic kernel it replaces:
+    6.9 s), its first Lie–Euler solve 6.7 s (6.7 s); minima of 3-4 fresh processes at load 3-6. The passes are
+    compiled functions of their own, called with flags as values rather than literals (numba would compile a
+    variant per literal). The heavy top no longer shares the generic kernel's compiled variants with the other
+    algebras, so a process that solves both compiles both: ``tools/warm_kernels.py --part mechanics --more``
+    took 57 s of CPU before, 68-79 s with this kernel (two pairs of fresh processes, load 3-6).
+    """
+    n = 6
+    bc = hi - lo
+    nk = dX.shape[1]
+    area = dXX.shape[0] > 0
+    c = (cnorm[0], cnorm[1], cnorm[2], cnorm[3], cnorm[4], cnorm[5])
+    wb = np.empty(_NROW * B)
+    xt = np.zeros((STEPS, 6, B))               # without the area its rows 3-5 stay 0 (see _eta3)
+    # flags as values, not literals (numba would compile a variant of the callee per literal True / False)
+    heun = code == 1
+    pred = nk >= 0
+    w0, w1 = _rows(wb, _W0), _rows(wb, _W1)
+    big = np.empty(bc, dtype=np.bool_)
+    work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
+    vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
+    lim = degth[degth.shape[0] - 1]
+    for p in range(bc):
+        for i in range(n):
+            wb[_MU + i * B + p] = y[lo + p, i]
+            wb[_A1 + i * B + p] = y[lo + p, i]         # rows _A1 hold μ at the start of every step
+    nfail = 0
+    slot = 0
+    for k in range(nk):
+        dt = dts[k]
+        kk = k % STEPS
+        if kk == 0:
+            _tile3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xt)
+        _eta3(xt[kk], wb, bc, xi, brk)
+        _velocity(wb, w0, lin, f, theta, qs, mts, bc, pred)
+        if heun:
+            # the predictor μ* = (μ + ad*_σ* μ) + ½ ad*_σ*(ad*_σ* μ), σ* = w(μ) dt + e: Taylor degrees 1 and 2 of
+            # exp(ad*_σ*) μ, every member adding both (θ row +inf), in rows _A1; then w(μ*)
+            _sigma(wb, not heun, pred, dt, c, 0.0, 0.0, bc)
+            _velocity(wb, w1, lin, f, theta, qs, mts, bc, pred)
+        _sigma(wb, heun, not pred, dt, c, degth[0], degth[1], bc)
+        # exp(ad*_σ) μ: the Taylor sum to the degree of the block's largest θ (each member adds its own degrees)
+        nbig, thmax = _theta_max(wb, lim, big, bc)
+        r = 3
+        while thmax > degth[r - 1]:
+            two = thmax > degth[r]
+            _taylor_degrees(wb, 1.0 / r, 1.0 / (r + 1), two, degth[r - 1], degth[r], bc)
+            r += 2 if two else 1
+        if thmax > degth[0]:
+            _accept(wb, big, bc)
+        if nbig > 0:
+            for p in range(bc):
+                if not big[p]:
+                    continue
+                finite_in = True
+                for i in range(n):
+                    vm[i] = wb[_MU + i * B + p]
+                    vs[i] = wb[_S + i * B + p]
+                    if not (math.isfinite(vm[i]) and math.isfinite(wb[_E + i * B + p])):
+                        finite_in = False
+                ok = False
+                if finite_in:
+                    ok = exp1(vs, vm, vo, work[0], work[1], work[2], work[3][0], work[3][1], ti, tj, tk, tv, cnorm,
+                              degth)
+                for i in range(n):
+                    wb[_MU + i * B + p] = vo[i] if ok else np.nan
+                    wb[_A1 + i * B + p] = wb[_MU + i * B + p]
+                if not ok:
+                    if first_bad[lo + p] < 0:
+                        first_bad[lo + p] = k
+                        reason[lo + p] = NON_FINITE
+                        nfail += 1
+        if save[k]:
+            for p in range(bc):
+                for i in range(n):
+                    out[lo + p, slot, i] = wb[_MU + i * B + p]
+            slot += 1
+        if stop and nfail > 0:
+            break
+    for p in range(bc):
+        for i in range(n):
+            y[lo + p, i] = wb[_MU + i * B + p]
+    return nfail

@@ -66,8 +66,8 @@ def test_bitwise_the_generic_kernel(name, area, solver, monkeypatch):
     mu0[2] *= 1e8                                            # a wild member: large θ, the scalar path
     X = _path(3, nb, area)
     kernels = []
-    real = _se3_block.block_kernel
-    monkeypatch.setattr(_se3_block, "block_kernel", lambda C: kernels.append(C) or real(C))
+    real = _se3_block.run_block
+    monkeypatch.setattr(_se3_block, "run_block", lambda *a: kernels.append(a[8]) or real(*a))
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
@@ -76,9 +76,9 @@ def test_bitwise_the_generic_kernel(name, area, solver, monkeypatch):
         ours2 = _solve(top, X, mu0, solver, False, monkeypatch)
     finally:
         numba.set_num_threads(threads)
-    assert kernels == [solver._code] * 2
+    assert kernels == [solver._code] * 6                     # three blocks, twice
     ref = _solve(top, X, mu0, solver, True, monkeypatch)
-    assert len(kernels) == 2                                 # the reference did not take it
+    assert len(kernels) == 6                                 # the reference did not take it
     for got in (ours, ours2):
         np.testing.assert_array_equal(got.states.view(np.uint64), ref.states.view(np.uint64))
         np.testing.assert_array_equal(got.failed_step, ref.failed_step)
@@ -96,8 +96,8 @@ def test_table_match_is_exact(solver, monkeypatch):
     top = TOPS["theta"]
     c = se3().structure_constants
     taken = []
-    real = _se3_block.block_kernel
-    monkeypatch.setattr(_se3_block, "block_kernel", lambda C: taken.append(C) or real(C))
+    real = _se3_block.run_block
+    monkeypatch.setattr(_se3_block, "run_block", lambda *a: taken.append(a[8]) or real(*a))
     mu0 = np.random.default_rng(2).standard_normal((5, 6))
     X = BrownianDriver(3, seed=3, dt=0.02, n_steps=30, batch_shape=(5,)).rough_path()
     save = np.ones(30, dtype=bool)
@@ -118,13 +118,8 @@ def test_table_match_is_exact(solver, monkeypatch):
 def test_other_noise_counts_run_the_generic_kernel(m, monkeypatch):
     top = heavy_top([1.0, 2.0, 3.0], chi=[0.1, -0.2, 1.0], xi=0.3 * np.eye(m, 6), theta=0.2)
     taken = []
-    monkeypatch.setattr(_se3_block, "block_kernel", lambda C: taken.append(C))
+    monkeypatch.setattr(_se3_block, "run_block", lambda *a: taken.append(a[8]))
     X = BrownianDriver(m, seed=1, dt=0.02, n_steps=10, batch_shape=(3,)).rough_path()
     solve(top, X, np.ones((3, 6)), LieHeun())
     solve(top, X, np.ones((3, 6)), ImplicitMidpoint())
     assert taken == []
-
-
-def test_only_the_explicit_schemes():
-    with pytest.raises(ValueError, match="Lie-Euler .0. and Lie-Heun .1."):
-        _se3_block.block_kernel(2)
