@@ -42,8 +42,8 @@ fixed-point iteration there). Otherwise a system with a quadratic Hamiltonian an
 kernels:
 for a :class:`~mechanics.systems.lie_algebra.SO3Algebra` the hand-written ones of
 :mod:`mechanics.integrators._so3_kernels`, for an :class:`~mechanics.systems.lie_algebra.SE3Algebra` (the heavy
-top) and the implicit midpoint rule that of :mod:`mechanics.integrators._se3_kernels` (Lie–Euler and
-Lie–Heun on se(3) measured faster in the generic kernel, ``benchmarks/bench_coadjoint_kernels.py``), and
+top) and the implicit midpoint rule that of :mod:`mechanics.integrators._se3_kernels` (Lie–Euler and Lie–Heun on se(3) go to the generic kernel's entry point, which runs its se(3) block kernel,
+:mod:`mechanics.integrators._se3_block`: the generic kernel's numbers bit for bit in about half its time), and
 otherwise the generic kernel of
 :mod:`mechanics.integrators._generic_kernels`, compiled once for all algebras (the structure constants are
 data: su(2), sl(2, R), so(4), semidirect products, a user's basis). A system on a
@@ -246,8 +246,8 @@ class CoadjointSolver(Solver):
             chord = (reason == _isospectral.CHORD_FAILED).reshape(batch)
         elif plain:
             # so(3): the hand-written kernel; se(3) (the heavy top): the hand-written kernel for the implicit
-            # midpoint rule; every other case (se(3) Lie-Euler / Lie-Heun included, where it measured faster):
-            # the generic one
+            # midpoint rule; every other case: the generic one (which runs its se(3) block kernel,
+            # ._se3_block, for se(3) Lie-Euler / Lie-Heun)
             if isinstance(system.algebra, SO3Algebra):
                 kernels, run = _so3_kernels, _so3_kernels.integrate_so3
             elif isinstance(system.algebra, SE3Algebra) and self._code == 2:
