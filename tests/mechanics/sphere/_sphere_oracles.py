@@ -37,6 +37,17 @@ def dense_laplacian(P, S):
     return out
 
 
+def laplacian_operator(N, S=None):
+    """The Laplacian as an N² x N² matrix acting on flattened matrices, column by column from dense_laplacian."""
+    S = spin(N) if S is None else S
+    op = np.zeros((N * N, N * N), dtype=complex)
+    for k in range(N * N):
+        E = np.zeros(N * N, dtype=complex)
+        E[k] = 1
+        op[:, k] = dense_laplacian(E.reshape(N, N), S).ravel()
+    return op
+
+
 def Y(l, m, theta, phi):
     """scipy's orthonormal harmonic with the Condon–Shortley phase (theta colatitude)."""
     return sp.sph_harm_y(l, m, theta, phi)

@@ -9,18 +9,14 @@ and sends the identity (l = 0) to zero. Oracles: the dense N^2 x N^2 operator bu
 import numpy as np
 import pytest
 
-from _sphere_oracles import dense_laplacian, random_su, spin
+from _sphere_oracles import dense_laplacian, laplacian_operator, random_su, spin
 from mechanics.sphere import inverse_laplacian, laplacian
 
 
 @pytest.mark.parametrize("N", [2, 3, 4, 7])
 def test_spectrum_is_the_truncated_sphere_spectrum(N):
     S = spin(N)
-    op = np.zeros((N * N, N * N), dtype=complex)
-    for k in range(N * N):
-        E = np.zeros(N * N, dtype=complex)
-        E[k] = 1
-        op[:, k] = dense_laplacian(E.reshape(N, N), S).ravel()
+    op = laplacian_operator(N, S)
     eig = np.sort(np.linalg.eigvalsh(0.5 * (op + op.conj().T)))
     expected = np.sort(np.concatenate([[-l * (l + 1)] * (2 * l + 1) for l in range(N)]).astype(float))
     np.testing.assert_allclose(eig, expected, atol=1e-10)

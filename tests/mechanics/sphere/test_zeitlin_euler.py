@@ -16,8 +16,8 @@ Oracles: dense Laplacian from spin matrices, scipy's harmonics and quadrature.
 import numpy as np
 import pytest
 
-from _sphere_oracles import (Field, bracket, dense_laplacian, fitted_slope, flat, project, quadrature, random_su,
-                             spin)
+from _sphere_oracles import (Field, bracket, dense_laplacian, fitted_slope, flat, laplacian_operator, project,
+                             quadrature, random_su, spin)
 from mechanics.sphere import (ZeitlinHamiltonian, casimirs, coefficients_to_matrix, energy, enstrophy, hbar,
                               matrix_to_coefficients)
 
@@ -29,11 +29,7 @@ def pairing(A, C):
 def dense_inverse_laplacian(W):
     N = W.shape[-1]
     S = spin(N)
-    op = np.zeros((N * N, N * N), dtype=complex)
-    for k in range(N * N):
-        E = np.zeros(N * N, dtype=complex)
-        E[k] = 1
-        op[:, k] = dense_laplacian(E.reshape(N, N), S).ravel()
+    op = laplacian_operator(N, S)
     P = np.linalg.lstsq(op, W.ravel(), rcond=None)[0].reshape(N, N)  # minimum norm: trace-free
     return P
 
