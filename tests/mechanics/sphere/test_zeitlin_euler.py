@@ -16,7 +16,7 @@ Oracles: dense Laplacian from spin matrices, scipy's harmonics and quadrature.
 import numpy as np
 import pytest
 
-from _sphere_oracles import (Field, bracket, dense_laplacian, fitted_slope, flat, laplacian_operator, project,
+from _sphere_oracles import (Field, bracket, fitted_slope, flat, laplacian_operator, project,
                              quadrature, random_su, spin)
 from mechanics.sphere import (ZeitlinHamiltonian, casimirs, coefficients_to_matrix, energy, enstrophy, hbar,
                               matrix_to_coefficients)
