@@ -57,6 +57,15 @@ FAMILIES = {
                                        "s = LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1)\n"
                                        "rp.solve(s, rp.BrownianDriver(3, seed=0, dt=0.01, n_steps=20, "
                                        "batch_shape=(4,)), np.ones((4, 3)), LieHeun())"),
+    "heavy top LieHeun": ("", "from mechanics import heavy_top, LieHeun\n"
+                              "t = heavy_top([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], sigma=0.1)\n"
+                              "rp.solve(t, rp.BrownianDriver(3, seed=0, dt=0.01, n_steps=20, batch_shape=(4,)), "
+                              "np.tile([0.1, 0.2, 0.3, 0.0, 0.0, 1.0], (4, 1)), LieHeun())"),
+    "matrix algebra su(6) LieHeun": ("", "from mechanics import LiePoissonSystem, LieHeun, su\n"
+                                         "g = su(6)\n"
+                                         "s = LiePoissonSystem(g, np.ones(g.dim), 0.3 * np.eye(g.dim)[:3], theta=0.1)\n"
+                                         "rp.solve(s, rp.BrownianDriver(3, seed=0, dt=0.01, n_steps=20, "
+                                         "batch_shape=(4,)), np.ones((4, g.dim)), LieHeun())"),
     "run_ensemble (rigid body)": ("", "from mechanics import rigid_body, run_ensemble\n"
                                       "run_ensemble(rigid_body([1.0, 2.0, 3.0], sigma=0.1), np.ones(3), dt=0.01, "
                                       "n_steps=8, n_paths=4, seed=0)"),
