@@ -293,9 +293,11 @@ class MatrixLieAlgebra:
         return self._matrix_to_dual(M @ X - X @ M)
 
     def _dense_operator(self, batch, what):
-        n = self._n
-        check_memory(8.0 * (1 + int(np.prod(batch, dtype=np.int64))) * n * n * (2 + 2 * self.dtype.itemsize // 8)
-                     * max(1, self._N ** 2 // n), f"{what} of {self.name} (n x n matrices, n = {n})",
+        """The unit vectors an ``n × n`` operator is applied to, after checking its memory: the ``n`` basis matrices,
+        three ``n × N × N`` products per member, and the ``n × n`` result (with its copy) per member."""
+        n, b = self._n, float(np.prod(batch, dtype=np.int64))
+        check_memory(float(n) * self._N ** 2 * self.dtype.itemsize * (1.0 + 3.0 * b) + 16.0 * b * n * n,
+                     f"{what} of {self.name} (n x n matrices, n = {n})",
                      "use the matrix operations (bracket, ad_star) instead")
         return np.eye(n)
 
