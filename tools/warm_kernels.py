@@ -99,7 +99,7 @@ def warm_more_gradients() -> None:
 
 def warm_more_coadjoint() -> None:
     """For the test suite (``--more``): Lie–Euler and the implicit midpoint rule on so(3), se(3) and a user
-    algebra; every scheme on the rough paths a user builds (a level-1 path, increments with areas, a path's
+    algebra, and the kernels of the rare steps past the vectorised exponential (a member with a huge state); every scheme on the rough paths a user builds (a level-1 path, increments with areas, a path's
     lift), whose arrays reach the so(3) and se(3) kernels writeable or read-only in other combinations than
     a driver's (each combination is a specialisation of its own, 6-8 s of CPU); the midpoint rule's
     six-dimensional variant of the generic kernel (se(3) from its constants, so(4))."""
@@ -110,8 +110,10 @@ def warm_more_coadjoint() -> None:
     rigid, top = rigid_body([1.0, 2.0, 3.0], sigma=0.1), heavy_top([1.0, 2.0, 3.0], chi=[0.0, 0.0, 1.0], sigma=0.1)
     for system in (LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1), rigid, top):
         X = BrownianDriver(system.n_noise, seed=0, dt=0.01, n_steps=2, batch_shape=(2,))
-        for method in (LieEuler(), ImplicitMidpoint()):
-            solve(system, X, np.ones((2, system.dim)), method)
+        wild = np.ones((2, system.dim))
+        wild[1] *= 1e8                 # a step past the vectorised exponential: the rare-step kernels
+        for method in (LieEuler(), LieHeun(), ImplicitMidpoint()):
+            solve(system, X, wild, method, on_failure="mask")
     rng = np.random.default_rng(0)
     times = np.linspace(0.0, 0.02, 3)
     for system in (rigid, top):

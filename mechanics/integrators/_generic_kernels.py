@@ -50,7 +50,7 @@ import numpy as np
 
 from roughpaths.validation import parallel_ranges
 from . import _se3_block
-from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1
+from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1, rare_steps
 from ._soa_rows import (CHORD_FAILED, NON_FINITE, OK, STEPS, ad_star_rows, algebra_tables, eta_rows,
                         sparse_rows, velocity_rows)
 
@@ -59,19 +59,27 @@ BLOCK = 128
 
 
 @lru_cache(maxsize=None)
-def _block_kernel(C: int, N: int):
+def _block_kernel(C: int, N: int, full: bool):
     """The compiled block kernel for scheme ``C`` (0 LieEuler, 1 LieHeun, 2 implicit midpoint) and, for the
     midpoint rule, the compile-time dimension ``N`` (3, 6; 0 reads it from the arrays).
 
     Each variant is its own kernel, compiled on first use and cached: a LieHeun solve compiles neither
     the chord iteration nor its three dimension variants (which cost most of the kernel's compile time).
+    Lie–Euler and Lie–Heun come in two variants: without the exact exponential of the rare large steps
+    (``full=False``: the kernel returns at such a step, :func:`integrate_generic` does it with
+    :func:`._generic_member.rare_steps` and goes on with the other variant) and with it inline (``full=True``).
+    A solve that never takes such a step compiles only the first (about 1.2 s of CPU less).
     """
 
     @numba.njit(cache=True, nogil=True)
     def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
-                  degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
-        """Members lo .. hi-1 over every step of the block; returns the number of members that failed
-        (``code`` is the scheme the variant was made for, ``C``)."""
+                  degth, save, out, first_bad, reason, stop, flag, sout, lo, hi, k0, start, qs, mts, has_f):
+        """Members lo .. hi-1 over the steps from ``k0`` on (``code`` is the scheme the variant was made for, ``C``).
+
+        Returns ``(failed, k)``: the number of members that failed, and ``-1`` when done (or stopped), or, for
+        Lie–Euler and Lie–Heun, the step ``k`` at which members flagged in ``flag`` need the exact exponential
+        (:func:`._generic_member.rare_steps`): the state before step ``k`` is in ``y`` for them (after it for the others), the
+        step's ``σ`` in ``sout``; step ``k`` is not saved yet."""
         n = y.shape[1]
         bc = hi - lo
         nk = dX.shape[1]
@@ -91,9 +99,12 @@ def _block_kernel(C: int, N: int):
                 mu[i, p] = y[lo + p, i]
         nfail = 0
         slot = 0
-        for k in range(nk):
+        for k in range(k0):
+            if save[k]:
+                slot += 1
+        for k in range(k0, nk):
             dt = dts[k]
-            kk = k % STEPS
+            kk = (k - k0) % STEPS
             if kk == 0:
                 eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
             e = ebuf[kk]
@@ -159,7 +170,19 @@ def _block_kernel(C: int, N: int):
                         mi, ai = mu[i], a1[i]
                         for p in range(bc):
                             mi[p] = ai[p] if not big[p] else mi[p]
-            if nbig > 0:
+            if nbig > 0 and C != 2 and not full:     # the exact exponential: rare_steps, compiled when needed
+                nl = 0
+                for p in range(bc):
+                    if big[p] and first_bad[lo + p] < 0:
+                        nl += 1
+                if nl > 0:
+                    for p in range(bc):
+                        flag[lo + p] = big[p] and first_bad[lo + p] < 0
+                        for i in range(n):
+                            y[lo + p, i] = mu[i, p]
+                            sout[lo + p, i] = s[i, p]
+                    return nfail, k
+            if nbig > 0 and (C == 2 or full):
                 for p in range(bc):
                     if not big[p]:
                         continue
@@ -205,9 +228,11 @@ def _block_kernel(C: int, N: int):
         for p in range(bc):
             for i in range(n):
                 y[lo + p, i] = mu[i, p]
-        return nfail
+        return nfail, -1
 
     return run_block
+
+
 
 
 def _readonly(a):
@@ -229,7 +254,7 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
     data = system.quadratic_velocity_data()
     ti, tj, tk, tv, start, cnorm = algebra_tables(system.algebra.structure_constants)
     nb, n = y.shape
-    nm = dX.shape[-1]
+    nk, nm = dX.shape[1], dX.shape[-1]
     pi, pj = np.triu_indices(nm, 1)
     brk = np.array(system.xi_brackets[pi, pj], dtype=np.float64, order="C")
     y = np.array(y, dtype=np.float64, order="C")
@@ -246,11 +271,27 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             np.array(dts, dtype=np.float64), int(code), np.array(data["q"], dtype=np.float64, order="C"),
             np.array(data["linear"], dtype=np.float64), f, mth, theta, float(tol), int(max_iter), ti, tj, tk,
             tv, cnorm, DEGREE_THETA, np.array(save, dtype=np.bool_), out, first_bad, reason,
-            bool(stop_on_failure))
+            bool(stop_on_failure), np.zeros(nb, dtype=np.bool_), np.empty((nb, n)))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
+    save, flag, sout = args[22], args[27], args[28]
     if code != 2 and nm == 3 and _se3_block.has_se3_table(ti, tj, tk, tv):   # the same numbers, written out
-        kernel, block = _se3_block.run_block, _se3_block.B
+        kernel, full, block = _se3_block.run_block, _se3_block.run_block_full, _se3_block.B
     else:
-        kernel, block = _block_kernel(int(code), n if code == 2 and n in (3, 6) else 0), BLOCK
-    parallel_ranges(lambda lo, hi: kernel(*args, lo, hi, *tail), nb, block)
+        N = n if code == 2 and n in (3, 6) else 0
+        kernel, full, block = _block_kernel(int(code), N, False), None, BLOCK
+
+    def run(lo, hi):
+        _, k = kernel(*args, lo, hi, 0, *tail)
+        if k < 0:
+            return
+        # a step the vectorised Taylor loop left to the exact exponential: do it, then go on with the variant
+        # that has it inline
+        nnew = rare_steps(y[lo:hi], sout[lo:hi], flag[lo:hi], ti, tj, tk, tv, cnorm, DEGREE_THETA,
+                          first_bad[lo:hi], reason[lo:hi], k)
+        if save[k]:
+            out[lo:hi, np.count_nonzero(save[:k])] = y[lo:hi]
+        if not ((stop_on_failure and nnew > 0) or k + 1 == nk):
+            (full or _block_kernel(int(code), 0, True))(*args, lo, hi, k + 1, *tail)
+
+    parallel_ranges(run, nb, block)
     return y, out, first_bad, reason

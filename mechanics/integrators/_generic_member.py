@@ -24,6 +24,8 @@ import math
 import numba
 import numpy as np
 
+from ._soa_rows import NON_FINITE
+
 _TOL = 2.0 ** -54
 
 #: Largest Taylor degree of the vector path.
@@ -345,3 +347,35 @@ def midpoint1(mu, e, s, out, dt, q, qs, lin, f, mts, theta, tol, max_iter, ti, t
     if not chord1(mu, e, s, dt, q, qs, lin, f, mts, theta, tol, max_iter, ti, tj, tk, tv, cnorm, degth, w, nd):
         return False, True
     return exp_dense1(s, mu, out, w[5], w[6], w[7], w[8][6], w[8][7], ti, tj, tk, tv, cnorm, degth, nd), False
+
+
+@numba.njit(cache=True, nogil=True)
+def rare_steps(y, sout, flag, ti, tj, tk, tv, cnorm, degth, first_bad, reason, k):
+    """The exact exponential (:func:`exp1`, scaling and squaring) of the flagged members of one
+    block, rows ``y`` (B, n) and their step's ``σ`` in ``sout`` (B, n): the steps the vectorised Taylor loop
+    left (θ past :data:`THETA_VECTOR`, or non-finite). Its own kernel, compiled only when a
+    solve reaches such a step (about 1.2 s of CPU that a sane run never pays). A member that fails gets NaN
+    and, on its first failure, ``first_bad = k`` and ``reason`` NON_FINITE. Returns the number of first
+    failures."""
+    n = y.shape[1]
+    work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
+    vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
+    nnew = 0
+    for p in range(y.shape[0]):
+        if not flag[p]:
+            continue
+        finite_in = True
+        for i in range(n):
+            vm[i] = y[p, i]
+            vs[i] = sout[p, i]
+            if not (math.isfinite(vm[i]) and math.isfinite(vs[i])):
+                finite_in = False
+        ok = finite_in and exp1(vs, vm, vo, work[0], work[1], work[2], work[3][6], work[3][7], ti, tj, tk, tv,
+                                cnorm, degth)
+        for i in range(n):
+            y[p, i] = vo[i] if ok else np.nan
+        if not ok:
+            first_bad[p] = k
+            reason[p] = NON_FINITE
+            nnew += 1
+    return nnew

@@ -7,7 +7,7 @@ se(3) given by its constants alike. The numbers are the generic kernel's, bit fo
 terms in the same order (a term :math:`(\pm1\cdot x)\,m` of the table is written :math:`\pm(x\,m)`, which
 rounds alike), the exponential is the same Taylor series with each member's own degree, the velocity the same
 sparse rows of ``Q`` and ``θM⁻¹`` (:func:`._soa_rows.affine_rows`), and a member with a large or non-finite
-:math:`\theta` takes the same scalar path (:func:`._generic_member.exp1`).
+:math:`\theta` takes the same scalar path (:func:`._generic_member.rare_steps`, compiled when first needed).
 
 What differs is the memory traffic. The generic kernel writes an output row once per non-zero constant (18
 passes over the block for one ``ad*``); here one pass over the block's members computes all six components
@@ -250,95 +250,133 @@ def _taylor_degrees(wb, inv1, inv2, two, l1, l2, bc):
         _set6(wb, _A1, p, (m0, m1, m2, m3, m4, m5))
 
 
-@numba.njit(cache=True, nogil=True)
-def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
-              degth, save, out, first_bad, reason, stop, lo, hi, start, qs, mts, has_f):
-    """Members lo .. hi-1 (at most :data:`B`) over every step of the block by Lie–Euler (``code`` 0) or Lie–Heun
-    (``code`` 1), with the signature of :func:`._generic_kernels._block_kernel`'s kernels; returns the number of
-    members that failed.
+def _kernel(full: bool):
+    """:func:`run_block` (``full=False``) or :func:`run_block_full` (the exact exponential of the rare large steps
+    inline): see :func:`._generic_kernels._block_kernel`. ``full`` is a closure constant."""
 
-    One compiled kernel for both schemes (the scheme is a value: Lie–Euler merely skips the predictor), so the
-    heavy top's second scheme compiles nothing. Compile cost: the heavy top's first Lie–Heun solve with an empty
-    numba cache takes 6.5 s of CPU (this kernel and the passes it calls; with the generic kernel it replaces:
-    6.9 s), its first Lie–Euler solve 6.7 s (6.7 s); minima of 3-4 fresh processes at load 3-6. The passes are
-    compiled functions of their own, called with flags as values rather than literals (numba would compile a
-    variant per literal). The heavy top no longer shares the generic kernel's compiled variants with the other
-    algebras, so a process that solves both compiles both: ``tools/warm_kernels.py --part mechanics --more``
-    took 57 s of CPU before, 68-79 s with this kernel (two pairs of fresh processes, load 3-6).
-    """
-    n = 6
-    bc = hi - lo
-    nk = dX.shape[1]
-    area = dXX.shape[0] > 0
-    c = (cnorm[0], cnorm[1], cnorm[2], cnorm[3], cnorm[4], cnorm[5])
-    wb = np.empty(_NROW * B)
-    xt = np.zeros((STEPS, 6, B))               # without the area its rows 3-5 stay 0 (see _eta3)
-    # flags as values, not literals (numba would compile a variant of the callee per literal True / False)
-    heun = code == 1
-    pred = nk >= 0
-    w0, w1 = _rows(wb, _W0), _rows(wb, _W1)
-    big = np.empty(bc, dtype=np.bool_)
-    work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
-    vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
-    lim = degth[degth.shape[0] - 1]
+    @numba.njit(cache=True, nogil=True)
+    def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
+                  degth, save, out, first_bad, reason, stop, flag, sout, lo, hi, k0, start, qs, mts, has_f):
+        """Members lo .. hi-1 (at most :data:`B`) over the steps from ``k0`` on by Lie–Euler (``code`` 0) or Lie–Heun
+        (``code`` 1), with the signature and the returns of :func:`._generic_kernels._block_kernel`'s kernels (the
+        exact exponential of the rare large steps runs in :func:`._generic_member.rare_steps`).
+
+        One compiled kernel for both schemes (the scheme is a value: Lie–Euler merely skips the predictor), so the
+        heavy top's second scheme compiles nothing. Compile cost: the heavy top's first Lie–Heun solve with an empty
+        numba cache takes 6.5 s of CPU (this kernel and the passes it calls; with the generic kernel it replaces:
+        6.9 s), its first Lie–Euler solve 6.7 s (6.7 s); minima of 3-4 fresh processes at load 3-6. The passes are
+        compiled functions of their own, called with flags as values rather than literals (numba would compile a
+        variant per literal). The heavy top no longer shares the generic kernel's compiled variants with the other
+        algebras, so a process that solves both compiles both: ``tools/warm_kernels.py --part mechanics --more``
+        took 57 s of CPU before, 68-79 s with this kernel (two pairs of fresh processes, load 3-6).
+        """
+        n = 6
+        bc = hi - lo
+        nk = dX.shape[1]
+        area = dXX.shape[0] > 0
+        c = (cnorm[0], cnorm[1], cnorm[2], cnorm[3], cnorm[4], cnorm[5])
+        wb = np.empty(_NROW * B)
+        xt = np.zeros((STEPS, 6, B))               # without the area its rows 3-5 stay 0 (see _eta3)
+        # flags as values, not literals (numba would compile a variant of the callee per literal True / False)
+        heun = code == 1
+        pred = nk >= 0
+        w0, w1 = _rows(wb, _W0), _rows(wb, _W1)
+        big = np.empty(bc, dtype=np.bool_)
+        lim = degth[degth.shape[0] - 1]
+        work = (np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((8, n)))
+        vs, vm, vo = np.empty(n), np.empty(n), np.empty(n)
+        for p in range(bc):
+            for i in range(n):
+                wb[_MU + i * B + p] = y[lo + p, i]
+                wb[_A1 + i * B + p] = y[lo + p, i]         # rows _A1 hold μ at the start of every step
+        nfail = 0
+        slot = 0
+        for k in range(k0):
+            if save[k]:
+                slot += 1
+        for k in range(k0, nk):
+            dt = dts[k]
+            kk = (k - k0) % STEPS
+            if kk == 0:
+                _tile3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xt)
+            _eta3(xt[kk], wb, bc, xi, brk)
+            _velocity(wb, w0, lin, f, theta, qs, mts, bc, pred)
+            if heun:
+                # the predictor μ* = (μ + ad*_σ* μ) + ½ ad*_σ*(ad*_σ* μ), σ* = w(μ) dt + e: Taylor degrees 1 and 2 of
+                # exp(ad*_σ*) μ, every member adding both (θ row +inf), in rows _A1; then w(μ*)
+                _sigma(wb, not heun, pred, dt, c, 0.0, 0.0, bc)
+                _velocity(wb, w1, lin, f, theta, qs, mts, bc, pred)
+            _sigma(wb, heun, not pred, dt, c, degth[0], degth[1], bc)
+            # exp(ad*_σ) μ: the Taylor sum to the degree of the block's largest θ (each member adds its own degrees)
+            nbig, thmax = _theta_max(wb, lim, big, bc)
+            r = 3
+            while thmax > degth[r - 1]:
+                two = thmax > degth[r]
+                _taylor_degrees(wb, 1.0 / r, 1.0 / (r + 1), two, degth[r - 1], degth[r], bc)
+                r += 2 if two else 1
+            if thmax > degth[0]:
+                _accept(wb, big, bc)
+            if nbig > 0:
+                nl = 0
+                for p in range(bc):
+                    if big[p] and first_bad[lo + p] >= 0:        # failed before: stays NaN
+                        for i in range(n):
+                            wb[_MU + i * B + p] = np.nan
+                            wb[_A1 + i * B + p] = np.nan
+                    elif big[p]:
+                        nl += 1
+                if nl > 0 and not full:                         # the exact exponential: rare_steps, when needed
+                    for p in range(bc):
+                        flag[lo + p] = big[p] and first_bad[lo + p] < 0
+                        for i in range(n):
+                            y[lo + p, i] = wb[_MU + i * B + p]
+                            sout[lo + p, i] = wb[_S + i * B + p]
+                    return nfail, k
+                if nl > 0 and full:
+                    nfail += _exact_steps(wb, big, first_bad[lo:hi], reason[lo:hi], k, ti, tj, tk, tv, cnorm, degth,
+                                          work, vs, vm, vo, bc)
+            if save[k]:
+                for p in range(bc):
+                    for i in range(n):
+                        out[lo + p, slot, i] = wb[_MU + i * B + p]
+                slot += 1
+            if stop and nfail > 0:
+                break
+        for p in range(bc):
+            for i in range(n):
+                y[lo + p, i] = wb[_MU + i * B + p]
+        return nfail, -1
+
+    return run_block
+
+
+@numba.njit(cache=True, inline="always")
+def _exact_steps(wb, big, first_bad, reason, k, ti, tj, tk, tv, cnorm, degth, work, vs, vm, vo, bc):
+    """The exact exponential (:func:`._generic_member.exp1`) of the members of ``big`` that have not failed
+    before, in the rows of ``wb``; a failure gets NaN, ``first_bad = k`` and ``reason`` NON_FINITE. Returns
+    the number of first failures."""
+    n = vs.shape[0]
+    nnew = 0
     for p in range(bc):
+        if not big[p] or first_bad[p] >= 0:
+            continue
+        finite_in = True
         for i in range(n):
-            wb[_MU + i * B + p] = y[lo + p, i]
-            wb[_A1 + i * B + p] = y[lo + p, i]         # rows _A1 hold μ at the start of every step
-    nfail = 0
-    slot = 0
-    for k in range(nk):
-        dt = dts[k]
-        kk = k % STEPS
-        if kk == 0:
-            _tile3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xt)
-        _eta3(xt[kk], wb, bc, xi, brk)
-        _velocity(wb, w0, lin, f, theta, qs, mts, bc, pred)
-        if heun:
-            # the predictor μ* = (μ + ad*_σ* μ) + ½ ad*_σ*(ad*_σ* μ), σ* = w(μ) dt + e: Taylor degrees 1 and 2 of
-            # exp(ad*_σ*) μ, every member adding both (θ row +inf), in rows _A1; then w(μ*)
-            _sigma(wb, not heun, pred, dt, c, 0.0, 0.0, bc)
-            _velocity(wb, w1, lin, f, theta, qs, mts, bc, pred)
-        _sigma(wb, heun, not pred, dt, c, degth[0], degth[1], bc)
-        # exp(ad*_σ) μ: the Taylor sum to the degree of the block's largest θ (each member adds its own degrees)
-        nbig, thmax = _theta_max(wb, lim, big, bc)
-        r = 3
-        while thmax > degth[r - 1]:
-            two = thmax > degth[r]
-            _taylor_degrees(wb, 1.0 / r, 1.0 / (r + 1), two, degth[r - 1], degth[r], bc)
-            r += 2 if two else 1
-        if thmax > degth[0]:
-            _accept(wb, big, bc)
-        if nbig > 0:
-            for p in range(bc):
-                if not big[p]:
-                    continue
-                finite_in = True
-                for i in range(n):
-                    vm[i] = wb[_MU + i * B + p]
-                    vs[i] = wb[_S + i * B + p]
-                    if not (math.isfinite(vm[i]) and math.isfinite(wb[_E + i * B + p])):
-                        finite_in = False
-                ok = False
-                if finite_in:
-                    ok = exp1(vs, vm, vo, work[0], work[1], work[2], work[3][0], work[3][1], ti, tj, tk, tv, cnorm,
-                              degth)
-                for i in range(n):
-                    wb[_MU + i * B + p] = vo[i] if ok else np.nan
-                    wb[_A1 + i * B + p] = wb[_MU + i * B + p]
-                if not ok:
-                    if first_bad[lo + p] < 0:
-                        first_bad[lo + p] = k
-                        reason[lo + p] = NON_FINITE
-                        nfail += 1
-        if save[k]:
-            for p in range(bc):
-                for i in range(n):
-                    out[lo + p, slot, i] = wb[_MU + i * B + p]
-            slot += 1
-        if stop and nfail > 0:
-            break
-    for p in range(bc):
+            vm[i] = wb[_MU + i * B + p]
+            vs[i] = wb[_S + i * B + p]
+            if not (math.isfinite(vm[i]) and math.isfinite(vs[i])):
+                finite_in = False
+        ok = finite_in and exp1(vs, vm, vo, work[0], work[1], work[2], work[3][0], work[3][1], ti, tj, tk, tv,
+                                cnorm, degth)
         for i in range(n):
-            y[lo + p, i] = wb[_MU + i * B + p]
-    return nfail
+            wb[_MU + i * B + p] = vo[i] if ok else np.nan
+            wb[_A1 + i * B + p] = wb[_MU + i * B + p]
+        if not ok:
+            first_bad[p] = k
+            reason[p] = NON_FINITE
+            nnew += 1
+    return nnew
+
+
+#: The block kernel without, and with, the exact exponential of the rare large steps inline.
+run_block, run_block_full = _kernel(False), _kernel(True)

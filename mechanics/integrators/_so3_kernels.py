@@ -75,19 +75,31 @@ def _so3_chord(m0, m1, m2, e0, e1, e2, s0, s1, s2, dt, q, lin, minv, theta, tol,
     g0 = q[0, 0] * m0 + q[0, 1] * m1 + q[0, 2] * m2 + lin[0] + lin[3]
     g1 = q[1, 0] * m0 + q[1, 1] * m1 + q[1, 2] * m2 + lin[1] + lin[4]
     g2 = q[2, 0] * m0 + q[2, 1] * m1 + q[2, 2] * m2 + lin[2] + lin[5]
-    L = np.empty((3, 3))
-    L[0, 0], L[0, 1], L[0, 2] = 0.0, -m2, m1
-    L[1, 0], L[1, 1], L[1, 2] = m2, 0.0, -m0
-    L[2, 0], L[2, 1], L[2, 2] = -m1, m0, 0.0
+    # small matrix products as loops (numba's ``@`` on 3x3 arrays compiles a BLAS call: ~3 s of CPU)
+    L = np.zeros((3, 3))
+    L[0, 1], L[0, 2], L[1, 0], L[1, 2], L[2, 0], L[2, 1] = -m2, m1, m2, -m0, -m1, m0
     Dw = q.copy()
     if theta != 0.0:
         # d(mu × g) = -hat(g) dmu + hat(mu) q dmu
-        A = np.empty((3, 3))
-        A[0, 0], A[0, 1], A[0, 2] = 0.0, g2, -g1
-        A[1, 0], A[1, 1], A[1, 2] = -g2, 0.0, g0
-        A[2, 0], A[2, 1], A[2, 2] = g1, -g0, 0.0
-        Dw = Dw + theta * (minv @ (A + L @ q))
-    J = np.eye(3) - 0.5 * dt * (Dw @ L)
+        B = np.zeros((3, 3))
+        B[0, 1], B[0, 2], B[1, 0], B[1, 2], B[2, 0], B[2, 1] = g2, -g1, -g2, g0, g1, -g0
+        for i in range(3):
+            for j in range(3):
+                for k in range(3):
+                    B[i, j] += L[i, k] * q[k, j]
+        for i in range(3):
+            for j in range(3):
+                acc = 0.0
+                for k in range(3):
+                    acc += minv[i, k] * B[k, j]
+                Dw[i, j] += theta * acc
+    J = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                acc += Dw[i, k] * L[k, j]
+            J[i, j] = (1.0 if i == j else 0.0) - 0.5 * dt * acc
     # 3x3 inverse by cofactors: a singular or non-finite Jacobian fails this member alone (LAPACK's
     # inv would raise and abort the whole block)
     c00 = J[1, 1] * J[2, 2] - J[1, 2] * J[2, 1]
@@ -173,100 +185,137 @@ def coefficients(data):
 
 
 @numba.njit(cache=True, inline="always")
-def _so3_block_step(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k):
-    """Advance every member of ``m`` (3, B) by one coadjoint step with stochastic velocities ``e`` (3, B).
-
-    ``code`` 0 (Lie–Euler) and 1 (Lie–Heun) run the vectorised loop; 2 (implicit midpoint) the scalar
-    chord solve per member. A member that fails at this step (step index ``k``) is set to NaN and,
-    if it had not failed before, gets ``first_bad = k`` and ``reason`` (NON_FINITE or CHORD_FAILED).
-    Returns the number of members that failed for the first time at this step.
+def _so3_vector_steps(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k):
+    """Advance every member of ``m`` (3, B) by one Lie–Euler (``code`` 0) or Lie–Heun (1) step with stochastic
+    velocities ``e`` (3, B), in the vectorised loop. A member whose ``|sigma|²`` is past the Taylor branch (or
+    non-finite) keeps its state and is flagged in ``bad``: the exact scalar step (:func:`_so3_rare_steps`)
+    redoes it. Returns minus the number of flagged members that have not failed before (0: the step is done).
     """
     nb = m.shape[1]
     ma, mb, mc = m[0], m[1], m[2]
     ea, eb, ec = e[0], e[1], e[2]
     nbad = 0
-    if code == 2:
-        for p in range(nb):
-            bad[p] = True
-        nbad = nb
-    else:
-        q00, q01, q02, q10, q11, q12, q20, q21, q22 = (coef[0], coef[1], coef[2], coef[3], coef[4], coef[5],
-                                                       coef[6], coef[7], coef[8])
-        l0, l1, l2 = coef[9], coef[10], coef[11]
-        f0, f1, f2 = coef[21], coef[22], coef[23]     # gradient change inside the double bracket
-        n00, n01, n02, n10, n11, n12, n20, n21, n22 = (coef[12], coef[13], coef[14], coef[15], coef[16],
-                                                       coef[17], coef[18], coef[19], coef[20])
-        hdt = 0.5 * dt
-        for p in range(nb):
-            m0 = ma[p]
-            m1 = mb[p]
-            m2 = mc[p]
-            e0 = ea[p]
-            e1 = eb[p]
-            e2 = ec[p]
-            # w(mu) = g + theta M⁻¹ (mu × (g + f)), g = Q mu + b + shift, f = shift_dissipation - shift
-            g0 = q00 * m0 + q01 * m1 + q02 * m2 + l0
-            g1 = q10 * m0 + q11 * m1 + q12 * m2 + l1
-            g2 = q20 * m0 + q21 * m1 + q22 * m2 + l2
-            v0 = m1 * (g2 + f2) - m2 * (g1 + f1)
-            v1 = m2 * (g0 + f0) - m0 * (g2 + f2)
-            v2 = m0 * (g1 + f1) - m1 * (g0 + f0)
-            w0 = g0 + n00 * v0 + n01 * v1 + n02 * v2
-            w1 = g1 + n10 * v0 + n11 * v1 + n12 * v2
-            w2 = g2 + n20 * v0 + n21 * v1 + n22 * v2
-            s0 = w0 * dt + e0
-            s1 = w1 * dt + e1
-            s2 = w2 * dt + e2
-            if code == 1:
-                # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
-                c0 = m1 * s2 - m2 * s1
-                c1 = m2 * s0 - m0 * s2
-                c2 = m0 * s1 - m1 * s0
-                y0 = m0 + c0 + 0.5 * (c1 * s2 - c2 * s1)
-                y1 = m1 + c1 + 0.5 * (c2 * s0 - c0 * s2)
-                y2 = m2 + c2 + 0.5 * (c0 * s1 - c1 * s0)
-                g0 = q00 * y0 + q01 * y1 + q02 * y2 + l0
-                g1 = q10 * y0 + q11 * y1 + q12 * y2 + l1
-                g2 = q20 * y0 + q21 * y1 + q22 * y2 + l2
-                v0 = y1 * (g2 + f2) - y2 * (g1 + f1)
-                v1 = y2 * (g0 + f0) - y0 * (g2 + f2)
-                v2 = y0 * (g1 + f1) - y1 * (g0 + f0)
-                s0 = (w0 + g0 + n00 * v0 + n01 * v1 + n02 * v2) * hdt + e0
-                s1 = (w1 + g1 + n10 * v0 + n11 * v1 + n12 * v2) * hdt + e1
-                s2 = (w2 + g2 + n20 * v0 + n21 * v1 + n22 * v2) * hdt + e2
-            # exp(ad*_s) m = m - a s×m + b s×(s×m), Taylor to t^8 (exact in float64 for t² < 1e-2)
-            t2 = s0 * s0 + s1 * s1 + s2 * s2
-            big = not (t2 < SMALL_ANGLE2)           # also NaN: redone (and diagnosed) by the scalar step
-            bad[p] = big
-            nbad += big
-            a, b, _ = _taylor(t2)
-            c0 = s1 * m2 - s2 * m1
-            c1 = s2 * m0 - s0 * m2
-            c2 = s0 * m1 - s1 * m0
-            d0 = s1 * c2 - s2 * c1
-            d1 = s2 * c0 - s0 * c2
-            d2 = s0 * c1 - s1 * c0
-            ma[p] = m0 if big else m0 - a * c0 + b * d0
-            mb[p] = m1 if big else m1 - a * c1 + b * d1
-            mc[p] = m2 if big else m2 - a * c2 + b * d2
-    nnew = 0
+    q00, q01, q02, q10, q11, q12, q20, q21, q22 = (coef[0], coef[1], coef[2], coef[3], coef[4], coef[5],
+                                                   coef[6], coef[7], coef[8])
+    l0, l1, l2 = coef[9], coef[10], coef[11]
+    f0, f1, f2 = coef[21], coef[22], coef[23]     # gradient change inside the double bracket
+    n00, n01, n02, n10, n11, n12, n20, n21, n22 = (coef[12], coef[13], coef[14], coef[15], coef[16],
+                                                   coef[17], coef[18], coef[19], coef[20])
+    hdt = 0.5 * dt
+    for p in range(nb):
+        m0 = ma[p]
+        m1 = mb[p]
+        m2 = mc[p]
+        e0 = ea[p]
+        e1 = eb[p]
+        e2 = ec[p]
+        # w(mu) = g + theta M⁻¹ (mu × (g + f)), g = Q mu + b + shift, f = shift_dissipation - shift
+        g0 = q00 * m0 + q01 * m1 + q02 * m2 + l0
+        g1 = q10 * m0 + q11 * m1 + q12 * m2 + l1
+        g2 = q20 * m0 + q21 * m1 + q22 * m2 + l2
+        v0 = m1 * (g2 + f2) - m2 * (g1 + f1)
+        v1 = m2 * (g0 + f0) - m0 * (g2 + f2)
+        v2 = m0 * (g1 + f1) - m1 * (g0 + f0)
+        w0 = g0 + n00 * v0 + n01 * v1 + n02 * v2
+        w1 = g1 + n10 * v0 + n11 * v1 + n12 * v2
+        w2 = g2 + n20 * v0 + n21 * v1 + n22 * v2
+        s0 = w0 * dt + e0
+        s1 = w1 * dt + e1
+        s2 = w2 * dt + e2
+        if code == 1:
+            # predictor mu* = (1 + ad*_s + ½ ad*_s²) mu, corrector s = ½(w(mu) + w(mu*)) dt + e
+            c0 = m1 * s2 - m2 * s1
+            c1 = m2 * s0 - m0 * s2
+            c2 = m0 * s1 - m1 * s0
+            y0 = m0 + c0 + 0.5 * (c1 * s2 - c2 * s1)
+            y1 = m1 + c1 + 0.5 * (c2 * s0 - c0 * s2)
+            y2 = m2 + c2 + 0.5 * (c0 * s1 - c1 * s0)
+            g0 = q00 * y0 + q01 * y1 + q02 * y2 + l0
+            g1 = q10 * y0 + q11 * y1 + q12 * y2 + l1
+            g2 = q20 * y0 + q21 * y1 + q22 * y2 + l2
+            v0 = y1 * (g2 + f2) - y2 * (g1 + f1)
+            v1 = y2 * (g0 + f0) - y0 * (g2 + f2)
+            v2 = y0 * (g1 + f1) - y1 * (g0 + f0)
+            s0 = (w0 + g0 + n00 * v0 + n01 * v1 + n02 * v2) * hdt + e0
+            s1 = (w1 + g1 + n10 * v0 + n11 * v1 + n12 * v2) * hdt + e1
+            s2 = (w2 + g2 + n20 * v0 + n21 * v1 + n22 * v2) * hdt + e2
+        # exp(ad*_s) m = m - a s×m + b s×(s×m), Taylor to t^8 (exact in float64 for t² < 1e-2)
+        t2 = s0 * s0 + s1 * s1 + s2 * s2
+        big = not (t2 < SMALL_ANGLE2)           # also NaN: redone (and diagnosed) by the scalar step
+        bad[p] = big
+        nbad += big
+        a, b, _ = _taylor(t2)
+        c0 = s1 * m2 - s2 * m1
+        c1 = s2 * m0 - s0 * m2
+        c2 = s0 * m1 - s1 * m0
+        d0 = s1 * c2 - s2 * c1
+        d1 = s2 * c0 - s0 * c2
+        d2 = s0 * c1 - s1 * c0
+        ma[p] = m0 if big else m0 - a * c0 + b * d0
+        mb[p] = m1 if big else m1 - a * c1 + b * d1
+        mc[p] = m2 if big else m2 - a * c2 + b * d2
+    nlazy = 0
     if nbad > 0:
         for p in range(nb):
-            if bad[p]:
-                m0, m1, m2, e0, e1, e2 = ma[p], mb[p], mc[p], ea[p], eb[p], ec[p]
-                finite_in = math.isfinite(m0 + m1 + m2) and math.isfinite(e0 + e1 + e2)
-                ok = False
-                finite_out = False
-                if finite_in:
-                    m0, m1, m2, ok = _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_iter)
-                    finite_out = math.isfinite(m0 + m1 + m2)
-                if not (ok and finite_out):
-                    if first_bad[p] < 0:
-                        first_bad[p] = k
-                        reason[p] = NON_FINITE if (not finite_in or ok) else CHORD_FAILED
-                        nnew += 1
-                    m0 = m1 = m2 = np.nan
-                ma[p], mb[p], mc[p] = m0, m1, m2
+            if bad[p] and first_bad[p] < 0:
+                nlazy += 1
+    return -nlazy
+
+
+@numba.njit(cache=True, inline="always")
+def _so3_full_steps(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k):
+    """:func:`_so3_vector_steps`, then the exact scalar step for the members it flagged, in the same kernel.
+    Returns the number of members that failed for the first time."""
+    if _so3_vector_steps(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k) < 0:
+        return _so3_scalar_steps(m[0], m[1], m[2], e[0], e[1], e[2], bad, dt, q, lin, minv, theta, code, tol,
+                                 max_iter, first_bad, reason, k)
+    return 0
+
+
+@numba.njit(cache=True, inline="always")
+def _so3_midpoint_steps(m, e, dt, coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k):
+    """One implicit-midpoint step (``code`` 2) of every member of ``m`` (3, B): the scalar chord solve per member
+    (:func:`_so3_scalar_steps`). Returns the number of members that failed for the first time."""
+    for p in range(m.shape[1]):
+        bad[p] = True
+    return _so3_scalar_steps(m[0], m[1], m[2], e[0], e[1], e[2], bad, dt, q, lin, minv, theta, code, tol, max_iter,
+                             first_bad, reason, k)
+
+
+@numba.njit(cache=True, inline="always")
+def _so3_scalar_steps(ma, mb, mc, ea, eb, ec, bad, dt, q, lin, minv, theta, code, tol, max_iter, first_bad, reason, k):
+    """The scalar exact step (:func:`_so3_step`) for the members flagged in ``bad``; a member that fails gets NaN
+    and, on its first failure, ``first_bad = k`` and ``reason``. Returns the number of first failures."""
+    nnew = 0
+    for p in range(ma.shape[0]):
+        if bad[p]:
+            m0, m1, m2, e0, e1, e2 = ma[p], mb[p], mc[p], ea[p], eb[p], ec[p]
+            finite_in = math.isfinite(m0 + m1 + m2) and math.isfinite(e0 + e1 + e2)
+            ok = False
+            finite_out = False
+            if finite_in:
+                m0, m1, m2, ok = _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_iter)
+                finite_out = math.isfinite(m0 + m1 + m2)
+            if not (ok and finite_out):
+                if first_bad[p] < 0:
+                    first_bad[p] = k
+                    reason[p] = NON_FINITE if (not finite_in or ok) else CHORD_FAILED
+                    nnew += 1
+                m0 = m1 = m2 = np.nan
+            ma[p], mb[p], mc[p] = m0, m1, m2
+    return nnew
+
+
+@numba.njit(cache=True, nogil=True)
+def _so3_rare_steps(y, e, bad, dt, q, lin, minv, theta, code, tol, max_iter, first_bad, reason, k):
+    """:func:`_so3_scalar_steps` on rows ``y`` (B, 3), ``e`` (B, 3) of one block: the steps the vector loop left
+    (``|sigma|²`` past the Taylor branch, or non-finite). Its own kernel, compiled only when a solve reaches
+    such a step (about 1.4 s of CPU that a sane run never pays)."""
+    ma, mb, mc = y[:, 0].copy(), y[:, 1].copy(), y[:, 2].copy()
+    nnew = _so3_scalar_steps(ma, mb, mc, e[:, 0].copy(), e[:, 1].copy(), e[:, 2].copy(), bad, dt, q, lin, minv,
+                             theta, code, tol, max_iter, first_bad, reason, k)
+    for p in range(y.shape[0]):
+        y[p, 0], y[p, 1], y[p, 2] = ma[p], mb[p], mc[p]
     return nnew
 
 
@@ -355,25 +404,33 @@ def _velocities(dX, dXX, xi, brk, pi, pj, k0, tile):
 
 
 @numba.njit(cache=True, inline="always")
-def _so3_dx_block(m, dX, dXX, xi, brk, pi, pj, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta, save,
-                  out, first_bad, reason, stop):
-    """Advance m (3, B) over the increments ``dX`` (B, K, m) and areas ``dXX`` (:func:`_velocities`, formed
-    :data:`_TILE` steps at a time); after step k with ``save[k]`` the state goes to the next slot of out
-    (B, S, 3). With ``stop``, returns after the first step at which a member failed. Returns the number of
-    steps done."""
+def _so3_dx_block(step, m, dX, dXX, xi, brk, pi, pj, dts, e, bad, coef, code, tol, max_iter, q, lin, minv, theta,
+                  save, out, first_bad, reason, stop, k0, eout):
+    """Advance m (3, B) over the increments ``dX`` (B, K, m) and areas ``dXX`` from step ``k0`` on
+    (:func:`_velocities`, formed :data:`_TILE` steps at a time); after step k with ``save[k]`` the state goes to
+    the next slot of out (B, S, 3). With ``stop``, returns after the first step at which a member failed.
+    Returns ``-1`` when done (or stopped), or the step ``k`` whose members flagged in ``bad`` need the exact
+    scalar step (Lie–Euler, Lie–Heun): their state is left as before step ``k``, the step's stochastic
+    velocities are in ``eout`` (B, 3), and step ``k`` is not saved yet."""
     nb = m.shape[1]
     slot = 0
+    for k in range(k0):
+        if save[k]:
+            slot += 1
     tile = np.empty((nb, _TILE, 3))
-    for k in range(dX.shape[1]):
-        t = k % _TILE
+    for k in range(k0, dX.shape[1]):
+        t = (k - k0) % _TILE
         if t == 0:
             _velocities(dX, dXX, xi, brk, pi, pj, k, tile)
         for p in range(nb):
             e[0, p] = tile[p, t, 0]
             e[1, p] = tile[p, t, 1]
             e[2, p] = tile[p, t, 2]
-        nnew = _so3_block_step(m, e, dts[k], coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad,
-                               reason, k)
+        nnew = step(m, e, dts[k], coef, code, tol, max_iter, bad, q, lin, minv, theta, first_bad, reason, k)
+        if nnew < 0:
+            for p in range(nb):
+                eout[p, 0], eout[p, 1], eout[p, 2] = e[0, p], e[1, p], e[2, p]
+            return k
         if save[k]:
             for p in range(nb):
                 out[p, slot, 0] = m[0, p]
@@ -381,8 +438,8 @@ def _so3_dx_block(m, dX, dXX, xi, brk, pi, pj, dts, e, bad, coef, code, tol, max
                 out[p, slot, 2] = m[2, p]
             slot += 1
         if stop and nnew > 0:
-            return k + 1
-    return dX.shape[1]
+            return -1
+    return -1
 
 
 #: Members per block of the thread split (each block runs all its steps on one thread).
@@ -390,29 +447,53 @@ BLOCK = 256
 
 
 @functools.lru_cache(maxsize=None)
-def _range_kernel(C: int):
+def _range_kernel(C: int, full: bool):
     """The compiled :func:`_so3_dx_block` over a range of members for scheme ``C`` (0 Lie–Euler, 1 Lie–Heun,
     2 implicit midpoint), a compile-time constant: each scheme is its own kernel, compiled on first use and
-    cached, so a Lie–Heun solve does not compile the chord iteration of the midpoint rule."""
+    cached, so a Lie–Heun solve does not compile the chord iteration of the midpoint rule.
+
+    Lie–Euler and Lie–Heun come in two variants. The first (``full=False``) has the vectorised loop only and
+    returns at a step that needs the exact scalar step (a member with ``|sigma|²`` past the Taylor branch, or
+    non-finite); :func:`integrate_so3` then does that step (:func:`_so3_rare_steps`) and runs the rest of the
+    solve with the second (``full=True``), which has the scalar step inline. A solve that never needs the scalar
+    step compiles only the first (about 1.4 s of CPU less); one that does compiles both, once per cache."""
+    F = bool(full)             # closure constants (ints and bools only: they key numba's cache)
 
     @numba.njit(cache=True, nogil=True)
     def so3_range(y, dX, dXX, xi, brk, pi, pj, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
-                  first_bad, reason, stop, lo, hi):
-        """Run :func:`_so3_dx_block` on members ``lo .. hi-1`` of ``y`` (B, 3) (one block of the thread split;
-        a member's result does not depend on its block); ``code`` is the variant's ``C``."""
+                  first_bad, reason, stop, bad, eout, lo, hi, k0):
+        """Run :func:`_so3_dx_block` on members ``lo .. hi-1`` of ``y`` (B, 3) from step ``k0`` (one block of the
+        thread split; a member's result does not depend on its block); ``code`` is the variant's ``C``. Returns
+        what :func:`_so3_dx_block` returns; the state is written back to ``y`` either way."""
         bc = hi - lo
         m = np.empty((3, bc))
         for p in range(bc):
             for i in range(3):
                 m[i, p] = y[lo + p, i]
-        _so3_dx_block(m, dX[lo:hi], dXX[lo:hi] if dXX.shape[0] > 0 else dXX, xi, brk, pi, pj, dts,
-                      np.empty((3, bc)), np.empty(bc, dtype=np.bool_), coef, C, tol, max_iter, q, lin, minv, theta,
-                      save, out[lo:hi], first_bad[lo:hi], reason[lo:hi], stop)
+        dXb, dXXb, e = dX[lo:hi], dXX[lo:hi] if dXX.shape[0] > 0 else dXX, np.empty((3, bc))
+        bb, ob, fb, rb, eb = bad[lo:hi], out[lo:hi], first_bad[lo:hi], reason[lo:hi], eout[lo:hi]
+        if C == 2:
+            k = _so3_dx_block(_so3_midpoint_steps, m, dXb, dXXb, xi, brk, pi, pj, dts, e, bb, coef, C, tol, max_iter, q, lin,
+                              minv, theta, save, ob, fb, rb, stop, k0, eb)
+        elif F:
+            k = _so3_dx_block(_so3_full_steps, m, dXb, dXXb, xi, brk, pi, pj, dts, e, bb, coef, C, tol, max_iter, q, lin,
+                              minv, theta, save, ob, fb, rb, stop, k0, eb)
+        else:
+            k = _so3_dx_block(_so3_vector_steps, m, dXb, dXXb, xi, brk, pi, pj, dts, e, bb, coef, C, tol, max_iter, q, lin,
+                              minv, theta, save, ob, fb, rb, stop, k0, eb)
         for p in range(bc):
             for i in range(3):
                 y[lo + p, i] = m[i, p]
+        return k
 
     return so3_range
+
+
+def _readonly(a):
+    """A read-only view: the kernel then compiles one signature whether the driver's arrays are writable or not."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
 
 
 def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_failure):
@@ -432,12 +513,27 @@ def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     reason = np.zeros(nb, dtype=np.int8)
     pi, pj = _pairs(nm)
     brk = np.ascontiguousarray(system.xi_brackets[pi, pj])
-    args = (y, dX, np.empty((0, 0, 0, 0)) if dXX is None else dXX, np.ascontiguousarray(system.xi, dtype=np.float64),
-            brk, pi, pj, np.ascontiguousarray(dts, dtype=np.float64), coef, code, float(tol), int(max_iter),
-            data["q"], lin, data["metric_inv"], float(data["theta"]), np.ascontiguousarray(save, dtype=np.bool_), out,
-            first_bad, reason, bool(stop_on_failure))
-    kernel = _range_kernel(int(code))
-    parallel_ranges(lambda lo, hi: kernel(*args, lo, hi), nb, BLOCK)
+    bad, eout = np.zeros(nb, dtype=np.bool_), np.empty((nb, 3))
+    args = (y, _readonly(dX), _readonly(np.empty((0, 0, 0, 0)) if dXX is None else dXX),
+            np.ascontiguousarray(system.xi, dtype=np.float64), brk, pi, pj, np.ascontiguousarray(dts, dtype=np.float64),
+            coef, code, float(tol), int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
+            np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure), bad, eout)
+    kernel = _range_kernel(int(code), False)
+
+    def run(lo, hi):
+        k = kernel(*args, lo, hi, 0)
+        if k < 0:
+            return
+        # a step the vector loop left to the exact scalar step: do it, then go on with the variant that has it
+        nnew = _so3_rare_steps(y[lo:hi], eout[lo:hi], bad[lo:hi], float(dts[k]), data["q"], lin, data["metric_inv"],
+                               float(data["theta"]), int(code), float(tol), int(max_iter), first_bad[lo:hi],
+                               reason[lo:hi], k)
+        if args[16][k]:
+            out[lo:hi, np.count_nonzero(args[16][:k])] = y[lo:hi]
+        if not ((stop_on_failure and nnew > 0) or k + 1 == nk):
+            _range_kernel(int(code), True)(*args, lo, hi, k + 1)
+
+    parallel_ranges(run, nb, BLOCK)
     return y, out, first_bad, reason
 
 
