@@ -73,6 +73,7 @@ fi
 # library's other kernels (tools/warm_kernels.py: signatures and their gradients, signature kernels, the
 # Brownian tree, the coadjoint kernels); afterwards the first call of a user does not wait for the compiler.
 echo "Compiling the numba kernels once (about a minute) ..." >&2
+WARM_START=$SECONDS
 WARM="$(mktemp -d)"
 MORE=""                                   # the test suite's kernels too, when the test extra is installed
 case ",$EXTRAS," in *,test,*) MORE="--more" ;; esac
@@ -90,6 +91,7 @@ case ",$EXTRAS," in *,test,*) MORE="--more" ;; esac
 wait
 cat "$WARM/main.log" "$WARM/rp.log" >>"$LOG"
 rm -rf "$WARM"
+echo "Compiled in $((SECONDS - WARM_START)) s." >&2
 
 { inputs_hash; norm_extras "$EXTRAS"; } > "$STAMP"
 echo "$PY"
