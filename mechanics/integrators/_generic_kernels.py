@@ -51,7 +51,7 @@ import numpy as np
 from roughpaths.validation import parallel_ranges
 from . import _se3_block
 from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1, rare_steps
-from ._soa_rows import (CHORD_FAILED, NON_FINITE, OK, STEPS, ad_star_rows, algebra_tables, eta_rows,
+from ._soa_rows import (CHORD_FAILED, NON_FINITE, OK, STEPS, ad_star_rows, algebra_tables, eta_rows, eta_rows3,
                         sparse_rows, velocity_rows)
 
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
@@ -59,7 +59,7 @@ BLOCK = 128
 
 
 @lru_cache(maxsize=None)
-def _block_kernel(C: int, N: int, full: bool):
+def _block_kernel(C: int, N: int, full: bool, M3: bool):
     """The compiled block kernel for scheme ``C`` (0 LieEuler, 1 LieHeun, 2 implicit midpoint) and, for the
     midpoint rule, the compile-time dimension ``N`` (3, 6; 0 reads it from the arrays).
 
@@ -68,7 +68,8 @@ def _block_kernel(C: int, N: int, full: bool):
     Lie–Euler and Lie–Heun come in two variants: without the exact exponential of the rare large steps
     (``full=False``: the kernel returns at such a step, :func:`integrate_generic` does it with
     :func:`._generic_member.rare_steps` and goes on with the other variant) and with it inline (``full=True``).
-    A solve that never takes such a step compiles only the first (about 1.2 s of CPU less).
+    A solve that never takes such a step compiles only the first (about 1.2 s of CPU less). ``M3``: three
+    noise components (:func:`._soa_rows.eta_rows3`, else :func:`._soa_rows.eta_rows`: one of them compiles).
     """
 
     @numba.njit(cache=True, nogil=True)
@@ -106,7 +107,10 @@ def _block_kernel(C: int, N: int, full: bool):
             dt = dts[k]
             kk = (k - k0) % STEPS
             if kk == 0:
-                eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
+                if M3:
+                    eta_rows3(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, ebuf)
+                else:
+                    eta_rows(dX, dXX, area, lo, bc, k, min(STEPS, nk - k), xi, brk, pi, pj, ebuf)
             e = ebuf[kk]
             nbig = 0
             if C == 2:
@@ -278,7 +282,7 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
         kernel, full, block = _se3_block.run_block, _se3_block.run_block_full, _se3_block.B
     else:
         N = n if code == 2 and n in (3, 6) else 0
-        kernel, full, block = _block_kernel(int(code), N, False), None, BLOCK
+        kernel, full, block = _block_kernel(int(code), N, False, nm == 3), None, BLOCK
 
     def run(lo, hi):
         _, k = kernel(*args, lo, hi, 0, *tail)
@@ -291,7 +295,7 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
         if save[k]:
             out[lo:hi, np.count_nonzero(save[:k])] = y[lo:hi]
         if not ((stop_on_failure and nnew > 0) or k + 1 == nk):
-            (full or _block_kernel(int(code), 0, True))(*args, lo, hi, k + 1, *tail)
+            (full or _block_kernel(int(code), 0, True, nm == 3))(*args, lo, hi, k + 1, *tail)
 
     parallel_ranges(run, nb, block)
     return y, out, first_bad, reason

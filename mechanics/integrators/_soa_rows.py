@@ -114,7 +114,7 @@ def velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv,
 
 
 @numba.njit(cache=True)
-def _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
+def eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
     """:func:`eta_rows` for three noise components: the same sums in the same order (the same bits), the
     loops over the components and pairs written out."""
     n = e.shape[1]
@@ -142,12 +142,10 @@ def _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
 @numba.njit(cache=True)
 def eta_rows(dX, dXX, area, lo, bc, k0, kc, xi, brk, pi, pj, e):
     """e[kk, :, p] = Σ_r dX_r ξ_r + Σ_{i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for members lo .. lo+bc-1 and
-    steps k0 .. k0+kc-1 (member by member, so each member's increments are read in order)."""
+    steps k0 .. k0+kc-1 (member by member, so each member's increments are read in order). Three noise
+    components: :func:`eta_rows3` (the kernels choose when they are compiled, so each compiles one of them)."""
     n = e.shape[1]
     nm = dX.shape[2]
-    if nm == 3 and (not area or pi.shape[0] == 3):
-        _eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e)
-        return
     for p in range(bc):
         for kk in range(kc):
             k = k0 + kk
