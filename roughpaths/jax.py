@@ -70,21 +70,29 @@ _TARGETS: list = []                     # the registered handlers, alive as long
 
 
 def _host_call(host):
-    """``call(result_shape_dtypes, *args)`` computing ``host(*numpy arrays) -> tuple of arrays``.
+    """``call(result_shape_dtypes, *args)`` computing ``host(*numpy arrays) -> tuple of arrays`` on the host.
 
-    An XLA FFI custom call of a ctypes handler (:mod:`roughpaths._xla_ffi`), registered once per
-    function; where this jax cannot register one, a ``jax.pure_callback`` (the same results, about
-    0.1 ms more per call). Under ``vmap`` one batched call, with the mapped axes in front of every operand.
+    On the CPU backend an XLA FFI custom call of a ctypes handler (:mod:`roughpaths._xla_ffi`),
+    registered once per function; on other backends, or where this jax cannot register the handler,
+    a ``jax.pure_callback`` (the same results; about 0.1 ms more per call, and JAX copies device
+    arrays to the host and back). Under ``vmap`` one batched call, with the mapped axes in front of
+    every operand.
     """
+    name = f"roughpaths_host_{len(_TARGETS)}"
     try:
-        name = f"roughpaths_host_{len(_TARGETS)}"
         handler = host_handler(host)
         jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler), platform="cpu", api_version=1)
         _TARGETS.append(handler)
-        return lambda result, *args: jax.ffi.ffi_call(name, result, vmap_method="broadcast_all")(*args)
     except Exception:                        # noqa: BLE001 -- no (or a changed) XLA FFI: the host callback
-        return lambda result, *args: jax.pure_callback(host if isinstance(result, tuple) else lambda *a: host(*a)[0],
-                                                       result, *args, vmap_method="broadcast_all")
+        name = None
+
+    def call(result, *args):
+        if name is not None and jax.default_backend() == "cpu":
+            return jax.ffi.ffi_call(name, result, vmap_method="broadcast_all")(*args)
+        callback = host if isinstance(result, tuple) else lambda *arrays: host(*arrays)[0]
+        return jax.pure_callback(callback, result, *args, vmap_method="broadcast_all")
+
+    return call
 
 
 def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):

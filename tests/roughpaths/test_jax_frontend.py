@@ -6,7 +6,7 @@ in gives float32 out; ``jax.test_util.check_grads`` (reverse mode, float64) pass
 gradients are the numpy VJPs, also under ``jit(vmap(grad))``; a few gradient steps lower a loss;
 integer inputs are refused; the call is an XLA custom call (not a ``pure_callback``), an error raised by the
 numpy API reaches the caller with its message, and where the FFI target cannot be registered the
-``pure_callback`` fallback gives the same values and gradients. The signature-kernel wrappers are checked the same way (values, batch
+``pure_callback`` fallback (also on other backends than the CPU) gives the same values and gradients. The signature-kernel wrappers are checked the same way (values, batch
 broadcasting, ``check_grads``, jit/vmap, gradient steps).
 """
 
@@ -121,10 +121,14 @@ def test_numpy_errors_reach_the_caller():
     assert "ValueError" in str(info.value)
 
 
-def test_callback_fallback_where_no_ffi_target_registers(x64, monkeypatch):
-    def refuse(*args, **kwargs):
-        raise RuntimeError("no FFI here")
-    monkeypatch.setattr(jax.ffi, "register_ffi_target", refuse)
+@pytest.mark.parametrize("why", ["no FFI target registers", "another backend"])
+def test_callback_fallback(x64, monkeypatch, why):
+    if why == "another backend":
+        monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
+    else:
+        def refuse(*args, **kwargs):
+            raise RuntimeError("no FFI here")
+        monkeypatch.setattr(jax.ffi, "register_ffi_target", refuse)
     square = rpj.differentiable(lambda a: a ** 2, lambda a, g: 2 * a * g, lambda b, c: b + c[0],
                                 names=("a",), core=(0,))
     x = jnp.array([1.0, -2.0, 3.0])
