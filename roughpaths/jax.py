@@ -2,26 +2,35 @@ r"""JAX front end: the library's signatures and signature kernels as differentia
 
 ``import roughpaths.jax as rpj`` (needs the ``jax`` extra: ``pip install 'roughpaths-mechanics[jax]'``;
 ``import roughpaths`` alone never imports jax). Each function is a :func:`jax.custom_vjp` whose
-forward and backward passes are :func:`jax.pure_callback` calls of the library's numpy API and its
-vector–Jacobian product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation.
-They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad`` (and their compositions):
+forward and backward passes are host calls of the library's numpy API and its vector–Jacobian
+product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation. On the CPU
+backend a host call is an XLA FFI custom call (``jax.ffi.ffi_call``) of a handler made with
+:mod:`ctypes` (``roughpaths._xla_ffi``: nothing compiled, at install or at run time), which wraps
+XLA's buffers as numpy arrays and calls the numpy function; elsewhere, or where the handler cannot
+be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
+(and their compositions):
 
-* **vmap** is one batched call, not a loop: the callbacks are declared with
+* **vmap** is one batched call, not a loop: the calls are declared with
   ``vmap_method="broadcast_all"``, so a mapped axis arrives as a leading batch axis, which the numpy
   API takes as it takes any batch axis.
 * **Precision.** float32 (JAX's default) and float64 (with ``jax_enable_x64``) inputs; the
   computation is float64 either way and the result is rounded to the input's dtype. Integer and
   half-precision inputs are refused with a ``TypeError``.
-* **Devices.** The callbacks run on the host; arrays on an accelerator are copied to the host and back
-  by JAX (correct, but the copy costs what it costs).
+* **Devices.** The numpy API runs on the host; on an accelerator the call is a ``pure_callback``
+  and JAX copies the arrays to the host and back (correct, but the copy costs what it costs).
+* **Errors.** An error of the numpy API (a non-finite point, say) is raised by JAX where the result
+  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
-  (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a callback.
-* **Cost.** A host callback is not free: a jitted forward plus backward (two callbacks) measured
-  about 1.4 ms of CPU time above the bare numpy calls on a loaded 2-core machine, against 0.075 ms for
-  the whole of pysiglib's XLA FFI custom call on a tiny input (``benchmarks/bench_frameworks.py``).
-  So an FFI custom call *would* pay for small inputs (kernel work below a few ms: 24x at one path of
-  8 points, 2x at 32 paths of 128 points in d = 3) and hardly for large ones (1.45x at d = 8, depth 3);
-  batch many paths into one call (``vmap`` does) to amortise it.
+  (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
+* **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls) measured, in CPU time
+  on a loaded 2-core machine (load 3), against pysiglib's XLA FFI calls into compiled C++ in the same
+  run (``benchmarks/bench_frameworks.py``): 0.131 ms against 0.020 ms on one path of 8 points in
+  d = 3 at depth 3 (6.6x; with ``pure_callback`` it was 0.39-0.44 ms, 19.6x), 0.70 against 0.62 ms on
+  32 paths of 128 points (1.12x; 1.20x before) and 4.8 against 5.3 ms in d = 8 (0.91x). The floor
+  on tiny inputs is the numpy API's own fixed cost (0.06 ms for the signature and its VJP there),
+  not the call: an FFI handler costs about 10 us, a ``pure_callback`` about 0.15 ms. Batch many
+  paths into one call (``vmap`` does) to amortise both. First call in a new process: the XLA
+  compiles of a ``jax.grad`` step take about 0.2 s CPU (and ``import jax`` about 1.1 s).
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
 :func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``
