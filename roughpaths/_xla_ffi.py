@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import ctypes
 import struct
+import traceback
 
 import numpy as np
 
@@ -35,7 +36,7 @@ _FRAME_SIZE, _BUFFER_SIZE = 168, 48
 _WORDS = {n: ctypes.c_int64 * n for n in range(1, 9)}
 _FRAME_BYTES = ctypes.c_char * _FRAME_SIZE
 _TYPESTR = {11: "<f4", 12: "<f8", 4: "<i4", 5: "<i8"}         # XLA_FFI_DataType codes
-_METADATA_EXTENSION = 1
+_METADATA_EXTENSION, _METADATA_SIZE, _EXECUTE = 1, 36, 3
 _API_VERSION = (0, 1)                   # the XLA FFI API version whose layout this module reads
 _INVALID_ARGUMENT, _INTERNAL = 3, 13
 
@@ -77,27 +78,34 @@ def _array(address: int) -> np.ndarray:
     return np.asarray(view)
 
 
-def _metadata(extension: int) -> None:
-    """Answer XLA's metadata query (at registration): the API version this handler was written for."""
-    base_size, ext_type = _words(extension, 2)
-    if ext_type & 0xFFFFFFFF != _METADATA_EXTENSION:
-        return
-    metadata = _words(extension + 24, 1)[0]
-    # XLA_FFI_Metadata: struct_size, then XLA_FFI_Api_Version {struct_size, extension_start, major, minor},
+def _answer_metadata(extension: int) -> bool:
+    """If the frame's first extension is XLA's metadata query, answer it (the API version this handler
+    reads) and return True; any other extension is not ours to read."""
+    ext_type = _words(extension + 8, 1)[0] & 0xFFFFFFFF
+    if ext_type != _METADATA_EXTENSION:
+        return False
+    metadata = _words(extension + 24, 1)[0]       # after the extension base {struct_size, type, next}
+    if _words(metadata, 1)[0] < _METADATA_SIZE:
+        raise RuntimeError(f"XLA_FFI_Metadata smaller than the {_METADATA_SIZE} bytes of version 0.1")
+    # XLA_FFI_Metadata: struct_size, XLA_FFI_Api_Version {struct_size, extension_start, major, minor},
     # then the traits (uint32): none (not command-buffer compatible: a host call)
     ctypes.c_int64.from_address(metadata + 8).value = 24
     ctypes.c_int64.from_address(metadata + 16).value = 0
     ctypes.c_int32.from_address(metadata + 24).value = _API_VERSION[0]
     ctypes.c_int32.from_address(metadata + 28).value = _API_VERSION[1]
     ctypes.c_uint32.from_address(metadata + 32).value = 0
+    return True
 
 
 def _error(api: int, exc: BaseException) -> int | None:
     """An XLA_FFI_Error made by XLA's own ``XLA_FFI_Error_Create`` (the first function of the API table)."""
     if not api:
         return None
-    code = _INVALID_ARGUMENT if isinstance(exc, (ValueError, TypeError)) else _INTERNAL
-    message = f"{type(exc).__name__}: {exc}".encode("utf-8", "replace")
+    if isinstance(exc, (ValueError, TypeError)):          # the numpy API's own checks: their message says it all
+        code, text = _INVALID_ARGUMENT, f"{type(exc).__name__}: {exc}"
+    else:                                                   # anything else: with the traceback
+        code, text = _INTERNAL, "".join(traceback.format_exception(exc)).rstrip()
+    message = text.encode("utf-8", "replace")
     create = _ERROR_CREATE(_words(api + 48, 1)[0])
     return create(ctypes.byref(_ErrorArgs(ctypes.sizeof(_ErrorArgs), None, message, code)))
 
@@ -109,7 +117,8 @@ def host_handler(fn):
     ----------
     fn : callable
         ``fn(*inputs) -> tuple of arrays``: the inputs are numpy views of the call's operands,
-        writeable (the library's kernels take writeable arrays without a copy) but not to be written; the results (one per result of the call, of its shape) are copied into the
+        writeable (the library's kernels take writeable arrays without a copy) but not to be
+        written; the results (one per result of the call, of its shape) are copied into the
         buffers XLA allocated for them, in their dtype.
 
     Returns
@@ -126,8 +135,9 @@ def host_handler(fn):
             api = w[2]
             if w[0] < _FRAME_SIZE:
                 raise RuntimeError(f"XLA_FFI_CallFrame of {w[0]} bytes, expected at least {_FRAME_SIZE}")
-            if w[1]:                                  # an extension: XLA's metadata query
-                _metadata(w[1])
+            if w[1] and _answer_metadata(w[1]):      # XLA's metadata query (at registration)
+                return None
+            if w[4] & 0xFFFFFFFF != _EXECUTE:          # only the execution stage does work
                 return None
             ins = [_array(p) for p in (_words(w[9], w[7]) if w[7] else ())]
             outs = [_array(p) for p in (_words(w[14], w[12]) if w[12] else ())]

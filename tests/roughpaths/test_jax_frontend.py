@@ -121,6 +121,18 @@ def test_numpy_errors_reach_the_caller():
     assert "ValueError" in str(info.value)
 
 
+def test_an_unexpected_error_reaches_the_caller_with_its_traceback():
+    def broken(a):
+        raise RuntimeError("kernel exploded")
+    bad = rpj.differentiable(broken, lambda a, g: g, lambda b, c: b + c[0], names=("a",), core=(0,))
+    with pytest.raises(Exception, match="kernel exploded") as info:
+        jax.block_until_ready(bad(jnp.ones(3)))
+    assert "Traceback" in str(info.value) and "broken" in str(info.value)
+    wrong = rpj.differentiable(lambda a: a[:-1], lambda a, g: g, lambda b, c: b + c[0], names=("a",), core=(0,))
+    with pytest.raises(Exception, match=r"a result of shape \(2,\) for a buffer of shape \(3,\)"):
+        jax.block_until_ready(wrong(jnp.ones(3)))
+
+
 @pytest.mark.parametrize("why", ["no FFI target registers", "another backend"])
 def test_callback_fallback(x64, monkeypatch, why):
     if why == "another backend":
