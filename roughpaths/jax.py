@@ -22,15 +22,17 @@ be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.v
   is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
-* **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls) measured, in CPU time
-  on a loaded 2-core machine (load 3), against pysiglib's XLA FFI calls into compiled C++ in the same
-  run (``benchmarks/bench_frameworks.py``): 0.131 ms against 0.020 ms on one path of 8 points in
-  d = 3 at depth 3 (6.6x; with ``pure_callback`` it was 0.39-0.44 ms, 19.6x), 0.70 against 0.62 ms on
-  32 paths of 128 points (1.12x; 1.20x before) and 4.8 against 5.3 ms in d = 8 (0.91x). The floor
-  on tiny inputs is the numpy API's own fixed cost (0.06 ms for the signature and its VJP there),
-  not the call: an FFI handler costs about 10 us, a ``pure_callback`` about 0.15 ms. Batch many
-  paths into one call (``vmap`` does) to amortise both. First call in a new process: the XLA
-  compiles of a ``jax.grad`` step take about 0.2 s CPU (and ``import jax`` about 1.1 s).
+* **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls), CPU time on a loaded
+  2-core machine (load 5.7), same run, against pysiglib's XLA FFI calls into compiled C++
+  (``benchmarks/bench_frameworks.py`` prints the same comparison): one path of 8 points in d = 3 at
+  depth 3, 0.147 ms against 0.019 ms (7.8x; through ``pure_callback`` it was 0.461 ms, 24.5x); 32
+  paths of 128 points, 0.79 against 0.63 ms (1.24x; 1.75x before); the same in d = 8, 5.0 against
+  6.4 ms (0.79x; 0.88x before). On the tiny input the time splits into the XLA program itself
+  (0.017 ms with handlers that do nothing: pysiglib's whole call), reading the call frames and
+  copying the results (0.018 ms), the wrappers (0.005 ms) and the two numpy calls (0.074 ms; 0.059
+  ms called directly): the numpy API's own fixed cost, not the call, is the floor. Batch many paths
+  into one call (``vmap`` does) to amortise it. First ``jax.grad`` step in a new process: about 0.2 s
+  CPU of XLA compiles (and ``import jax`` about 1.1 s); the handler adds no numba compile.
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
 :func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``

@@ -32,12 +32,13 @@ Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`
 * **Cost.** The forward converts the tensors to numpy once, without a copy (float64) or with one
   cast (float32, whose float64 copy is kept for the backward), and the result back without a copy;
   the backward reuses those arrays. The fixed cost of a step (forward plus ``backward``) above the
-  bare numpy calls, measured in CPU time on a loaded 2-core machine (load 3-5, same runs): 0.088 ms
-  on one path of 8 points (0.119 ms before this wrapper was trimmed), 0.10 ms on 32 paths of 128
-  points in d = 3 at depth 2 (0.145 ms before), of which a bare ``torch.autograd.Function`` around
-  the same two numpy calls, with no checks at all, already costs 0.066 / 0.078 ms (torch's node,
-  ``backward``'s argument checks and engine). pysiglib's torch API pays the same order of overhead
-  (``benchmarks/bench_frameworks.py`` prints both, and their ratio, in one run).
+  bare numpy calls, CPU time on a loaded 2-core machine (load 4.6-5), same runs: 0.088 ms on one path
+  of 8 points (0.119 ms before this wrapper was trimmed), 0.103 ms on 32 paths of 128 points in d = 3
+  at depth 2 (0.145 ms before). A bare ``torch.autograd.Function`` around the same two numpy calls,
+  with no checks or conversions at all, already costs 0.066 / 0.078 ms there (torch's node,
+  ``backward``'s argument checks, its engine), so what is left of the wrapper's own is about
+  0.02 ms. pysiglib's torch API pays an overhead of the same size (``benchmarks/bench_frameworks.py``
+  prints both, and their ratio, in one run).
 
 Examples
 --------
