@@ -54,6 +54,8 @@ Array([[-1. , -0.5],
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import jax
 import jax.numpy as jnp
@@ -78,6 +80,9 @@ def _as_jax(x, name: str):
 
 
 _TARGETS: list = []                     # the registered handlers, alive as long as XLA's registry
+#: Target names are unique to the process: a compiled program (jax's persistent compilation cache, an
+#: export) names its custom calls, and another process's target of the same name may be another function.
+_PREFIX = f"roughpaths_host_{os.urandom(6).hex()}_"
 
 
 def _host_call(host):
@@ -89,7 +94,7 @@ def _host_call(host):
     arrays to the host and back). Under ``vmap`` one batched call, with the mapped axes in front of
     every operand.
     """
-    name = f"roughpaths_host_{len(_TARGETS)}"
+    name = f"{_PREFIX}{len(_TARGETS)}"
     try:
         handler = host_handler(host)
         jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler), platform="cpu", api_version=1)

@@ -14,6 +14,9 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import re
+import subprocess
+import sys
 
 from functools import partial
 
@@ -113,6 +116,19 @@ def test_bad_input_is_refused(bad, exc, words):
 def test_the_call_is_an_xla_custom_call():
     hlo = jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text()
     assert "roughpaths_host_" in hlo and "callback" not in hlo.lower(), hlo
+
+
+def test_target_names_are_unique_to_the_process():
+    """A compiled program names its custom calls (jax's persistent compilation cache keys on it): another
+    process must not find a different function under the same name."""
+    code = ("import jax.numpy as jnp, roughpaths.jax as rpj, jax\n"
+            "print(jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text())")
+    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert other.returncode == 0, other.stderr
+    ours = jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text()
+    name = re.compile(r"roughpaths_host_\w+")
+    assert name.search(ours) and name.search(other.stdout)
+    assert name.search(ours).group() != name.search(other.stdout).group()
 
 
 def test_numpy_errors_reach_the_caller():
