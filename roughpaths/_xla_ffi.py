@@ -1,10 +1,10 @@
 """A Python function as an XLA FFI handler: the host call of :mod:`roughpaths.jax` (private).
 
-:func:`host_handler` turns ``fn(*inputs) -> outputs`` (numpy arrays over XLA's own buffers in, arrays
-copied into XLA's result buffers out) into
-a C function pointer with the signature of an XLA typed-FFI handler (``XLA_FFI_Error* (XLA_FFI_CallFrame*)``,
-``xla/ffi/api/c_api.h``), made with :mod:`ctypes`: no compiler, no numba compile, nothing built at
-install. :mod:`roughpaths.jax` registers it with ``jax.ffi.register_ffi_target`` and calls it with
+:func:`host_handler` turns ``fn(*inputs) -> outputs`` (numpy arrays over XLA's own buffers in,
+arrays copied into XLA's result buffers out) into a C function pointer with the signature of an XLA
+typed-FFI handler (``XLA_FFI_Error* (XLA_FFI_CallFrame*)``, ``xla/ffi/api/c_api.h``), made with
+:mod:`ctypes`: no compiler, no numba compile (nothing to state against the compile budget), nothing
+built at install. :mod:`roughpaths.jax` registers it with ``jax.ffi.register_ffi_target`` and calls it with
 ``jax.ffi.ffi_call``. Against ``jax.pure_callback`` this skips JAX's host-callback machinery (about
 0.1 ms per call: result checks, device puts, a Python-level dispatch): the handler reads the call frame
 (argument and result buffers: dtype, data pointer, dims), wraps the buffers as numpy arrays without a
@@ -69,7 +69,7 @@ def _array(address: int) -> np.ndarray:
         raise RuntimeError(f"XLA_FFI_Buffer of {size} bytes, expected at least {_BUFFER_SIZE}")
     typestr = _TYPESTR.get(dtype & 0xFFFFFFFF)
     if typestr is None:
-        raise TypeError(f"XLA buffer of dtype code {dtype & 0xFFFFFFFF} (this handler takes float32/float64)")
+        raise TypeError(f"XLA buffer of dtype code {dtype & 0xFFFFFFFF} (this handler takes float32, float64, int32 and int64)")
     shape = tuple(_words(dims, rank)) if rank else ()
     if not data:                                  # an empty buffer
         return np.zeros(shape, typestr)
