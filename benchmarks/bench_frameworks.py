@@ -11,13 +11,18 @@ after an untimed call of the same function. "ratio" is ours / peer (below 1: our
    pysiglib ``method=2``). Both libraries get the machine's threads; torch's own intra-op threads are
    set to 1 (``torch.set_num_threads(1)``) for both, since their idle spinning after a torch operation
    is counted as CPU time and is nobody's kernel.
-2. The wrapper's own cost: ``roughpaths.torch`` forward + backward against the bare numpy calls
-   ``roughpaths.signature`` + ``roughpaths.signature_vjp`` on the same array.
-3. JAX: a jitted ``roughpaths.jax.signature`` (``pure_callback``) forward + backward against the bare
-   numpy calls, at a tiny and a moderate size, and against pysiglib's JAX API (an XLA FFI custom call)
-   where it loads: what a callback costs per call, and so whether an FFI custom call would pay.
+2. The wrappers' own cost: a torch step (forward + backward) minus the bare numpy calls it makes
+   (``roughpaths.signature`` + ``roughpaths.signature_vjp``), and the same for pysiglib
+   (``pysiglib.torch_api.sig`` against ``pysiglib.sig`` + ``pysiglib.sig_backprop``), from a tiny
+   input (one path of 8 points) up; "overhead ratio" is ours / pysiglib's (not printed where an overhead
+   is within 3% of the step, the medians' noise: the large cells). Both include torch's own
+   autograd cost (the ``torch.autograd.Function`` node, ``backward``'s argument checks), which is
+   printed as "autograd floor": the same step through an identity ``Function``.
+3. JAX: a jitted ``value_and_grad`` of ``sum(roughpaths.jax.signature(x, 3) * G)`` (two XLA FFI custom
+   calls of the numpy API) against the bare numpy calls and against pysiglib's JAX API (its own XLA
+   FFI custom calls into compiled C++) where it loads, at a tiny and a moderate size.
 
-Usage: ``python benchmarks/bench_frameworks.py [--repeats 7] [--batch 32] [--length 128]``
+Usage: ``python benchmarks/bench_frameworks.py [--repeats 7] [--batch 32] [--length 128] [--sections 123]``
 (with ``PYTHONPATH`` putting this checkout first; needs torch, jax and pysiglib: the ``bench`` extra).
 """
 
@@ -49,6 +54,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--batch", type=int, default=32)
     parser.add_argument("--length", type=int, default=128)
+    parser.add_argument("--sections", default="123", help="which sections to run, e.g. 23")
     args = parser.parse_args()
 
     import numba
@@ -75,7 +81,7 @@ def main() -> None:
             return xt.grad
         return run
 
-    for kind in ("signature", "log-signature"):
+    for kind in ("signature", "log-signature") if "1" in args.sections else ():
         print(f"1. torch, forward + backward, {kind}")
         print(f"{'d':>3}{'depth':>7}{'ours':>10}{'pysiglib':>10}{'ratio':>8}{'max |Δgrad|':>14}")
         for d in (3, 5, 8):
@@ -97,15 +103,37 @@ def main() -> None:
                 print(f"{d:>3}{depth:>7}{1e3 * t_o:>10.2f}{1e3 * t_p:>10.2f}{t_o / t_p:>8.2f}{diff:>14.1e}", flush=True)
         print()
 
-    print("2. the torch wrapper's own cost: rpt.signature forward + backward vs rp.signature + rp.signature_vjp")
-    print(f"{'d':>3}{'depth':>7}{'wrapper':>10}{'numpy':>10}{'ratio':>8}")
-    for d, depth in ((3, 2), (3, 4), (8, 4)):
-        xn = np.cumsum(rng.standard_normal((B, n, d)), axis=1) / np.sqrt(n)
-        gn = rng.standard_normal((B, rp.sigdim(d, depth)))
-        f_o = fwd_bwd(lambda p, m=depth: rpt.signature(p, m), torch.from_numpy(xn), torch.from_numpy(gn))
-        f_n = lambda m=depth: (rp.signature(xn, m), rp.signature_vjp(xn, m, gn))
-        t_o, t_n = cpu_medians((f_o, f_n), args.repeats)
-        print(f"{d:>3}{depth:>7}{1e3 * t_o:>10.3f}{1e3 * t_n:>10.3f}{t_o / t_n:>8.2f}", flush=True)
+    print("2. the torch wrappers' own cost (a step minus its bare numpy calls), signature, ms")
+    print(f"{'case':<20}{'ours':>8}{'numpy':>8}{'overhead':>10}{'pysiglib':>10}{'numpy':>8}{'overhead':>10}"
+          f"{'overhead ratio':>16}{'autograd floor':>16}")
+
+    class Identity(torch.autograd.Function):
+        @staticmethod
+        def forward(ctx, p):
+            return p * 1.0
+
+        @staticmethod
+        def backward(ctx, g):
+            return g
+
+    for B2, n2, d, depth in ((1, 8, 3, 2), (B, n, 3, 2), (B, n, 3, 4), (B, n, 8, 4)) if "2" in args.sections else ():
+        xn = np.cumsum(rng.standard_normal((B2, n2, d)), axis=1) / np.sqrt(n2)
+        gn = rng.standard_normal((B2, rp.sigdim(d, depth)))
+        xt, gt = torch.from_numpy(xn), torch.from_numpy(gn)
+        f_o = fwd_bwd(lambda p, m=depth: rpt.signature(p, m), xt, gt)
+        f_on = lambda m=depth: (rp.signature(xn, m), rp.signature_vjp(xn, m, gn))
+        f_p = fwd_bwd(lambda p, m=depth: pst.sig(p, m, n_jobs=-1), xt, gt)
+
+        def f_pn(m=depth):
+            s = pysiglib.sig(xn, m, n_jobs=-1)
+            return pysiglib.sig_backprop(xn, s, gn, m, n_jobs=-1)
+        f_id = fwd_bwd(Identity.apply, xt, xt)
+        t = cpu_medians((f_o, f_on, f_p, f_pn, f_id), args.repeats)
+        ov_o, ov_p = t[0] - t[1], t[2] - t[3]
+        noise = 0.03 * max(t[:4])                # a difference below this is within the medians' noise
+        ratio = f"{ov_o / ov_p:>16.2f}" if min(ov_o, ov_p) > noise else f"{'(in noise)':>16}"
+        print(f"{f'{B2} x {n2}, d={d}, m={depth}':<20}{1e3 * t[0]:>8.3f}{1e3 * t[1]:>8.3f}{1e3 * ov_o:>10.3f}"
+              f"{1e3 * t[2]:>10.3f}{1e3 * t[3]:>8.3f}{1e3 * ov_p:>10.3f}{ratio}{1e3 * t[4]:>16.3f}", flush=True)
     print()
 
     import jax
@@ -120,9 +148,9 @@ def main() -> None:
     except Exception as exc:                    # the FFI plugin may not load with this jax
         psj = None
         print(f"(pysiglib's JAX API did not load: {type(exc).__name__}: {str(exc)[:100]})")
-    print("3. JAX, jitted forward + backward (value_and_grad of sum(sig * G)), depth 3")
-    print(f"{'case':<22}{'callback':>10}{'numpy':>10}{'overhead':>10}{'pysiglib FFI':>14}{'ratio/FFI':>11}")
-    for B3, n3, d in ((1, 8, 3), (B, n, 3), (B, n, 8)):
+    print("3. JAX, jitted forward + backward (value_and_grad of sum(sig * G)), depth 3, ms; ratio = ours / pysiglib")
+    print(f"{'case':<22}{'ours':>10}{'numpy':>10}{'overhead':>10}{'pysiglib':>10}{'ratio':>8}")
+    for B3, n3, d in ((1, 8, 3), (B, n, 3), (B, n, 8)) if "3" in args.sections else ():
         xn = np.cumsum(rng.standard_normal((B3, n3, d)), axis=1) / np.sqrt(n3)
         gn = rng.standard_normal((B3, rp.sigdim(d, 3)))
         xj, gj = jnp.asarray(xn), jnp.asarray(gn)
@@ -135,7 +163,7 @@ def main() -> None:
             fns.append(lambda: jax.block_until_ready(peer(xj)))
         t = cpu_medians(fns, args.repeats)
         name = f"{B3} x {n3}, d={d}"
-        ffi = f"{1e3 * t[2]:>14.3f}{t[0] / t[2]:>11.2f}" if psj is not None else f"{'-':>14}{'-':>11}"
+        ffi = f"{1e3 * t[2]:>10.3f}{t[0] / t[2]:>8.2f}" if psj is not None else f"{'-':>10}{'-':>8}"
         print(f"{name:<22}{1e3 * t[0]:>10.3f}{1e3 * t[1]:>10.3f}{1e3 * (t[0] - t[1]):>10.3f}{ffi}", flush=True)
 
 

@@ -2,26 +2,37 @@ r"""JAX front end: the library's signatures and signature kernels as differentia
 
 ``import roughpaths.jax as rpj`` (needs the ``jax`` extra: ``pip install 'roughpaths-mechanics[jax]'``;
 ``import roughpaths`` alone never imports jax). Each function is a :func:`jax.custom_vjp` whose
-forward and backward passes are :func:`jax.pure_callback` calls of the library's numpy API and its
-vector–Jacobian product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation.
-They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad`` (and their compositions):
+forward and backward passes are host calls of the library's numpy API and its vector–Jacobian
+product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation. On the CPU
+backend a host call is an XLA FFI custom call (``jax.ffi.ffi_call``) of a handler made with
+:mod:`ctypes` (``roughpaths._xla_ffi``: nothing compiled, at install or at run time), which wraps
+XLA's buffers as numpy arrays and calls the numpy function; elsewhere, or where the handler cannot
+be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
+(and their compositions):
 
-* **vmap** is one batched call, not a loop: the callbacks are declared with
+* **vmap** is one batched call, not a loop: the calls are declared with
   ``vmap_method="broadcast_all"``, so a mapped axis arrives as a leading batch axis, which the numpy
   API takes as it takes any batch axis.
 * **Precision.** float32 (JAX's default) and float64 (with ``jax_enable_x64``) inputs; the
   computation is float64 either way and the result is rounded to the input's dtype. Integer and
   half-precision inputs are refused with a ``TypeError``.
-* **Devices.** The callbacks run on the host; arrays on an accelerator are copied to the host and back
-  by JAX (correct, but the copy costs what it costs).
+* **Devices.** The numpy API runs on the host; on an accelerator the call is a ``pure_callback``
+  and JAX copies the arrays to the host and back (correct, but the copy costs what it costs).
+* **Errors.** An error of the numpy API (a non-finite point, say) is raised by JAX where the result
+  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
-  (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a callback.
-* **Cost.** A host callback is not free: a jitted forward plus backward (two callbacks) measured
-  about 1.4 ms of CPU time above the bare numpy calls on a loaded 2-core machine, against 0.075 ms for
-  the whole of pysiglib's XLA FFI custom call on a tiny input (``benchmarks/bench_frameworks.py``).
-  So an FFI custom call *would* pay for small inputs (kernel work below a few ms: 24x at one path of
-  8 points, 2x at 32 paths of 128 points in d = 3) and hardly for large ones (1.45x at d = 8, depth 3);
-  batch many paths into one call (``vmap`` does) to amortise it.
+  (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
+* **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls), CPU time on a loaded
+  2-core machine (load 5.7), same run, against pysiglib's XLA FFI calls into compiled C++
+  (``benchmarks/bench_frameworks.py`` prints the same comparison): one path of 8 points in d = 3 at
+  depth 3, 0.147 ms against 0.019 ms (7.8x; through ``pure_callback`` it was 0.461 ms, 24.5x); 32
+  paths of 128 points, 0.79 against 0.63 ms (1.24x; 1.75x before); the same in d = 8, 5.0 against
+  6.4 ms (0.79x; 0.88x before). On the tiny input the time splits into the XLA program itself
+  (0.017 ms with handlers that do nothing: pysiglib's whole call), reading the call frames and
+  copying the results (0.018 ms), the wrappers (0.005 ms) and the two numpy calls (0.074 ms; 0.059
+  ms called directly): the numpy API's own fixed cost, not the call, is the floor. Batch many paths
+  into one call (``vmap`` does) to amortise it. First ``jax.grad`` step in a new process: about 0.2 s
+  CPU of XLA compiles (and ``import jax`` about 1.1 s); the handler adds no numba compile.
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
 :func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``
@@ -43,12 +54,15 @@ Array([[-1. , -0.5],
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import jax
 import jax.numpy as jnp
 
 import roughpaths as _rp
 from roughpaths._frontends import batch_broadcast, sum_to
+from roughpaths._xla_ffi import host_handler
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -63,6 +77,38 @@ def _as_jax(x, name: str):
         raise TypeError(f"{name} has dtype {x.dtype}; roughpaths.jax takes float32 or float64 arrays: pass "
                         f"{name}.astype(jnp.float32) (or float64 with jax_enable_x64).")
     return x
+
+
+_TARGETS: list = []                     # the registered handlers, alive as long as XLA's registry
+#: Target names are unique to the process: a compiled program (jax's persistent compilation cache, an
+#: export) names its custom calls, and another process's target of the same name may be another function.
+_PREFIX = f"roughpaths_host_{os.urandom(6).hex()}_"
+
+
+def _host_call(host):
+    """``call(result_shape_dtypes, *args)`` computing ``host(*numpy arrays) -> tuple of arrays`` on the host.
+
+    On the CPU backend an XLA FFI custom call of a ctypes handler (:mod:`roughpaths._xla_ffi`),
+    registered once per function; on other backends, or where this jax cannot register the handler,
+    a ``jax.pure_callback`` (the same results; about 0.1 ms more per call, and JAX copies device
+    arrays to the host and back). Under ``vmap`` one batched call, with the mapped axes in front of
+    every operand.
+    """
+    name = f"{_PREFIX}{len(_TARGETS)}"
+    try:
+        handler = host_handler(host)
+        jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler), platform="cpu", api_version=1)
+        _TARGETS.append(handler)
+    except Exception:                        # noqa: BLE001 -- no (or a changed) XLA FFI: the host callback
+        name = None
+
+    def call(result, *args):
+        if name is not None and jax.default_backend() == "cpu":
+            return jax.ffi.ffi_call(name, result, vmap_method="broadcast_all")(*args)
+        callback = host if isinstance(result, tuple) else lambda *arrays: host(*arrays)[0]
+        return jax.pure_callback(callback, result, *args, vmap_method="broadcast_all")
+
+    return call
 
 
 def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
@@ -97,11 +143,11 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
     """
 
     def build(params: dict, dtype):
-        def forward_cb(*arrs):
+        def forward_host(*arrs):
             arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
-            return np.asarray(forward(*arrays, **params), dtype=dtype)
+            return (np.asarray(forward(*arrays, **params), dtype=dtype),)
 
-        def backward_cb(*arrs):
+        def backward_host(*arrs):
             *arrs, g = arrs
             shapes = [a.shape for a in arrs]        # as received: with vmap's axes in front
             arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
@@ -109,19 +155,19 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
             grads = (grads,) if len(arrs) == 1 else tuple(grads)
             return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
 
+        forward_call, backward_call = _host_call(forward_host), _host_call(backward_host)
+
         @jax.custom_vjp
         def f(*args):
             batch = np.broadcast_shapes(*(a.shape[:a.ndim - c] for a, c in zip(args, core)))
             cores = [a.shape[a.ndim - c:] for a, c in zip(args, core)]
-            result = jax.ShapeDtypeStruct(tuple(out_shape(batch, cores, **params)), dtype)
-            return jax.pure_callback(forward_cb, result, *args, vmap_method="broadcast_all")
+            return forward_call(jax.ShapeDtypeStruct(tuple(out_shape(batch, cores, **params)), dtype), *args)
 
         def f_fwd(*args):
             return f(*args), args
 
         def f_bwd(args, g):
-            structs = tuple(jax.ShapeDtypeStruct(a.shape, a.dtype) for a in args)
-            return tuple(jax.pure_callback(backward_cb, structs, *args, g, vmap_method="broadcast_all"))
+            return tuple(backward_call(tuple(jax.ShapeDtypeStruct(a.shape, a.dtype) for a in args), *args, g))
 
         f.defvjp(f_fwd, f_bwd)
         return jax.jit(f)

@@ -1,10 +1,12 @@
-"""``roughpaths.jax``: the numpy signatures as ``custom_vjp`` functions over ``pure_callback``.
+"""``roughpaths.jax``: the numpy signatures as ``custom_vjp`` functions over an XLA FFI host call.
 
 Claims: with x64 the values are the numpy API's to 1e-12, eagerly, under ``jit`` and under ``vmap``
 (which calls the numpy function once, with the mapped axis in front, not once per element); float32
 in gives float32 out; ``jax.test_util.check_grads`` (reverse mode, float64) passes and the
 gradients are the numpy VJPs, also under ``jit(vmap(grad))``; a few gradient steps lower a loss;
-integer inputs are refused. The signature-kernel wrappers are checked the same way (values, batch
+integer inputs are refused; the call is an XLA custom call (not a ``pure_callback``), an error raised by the
+numpy API reaches the caller with its message, and where the FFI target cannot be registered the
+``pure_callback`` fallback (also on other backends than the CPU) gives the same values and gradients. The signature-kernel wrappers are checked the same way (values, batch
 broadcasting, ``check_grads``, jit/vmap, gradient steps).
 """
 
@@ -12,6 +14,9 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import re
+import subprocess
+import sys
 
 from functools import partial
 
@@ -106,6 +111,60 @@ def test_bad_input_is_refused(bad, exc, words):
         rpj.signature(bad, 2)
     for w in words:
         assert w in str(info.value)
+
+
+def test_the_call_is_an_xla_custom_call():
+    hlo = jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text()
+    assert "roughpaths_host_" in hlo and "callback" not in hlo.lower(), hlo
+
+
+def test_target_names_are_unique_to_the_process():
+    """A compiled program names its custom calls (jax's persistent compilation cache keys on it): another
+    process must not find a different function under the same name."""
+    code = ("import jax.numpy as jnp, roughpaths.jax as rpj, jax\n"
+            "print(jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text())")
+    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert other.returncode == 0, other.stderr
+    ours = jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text()
+    name = re.compile(r"roughpaths_host_\w+")
+    assert name.search(ours) and name.search(other.stdout)
+    assert name.search(ours).group() != name.search(other.stdout).group()
+
+
+def test_numpy_errors_reach_the_caller():
+    with pytest.raises(Exception, match="non-finite") as info:
+        jax.block_until_ready(rpj.signature(jnp.full((3, 4, 2), jnp.nan), 2))
+    assert "ValueError" in str(info.value)
+
+
+def test_an_unexpected_error_reaches_the_caller_with_its_traceback():
+    def broken(a):
+        raise RuntimeError("kernel exploded")
+    bad = rpj.differentiable(broken, lambda a, g: g, lambda b, c: b + c[0], names=("a",), core=(0,))
+    with pytest.raises(Exception, match="kernel exploded") as info:
+        jax.block_until_ready(bad(jnp.ones(3)))
+    assert "Traceback" in str(info.value) and "broken" in str(info.value)
+    wrong = rpj.differentiable(lambda a: a[:-1], lambda a, g: g, lambda b, c: b + c[0], names=("a",), core=(0,))
+    with pytest.raises(Exception, match=r"a result of shape \(2,\) for a buffer of shape \(3,\)"):
+        jax.block_until_ready(wrong(jnp.ones(3)))
+
+
+@pytest.mark.parametrize("why", ["no FFI target registers", "another backend"])
+def test_callback_fallback(x64, monkeypatch, why):
+    if why == "another backend":
+        monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
+    else:
+        def refuse(*args, **kwargs):
+            raise RuntimeError("no FFI here")
+        monkeypatch.setattr(jax.ffi, "register_ffi_target", refuse)
+    square = rpj.differentiable(lambda a: a ** 2, lambda a, g: 2 * a * g, lambda b, c: b + c[0],
+                                names=("a",), core=(0,))
+    x = jnp.array([1.0, -2.0, 3.0])
+    assert "callback" in jax.jit(square).lower(x).as_text().lower()
+    np.testing.assert_array_equal(np.asarray(jax.jit(square)(x)), [1.0, 4.0, 9.0])
+    np.testing.assert_array_equal(np.asarray(jax.grad(lambda a: square(a).sum())(x)), [2.0, -4.0, 6.0])
+    np.testing.assert_array_equal(np.asarray(jax.vmap(jax.grad(lambda a: square(a).sum()))(x[:, None])),
+                                  [[2.0], [-4.0], [6.0]])
 
 
 # ------------------------------------------------------------------ signature kernels
