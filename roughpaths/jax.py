@@ -85,20 +85,22 @@ _TARGETS: list = []                     # the registered handlers, alive as long
 _PREFIX = f"roughpaths_host_{os.urandom(6).hex()}_"
 
 
-def _host_call(host):
+def _host_call(host, register: bool = True):
     """``call(result_shape_dtypes, *args)`` computing ``host(*numpy arrays) -> tuple of arrays`` on the host.
 
     On the CPU backend an XLA FFI custom call of a ctypes handler (:mod:`roughpaths._xla_ffi`),
     registered once per function; on other backends, or where this jax cannot register the handler,
     a ``jax.pure_callback`` (the same results; about 0.1 ms more per call, and JAX copies device
     arrays to the host and back). Under ``vmap`` one batched call, with the mapped axes in front of
-    every operand.
+    every operand. ``register=False``: always the callback (a function built for one call only, whose
+    target XLA would keep for the life of the process).
     """
-    name = f"{_PREFIX}{len(_TARGETS)}"
+    name = f"{_PREFIX}{len(_TARGETS)}" if register else None
     try:
-        handler = host_handler(host)
-        jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler), platform="cpu", api_version=1)
-        _TARGETS.append(handler)
+        if name is not None:
+            handler = host_handler(host)
+            jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler), platform="cpu", api_version=1)
+            _TARGETS.append(handler)
     except Exception:                        # noqa: BLE001 -- no (or a changed) XLA FFI: the host callback
         name = None
 
@@ -142,7 +144,7 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
     Array([6.], dtype=float32)
     """
 
-    def build(params: dict, dtype):
+    def build(params: dict, dtype, register: bool = True):
         def forward_host(*arrs):
             arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             return (np.asarray(forward(*arrays, **params), dtype=dtype),)
@@ -155,7 +157,7 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
             grads = (grads,) if len(arrs) == 1 else tuple(grads)
             return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
 
-        forward_call, backward_call = _host_call(forward_host), _host_call(backward_host)
+        forward_call, backward_call = _host_call(forward_host, register), _host_call(backward_host, register)
 
         @jax.custom_vjp
         def f(*args):
@@ -187,7 +189,7 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
         try:
             f = cache.get(key)
         except TypeError:                            # an unhashable parameter: no reuse
-            return build(params, dtype)(*xs)
+            return build(params, dtype, register=False)(*xs)
         if f is None:
             f = cache[key] = build(params, dtype)
         return f(*xs)

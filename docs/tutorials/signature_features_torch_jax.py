@@ -112,9 +112,10 @@ assert acc_torch > 0.85, acc_torch                                              
 
 # %% [markdown]
 # ## 3. The same model in JAX
-# `roughpaths.jax.logsignature` is a `jax.custom_vjp` over `jax.pure_callback` of the same numpy
-# functions: it runs under `jit` (the whole training step below is one compiled function, the
-# log-signature a host callback inside it), `grad` and `vmap`. Same architecture, Adam written out.
+# `roughpaths.jax.logsignature` is a `jax.custom_vjp` whose passes are host calls of the same numpy
+# functions (on the CPU an XLA FFI custom call, elsewhere a `jax.pure_callback`): it runs under `jit`
+# (the whole training step below is one compiled function, the log-signature a host call inside it),
+# `grad` and `vmap`. Same architecture, Adam written out.
 
 # %%
 import jax  # noqa: E402
