@@ -31,26 +31,37 @@ _WALK_CACHE_BYTES = 64 * 2 ** 20
 def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
     """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`); the children
     of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none;
-    a 1-row cache with ``cidx.shape[0] == 0`` disables it)."""
+    a 1-row cache with ``cidx.shape[0] == 0`` disables it). Copies are explicit loops: numba's array
+    assignments compile a shape check with a formatted error message (about 3 s)."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
     cap = L + 4
+    caching = cidx.shape[0] > 0
     sd, si = np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64)
     sw, sG = np.empty((cap, nseg, d)), np.empty((cap, d, d))
     ent = np.empty((1, m + 5), dtype=np.uint32)
     seeds, states = np.empty((1, 4), dtype=np.uint64), np.empty((1, 4), dtype=np.uint64)
     z, fine = np.empty((1, width)), np.empty((1, 2 * nseg, d))
     GL, GR, Wn, An = np.empty((1, d, d)), np.empty((1, d, d)), np.empty((1, d)), np.empty((1, d, d))
-    for q in range(m):
-        ent[0, q] = prefix[q]
+    for j in range(m):
+        ent[0, j] = prefix[j]
     ent[0, m] = tag
     for q in range(Q):
-        W[q] = 0.0
-        A[q] = 0.0
+        r = rows[q]
+        for c in range(n):
+            for a in range(d):
+                W[q, c, a] = 0.0
+                for b in range(d):
+                    A[q, c, a, b] = 0.0
         first, last = idx[q, 0], idx[q, n]
         sd[0], si[0] = 0, 0
-        sw[0], sG[0] = root_w[rows[q]], root_G[rows[q]]
+        for j in range(nseg):
+            for a in range(d):
+                sw[0, j, a] = root_w[r, j, a]
+        for a in range(d):
+            for b in range(d):
+                sG[0, a, b] = root_G[r, a, b]
         top = 1
         while top > 0:
             top -= 1
@@ -71,8 +82,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 for a in range(d):
                     W[q, c, a] += Wn[0, a]
                 continue
-            r = rows[q]
-            if cidx.shape[0] == 0 or cidx[r, depth] != index:
+            if not caching or cidx[r, depth] != index:
                 ent[0, m + 1] = keys[q]
                 ent[0, m + 2] = depth
                 ent[0, m + 3] = index >> 32
@@ -82,16 +92,29 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 _pcg64_normals(states, z)
                 _refine_segments_nb(sw[top:top + 1], sG[top:top + 1], span / float(np.int64(1) << depth) / nseg,
                                     z, fine, GL, GR)
-                if cidx.shape[0] == 0:
-                    sd[top], si[top], sw[top], sG[top] = depth + 1, 2 * index + 1, fine[0, nseg:], GR[0]
-                    sd[top + 1], si[top + 1], sw[top + 1], sG[top + 1] = depth + 1, 2 * index, fine[0, :nseg], GL[0]
-                    top += 2
-                    continue
-                cidx[r, depth] = index
-                cw[r, depth, 0], cw[r, depth, 1], cG[r, depth, 0], cG[r, depth, 1] = \
-                    fine[0, :nseg], fine[0, nseg:], GL[0], GR[0]
-            sd[top], si[top], sw[top], sG[top] = depth + 1, 2 * index + 1, cw[r, depth, 1], cG[r, depth, 1]
-            sd[top + 1], si[top + 1], sw[top + 1], sG[top + 1] = depth + 1, 2 * index, cw[r, depth, 0], cG[r, depth, 0]
+                if caching:
+                    cidx[r, depth] = index
+                    for j in range(nseg):
+                        for a in range(d):
+                            cw[r, depth, 0, j, a] = fine[0, j, a]
+                            cw[r, depth, 1, j, a] = fine[0, nseg + j, a]
+                    for a in range(d):
+                        for b in range(d):
+                            cG[r, depth, 0, a, b] = GL[0, a, b]
+                            cG[r, depth, 1, a, b] = GR[0, a, b]
+            # push the right child, then the left (popped first)
+            for h in range(2):
+                t = top + 1 - h
+                sd[t], si[t] = depth + 1, 2 * index + h
+                for j in range(nseg):
+                    for a in range(d):
+                        sw[t, j, a] = cw[r, depth, h, j, a] if caching else fine[0, h * nseg + j, a]
+                for a in range(d):
+                    for b in range(d):
+                        if caching:
+                            sG[t, a, b] = cG[r, depth, h, a, b]
+                        else:
+                            sG[t, a, b] = GR[0, a, b] if h == 1 else GL[0, a, b]
             top += 2
 
 
