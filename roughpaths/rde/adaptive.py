@@ -160,7 +160,7 @@ class _TreeSteps:
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
         L, cell, i, h = self.L, self.cell, self.i[act], self.state["h"][act]
-        target = self.targets[np.searchsorted(self.targets, i, side="right")]
+        target = self.end if self.targets.size == 1 else self.targets[np.searchsorted(self.targets, i, side="right")]
         depth = np.clip(np.ceil(np.log2(self.span / h)).astype(np.int64) + self.fine, 0, L)
         unit = np.left_shift(np.int64(1), L - depth)
         j = np.round((i + h / cell) / unit).astype(np.int64) * unit
