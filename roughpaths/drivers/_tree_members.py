@@ -37,8 +37,8 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
     of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none; with
     ``cidx.shape[0] == 0`` a scratch cache of one row serves each query). A node on the walk's stack is read
     where it is kept (the root, or its parent's slot of children): the walk is depth first, so a slot is
-    overwritten only after both children in it are done. Copies are loops: numba's array assignments compile
-    a shape check with a formatted error message (about 3 s)."""
+    overwritten only after both children in it are done; a split writes its children into their slot. No array
+    assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
@@ -46,8 +46,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
     sd, si = np.empty(L + 4, dtype=np.int64), np.empty(L + 4, dtype=np.int64)
     ent = np.empty((1, m + 5), dtype=np.uint32)
     seeds, states = np.empty((1, 4), dtype=np.uint64), np.empty((1, 4), dtype=np.uint64)
-    z, fine = np.empty((1, width)), np.empty((1, 2 * nseg, d))
-    GL, GR, Wn, An = np.empty((1, d, d)), np.empty((1, d, d)), np.empty((1, d)), np.empty((1, d, d))
+    z, Wn, An = np.empty((1, width)), np.empty((1, d)), np.empty((1, d, d))
     kidx = np.full(1 if caching else L + 1, -1, dtype=np.int64)
     kw, kG = np.empty((1 if caching else L + 1, 2, nseg, d)), np.empty((1 if caching else L + 1, 2, d, d))
     for j in range(m):
@@ -108,16 +107,9 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 _seed_states(ent, seeds)
                 _pcg64_seed(seeds, states)
                 _pcg64_normals(states, z)
-                _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z, fine, GL, GR)
+                _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z,
+                                    rw[depth].reshape((1, 2 * nseg, d)), rG[depth, 0:1], rG[depth, 1:2])
                 ri[depth] = index
-                for j in range(nseg):
-                    for a in range(d):
-                        rw[depth, 0, j, a] = fine[0, j, a]
-                        rw[depth, 1, j, a] = fine[0, nseg + j, a]
-                for a in range(d):
-                    for b in range(d):
-                        rG[depth, 0, a, b] = GL[0, a, b]
-                        rG[depth, 1, a, b] = GR[0, a, b]
             sd[top], si[top] = depth + 1, 2 * index + 1          # the right child, then the left (popped first)
             sd[top + 1], si[top + 1] = depth + 1, 2 * index
             top += 2
