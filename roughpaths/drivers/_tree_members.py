@@ -12,10 +12,11 @@ The children of the last node split at each depth of each path are kept (if 64 M
 depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk starts at
 the deepest kept node that holds all its times and splits only the few nodes near its new times (the same
 nodes, Chen-multiplied in the same order, as a walk from the root). Adaptive steps of the noise-burst
-problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): about 9 µs per path and attempt, of which
-3.7 splits of 1.7 µs each. Compiling :func:`_walk_nb` (first call, empty cache) costs about 3.5 s of CPU
-after the tree's split and reduction kernels (2.8 s and 0.4 s, compiled with it on a first adaptive solve;
-load 3); from numba's cache, 0.03 s.
+problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): about 7 µs per path and attempt, of which
+3.7 splits of about 1.5 µs each. Compiling :func:`_walk_nb` (first call, empty cache) costs about 2.7 s of
+CPU after the tree's split kernel (``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive
+solve), of which about 1 s re-optimises that kernel's code linked into the walk (load 3); from numba's
+cache, 0.03 s.
 """
 
 from __future__ import annotations
@@ -23,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._random import _pcg64_normals, _pcg64_seed, _seed_states
-from ._tree_kernels import _reduce_nb, _refine_segments_nb, split_width
+from ._random import _pcg64_fill, _pcg64_seed, _seed_states
+from ._tree_kernels import _refine_segments_nb, split_width
 
 __all__ = ["member_cells"]
 
@@ -37,8 +38,9 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
     of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none; with
     ``cidx.shape[0] == 0`` a scratch cache of one row serves each query). A node on the walk's stack is read
     where it is kept (the root, or its parent's slot of children): the walk is depth first, so a slot is
-    overwritten only after both children in it are done; a split writes its children into their slot. No array
-    assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
+    overwritten only after both children in it are done; a split writes its children into their slot. A node
+    inside a cell is reduced here (the arithmetic of ``reduce_node``, one compiled kernel less to link). No
+    array assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
@@ -46,8 +48,10 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
     sd, si = np.empty(L + 4, dtype=np.int64), np.empty(L + 4, dtype=np.int64)
     ent = np.empty((1, m + 5), dtype=np.uint32)
     seeds, states = np.empty((1, 4), dtype=np.uint64), np.empty((1, 4), dtype=np.uint64)
-    z, Wn, An = np.empty((1, width)), np.empty((1, d)), np.empty((1, d, d))
-    kidx = np.full(1 if caching else L + 1, -1, dtype=np.int64)
+    z, Wn, An = np.empty((1, width)), np.empty(d), np.empty((d, d))
+    words = np.empty(width + 64, dtype=np.uint64)
+    kidx = np.empty(1 if caching else L + 1, dtype=np.int64)         # reset per row below
+    zero = np.int64(0)                # not the literal 0, which numba compiles as a variant of its own
     kw, kG = np.empty((1 if caching else L + 1, 2, nseg, d)), np.empty((1 if caching else L + 1, 2, d, d))
     for j in range(m):
         ent[0, j] = prefix[j]
@@ -92,12 +96,23 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 k += 1
             if k > n or idx[q, k] >= lo + size:            # within cell k - 1: Chen-multiply it in
                 c = k - 1
-                _reduce_nb(w, G, Wn, An)
+                for a in range(d):                    # the node's increment and Lévy area (reduce_node)
+                    Wn[a] = 0.0
+                    for b in range(d):
+                        An[a, b] = G[0, a, b]
+                for i in range(nseg):
+                    for a in range(d):
+                        for b in range(a + 1, d):
+                            v = 0.5 * (Wn[a] * w[0, i, b] - Wn[b] * w[0, i, a])
+                            An[a, b] += v
+                            An[b, a] -= v
+                    for a in range(d):
+                        Wn[a] += w[0, i, a]
                 for a in range(d):
                     for b in range(d):
-                        A[q, c, a, b] += An[0, a, b] + 0.5 * (W[q, c, a] * Wn[0, b] - W[q, c, b] * Wn[0, a])
+                        A[q, c, a, b] += An[a, b] + 0.5 * (W[q, c, a] * Wn[b] - W[q, c, b] * Wn[a])
                 for a in range(d):
-                    W[q, c, a] += Wn[0, a]
+                    W[q, c, a] += Wn[a]
                 continue
             if ri[depth] != index:
                 ent[0, m + 1] = keys[q]
@@ -106,7 +121,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 ent[0, m + 4] = index & 0xFFFFFFFF
                 _seed_states(ent, seeds)
                 _pcg64_seed(seeds, states)
-                _pcg64_normals(states, z)
+                _pcg64_fill(states, zero, z[0], words)    # _pcg64_normals of one row, without its pair kernel
                 _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z,
                                     rw[depth].reshape((1, 2 * nseg, d)), rG[depth, 0:1], rG[depth, 1:2])
                 ri[depth] = index
