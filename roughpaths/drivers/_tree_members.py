@@ -9,9 +9,14 @@ equals the tree's answer on shared times (``BrownianTree._cells``) to round-off,
 assembled by another order of the same sums.
 
 The children of the last node split at each depth of each path are kept (if 64 MiB hold one such pair per
-depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk splits
-only the few nodes near its new times. Compiling :func:`_walk_nb` (first call, empty cache) costs about
-8 s of CPU (measured at load 6, after the tree's own kernels); from numba's cache, 0.03 s.
+depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk starts at
+the deepest kept node that holds all its times and splits only the few nodes near its new times (the same
+nodes, Chen-multiplied in the same order, as a walk from the root). Adaptive steps of the noise-burst
+problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): about 7 µs per path and attempt, of which
+3.7 splits of about 1.5 µs each. Compiling :func:`_walk_nb` (first call, empty cache) costs about 2.7 s of
+CPU after the tree's split kernel (``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive
+solve), of which about 1 s re-optimises that kernel's code linked into the walk (load 3); from numba's
+cache, 0.03 s.
 """
 
 from __future__ import annotations
@@ -19,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._random import _pcg64_normals, _pcg64_seed, _seed_states
-from ._tree_kernels import _reduce_nb, _refine_segments_nb, split_width
+from ._random import _pcg64_fill, _pcg64_seed, _seed_states
+from ._tree_kernels import _refine_segments_nb, split_width
 
 __all__ = ["member_cells"]
 
@@ -29,28 +34,50 @@ _WALK_CACHE_BYTES = 64 * 2 ** 20
 
 @njit(cache=True, nogil=True)
 def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
-    """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`); the children
-    of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none;
-    a 1-row cache with ``cidx.shape[0] == 0`` disables it)."""
+    """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children
+    of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none; with
+    ``cidx.shape[0] == 0`` a scratch cache of one row serves each query). A node on the walk's stack is read
+    where it is kept (the root, or its parent's slot of children): the walk is depth first, so a slot is
+    overwritten only after both children in it are done; a split writes its children into their slot. A node
+    inside a cell is reduced here (the arithmetic of ``reduce_node``, one compiled kernel less to link). No
+    array assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
-    cap = L + 4
-    sd, si = np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64)
-    sw, sG = np.empty((cap, nseg, d)), np.empty((cap, d, d))
+    caching = cidx.shape[0] > 0
+    sd, si = np.empty(L + 4, dtype=np.int64), np.empty(L + 4, dtype=np.int64)
     ent = np.empty((1, m + 5), dtype=np.uint32)
     seeds, states = np.empty((1, 4), dtype=np.uint64), np.empty((1, 4), dtype=np.uint64)
-    z, fine = np.empty((1, width)), np.empty((1, 2 * nseg, d))
-    GL, GR, Wn, An = np.empty((1, d, d)), np.empty((1, d, d)), np.empty((1, d)), np.empty((1, d, d))
-    for q in range(m):
-        ent[0, q] = prefix[q]
+    z, Wn, An = np.empty((1, width)), np.empty(d), np.empty((d, d))
+    words = np.empty(width + 64, dtype=np.uint64)
+    kidx = np.empty(1 if caching else L + 1, dtype=np.int64)         # reset per row below
+    zero = np.int64(0)                # not the literal 0, which numba compiles as a variant of its own
+    kw, kG = np.empty((1 if caching else L + 1, 2, nseg, d)), np.empty((1 if caching else L + 1, 2, d, d))
+    for j in range(m):
+        ent[0, j] = prefix[j]
     ent[0, m] = tag
     for q in range(Q):
-        W[q] = 0.0
-        A[q] = 0.0
+        r = rows[q]
+        if caching:
+            ri, rw, rG = cidx[r], cw[r], cG[r]
+        else:
+            ri, rw, rG = kidx, kw, kG
+            for j in range(L + 1):
+                ri[j] = -1
+        for c in range(n):
+            for a in range(d):
+                W[q, c, a] = 0.0
+                for b in range(d):
+                    A[q, c, a, b] = 0.0
         first, last = idx[q, 0], idx[q, n]
-        sd[0], si[0] = 0, 0
-        sw[0], sG[0] = root_w[rows[q]], root_G[rows[q]]
+        # start at the deepest node holding [first, last) whose state is kept (the root at worst): the nodes
+        # above it hold a query point strictly inside and would only be descended through
+        start = L - 1
+        while start > 0 and (first >> (L - start)) != ((last - 1) >> (L - start)):
+            start -= 1
+        while start > 0 and ri[start - 1] != (first >> (L - start + 1)):
+            start -= 1
+        sd[0], si[0] = start, first >> (L - start)
         top = 1
         while top > 0:
             top -= 1
@@ -59,39 +86,47 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
             lo = index * size
             if lo + size <= first or lo >= last:
                 continue
+            if depth == 0:
+                w, G = root_w[r:r + 1], root_G[r:r + 1]
+            else:
+                h = index & 1
+                w, G = rw[depth - 1, h:h + 1], rG[depth - 1, h:h + 1]
             k = 0
             while k <= n and idx[q, k] <= lo:
                 k += 1
             if k > n or idx[q, k] >= lo + size:            # within cell k - 1: Chen-multiply it in
                 c = k - 1
-                _reduce_nb(sw[top:top + 1], sG[top:top + 1], Wn, An)
+                for a in range(d):                    # the node's increment and Lévy area (reduce_node)
+                    Wn[a] = 0.0
+                    for b in range(d):
+                        An[a, b] = G[0, a, b]
+                for i in range(nseg):
+                    for a in range(d):
+                        for b in range(a + 1, d):
+                            v = 0.5 * (Wn[a] * w[0, i, b] - Wn[b] * w[0, i, a])
+                            An[a, b] += v
+                            An[b, a] -= v
+                    for a in range(d):
+                        Wn[a] += w[0, i, a]
                 for a in range(d):
                     for b in range(d):
-                        A[q, c, a, b] += An[0, a, b] + 0.5 * (W[q, c, a] * Wn[0, b] - W[q, c, b] * Wn[0, a])
+                        A[q, c, a, b] += An[a, b] + 0.5 * (W[q, c, a] * Wn[b] - W[q, c, b] * Wn[a])
                 for a in range(d):
-                    W[q, c, a] += Wn[0, a]
+                    W[q, c, a] += Wn[a]
                 continue
-            r = rows[q]
-            if cidx.shape[0] == 0 or cidx[r, depth] != index:
+            if ri[depth] != index:
                 ent[0, m + 1] = keys[q]
                 ent[0, m + 2] = depth
                 ent[0, m + 3] = index >> 32
                 ent[0, m + 4] = index & 0xFFFFFFFF
                 _seed_states(ent, seeds)
                 _pcg64_seed(seeds, states)
-                _pcg64_normals(states, z)
-                _refine_segments_nb(sw[top:top + 1], sG[top:top + 1], span / float(np.int64(1) << depth) / nseg,
-                                    z, fine, GL, GR)
-                if cidx.shape[0] == 0:
-                    sd[top], si[top], sw[top], sG[top] = depth + 1, 2 * index + 1, fine[0, nseg:], GR[0]
-                    sd[top + 1], si[top + 1], sw[top + 1], sG[top + 1] = depth + 1, 2 * index, fine[0, :nseg], GL[0]
-                    top += 2
-                    continue
-                cidx[r, depth] = index
-                cw[r, depth, 0], cw[r, depth, 1], cG[r, depth, 0], cG[r, depth, 1] = \
-                    fine[0, :nseg], fine[0, nseg:], GL[0], GR[0]
-            sd[top], si[top], sw[top], sG[top] = depth + 1, 2 * index + 1, cw[r, depth, 1], cG[r, depth, 1]
-            sd[top + 1], si[top + 1], sw[top + 1], sG[top + 1] = depth + 1, 2 * index, cw[r, depth, 0], cG[r, depth, 0]
+                _pcg64_fill(states, zero, z[0], words)    # _pcg64_normals of one row, without its pair kernel
+                _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z,
+                                    rw[depth].reshape((1, 2 * nseg, d)), rG[depth, 0:1], rG[depth, 1:2])
+                ri[depth] = index
+            sd[top], si[top] = depth + 1, 2 * index + 1          # the right child, then the left (popped first)
+            sd[top + 1], si[top + 1] = depth + 1, 2 * index
             top += 2
 
 

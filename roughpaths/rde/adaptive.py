@@ -31,9 +31,12 @@ strong error of an order-1 scheme is proportional to ``rtol`` (an error-per-step
 
 The step ends
 -------------
-Step ends are snapped to the dyadic grid of spacing at most ``h/8`` (a relative change of at most 1/16), so a
-query walks only about :math:`\log_2(T/h) + 4` levels of the tree. Save times and ``t1`` are never stepped
-over. A step at ``dt_min`` whose error ratio exceeds 1 fails its members (``on_failure``).
+Step ends are snapped to a dyadic grid of spacing at most ``h/8`` (a relative change of at most 1/16), so a
+query walks only about :math:`\log_2(T/h) + 4` levels of the tree; adaptive steps per member use the grid of
+spacing in :math:`(h/4, h/2]` (a relative change of the proposed step of at most 1/4, which the error estimate
+then judges). Each member walks the tree on its own there, and a new step end on the coarser grid needs about
+two new tree nodes instead of seven (the splits are most of a per-member query's cost; with shared steps one
+split serves the whole batch, which keeps the finer grid unless it has one member). Save times and ``t1`` are never stepped over. A step at ``dt_min`` whose error ratio exceeds 1 fails its members (``on_failure``).
 
 What is exact and what is approximate
 -------------------------------------
@@ -66,6 +69,24 @@ def _whole_step(W, XX):
     W1, W2 = W[..., 0, :], W[..., 1, :]
     XXw = XX[..., 0, :, :] + XX[..., 1, :, :] + W1[..., :, None] * W2[..., None, :]
     return (W1 + W2)[..., None, :], XXw[..., None, :, :]
+
+
+def _step_doubling(solver, fields, y, a):
+    """``(y_2, y_1)`` of an attempt ``a`` from ``y``: two solver steps over its halves and one over the whole.
+
+    With each member on its own times (``a.times (members, 3)``) the first half and the whole step are one
+    call of the solver on the members stacked twice (a member's arithmetic is its own in any batch), the
+    second half another: two calls instead of three, the same numbers."""
+    no = np.zeros(1, dtype=bool)
+    if a.times.ndim == 2 and isinstance(a.dXX, np.ndarray):
+        n = y.shape[0]
+        both = solver.integrate(fields, np.concatenate([y, y]), np.concatenate([a.times[:, :2], a.times[:, ::2]]),
+                                np.concatenate([a.dX[:, :1], a.whole[0]]), np.concatenate([a.dXX[:, :1], a.whole[1]]),
+                                no, stop_on_failure=False)[0]
+        y2 = solver.integrate(fields, both[:n], a.times[:, 1:], a.dX[:, 1:], a.dXX[:, 1:], no, stop_on_failure=False)[0]
+        return y2, both[n:]
+    y2 = solver.integrate(fields, y, a.times, a.dX, a.dXX, a.save, stop_on_failure=a.stop)[0]
+    return y2, solver.integrate(fields, y, a.times[..., [0, -1]], *a.whole, a.save[:1], stop_on_failure=False)[0]
 
 
 class _Attempt:
@@ -102,6 +123,7 @@ class _TreeSteps:
                                  f"duplicates.")
             self.targets = np.array(sorted(snapped - {0} | {end}))
         self.save_all = isinstance(save_at, str) and save_at == "all"
+        self.save_list = np.array(sorted(self.save_idx), dtype=np.int64)
         P = run.members
         self.vector = bool(getattr(solver, "member_times", False)) and (
             not getattr(fields, "time_dependent", False) or getattr(fields, "batched_time", False))
@@ -117,9 +139,11 @@ class _TreeSteps:
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
         self.i, self.j = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))
-        self.t_acc = [[t0] for _ in range(n)]
+        # step ends snapped to spacing (h/4, h/2] per path, adaptive; else (h/16, h/8] (module docstring)
+        self.fine = 1 if control.adaptive and (not self.shared or P == 1) else 3
         keep0 = self.save_all or 0 in self.save_idx
         self.saved = [([t0], [run.y[m].copy()]) if keep0 else ([], []) for m in self.lane_members]
+        self.n_saved = n if keep0 else 0                   # states saved so far, over all lanes
         self.y_new, self.err = np.empty_like(run.y), np.zeros(P)
         self.progress_total, self.reached = (T, "solve (adaptive)", "time"), 0.0
 
@@ -136,8 +160,8 @@ class _TreeSteps:
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
         L, cell, i, h = self.L, self.cell, self.i[act], self.state["h"][act]
-        target = self.targets[np.searchsorted(self.targets, i, side="right")]
-        depth = np.clip(np.ceil(np.log2(self.span / h)).astype(np.int64) + 3, 0, L)
+        target = self.end if self.targets.size == 1 else self.targets[np.searchsorted(self.targets, i, side="right")]
+        depth = np.clip(np.ceil(np.log2(self.span / h)).astype(np.int64) + self.fine, 0, L)
         unit = np.left_shift(np.int64(1), L - depth)
         j = np.round((i + h / cell) / unit).astype(np.int64) * unit
         j = np.maximum(np.maximum(j, i + self.min_cells), (i // unit + 1) * unit)
@@ -151,7 +175,10 @@ class _TreeSteps:
         ts = self.t0 + cell * np.stack(cols, axis=-1).astype(np.float64)          # (lanes, 3) or (lanes, 2)
         if self.shared:
             members, ts, h = self.lane_members[0], ts[0], float((j[0] - i[0]) * cell)
-            W, XX = self.tree.increments_and_areas(ts, None if self.whole_batch else self.paths)
+            if members.size == 1:               # one member: walked as a path of its own, as per member
+                W, XX = self.tree.increments_and_areas(ts[None], self.paths)
+            else:
+                W, XX = self.tree.increments_and_areas(ts, None if self.whole_batch else self.paths)
             W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
         else:
             members, h = act, (j - i) * cell
@@ -175,8 +202,12 @@ class _TreeSteps:
             self.err[a.members] = err
 
     def _lane_ratios(self, ok):
-        r = np.zeros(self.lanes)
-        np.maximum.at(r, self.lane_of[ok], self.err[ok])                # NaN propagates: never accepted
+        if self.shared:
+            r = np.zeros(1)
+            if ok.any():
+                r[0] = np.max(self.err[ok])                             # NaN propagates: never accepted
+        else:
+            r = np.where(ok, self.err, 0.0)
         r[self.lane_of[self.bad & self.run.healthy]] = math.inf
         return r
 
@@ -208,23 +239,28 @@ class _TreeSteps:
         run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
         self.accepted[lanes] += 1
         self.i[lanes] = self.j[lanes]
+        if not self.save_all:
+            at = self.i[lanes]
+            lanes = lanes[at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else
+                          np.isin(at, self.save_list)]
         for k in lanes.tolist():
             ik = int(self.i[k])
-            tn = self.t0 + ik * cell if ik < self.end else self.t1
-            self.t_acc[k].append(tn)
-            if self.save_all or ik in self.save_idx:
-                self.saved[k][0].append(tn)
-                self.saved[k][1].append(run.y[self.lane_members[k]].copy())
-        run.check_saves(sum(len(ts) for ts, _ in self.saved) // self.lanes, growing=True)
+            self.saved[k][0].append(self.t0 + ik * cell if ik < self.end else self.t1)
+            self.saved[k][1].append(run.y[self.lane_members[k]].copy())
+        self.n_saved += lanes.size
+        run.check_saves(self.n_saved // self.lanes, growing=True)
         reached = float(np.min(self.i)) * cell           # exact: cell = T / 2^L, and end * cell == T
         if reached > self.reached:
             self.reached = reached
             run.progress(reached)
 
     def _times_of(self, member):
-        """The accepted step ends of ``member`` (flat index) and its attempt's end: for failure messages."""
+        """The step ends the failure message of ``member`` (flat index) reads: its failed attempt's start and end
+        at positions ``accepted`` and ``accepted + 1`` (the earlier ends, not kept, are NaN)."""
         k = int(self.lane_of[member])
-        return np.array(self.t_acc[k] + [self.t0 + float(self.j[k]) * self.cell])
+        times = np.full(int(self.accepted[k]) + 2, np.nan)
+        times[-2:] = self.t0 + np.array([float(self.i[k]), float(self.j[k])]) * self.cell
+        return times
 
     def finish(self):
         """``(times, states, stats)``: one time axis for shared steps and for save times; per member otherwise."""

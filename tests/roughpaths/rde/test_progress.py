@@ -99,7 +99,7 @@ def test_adaptive_solve_reports_the_time_reached_per_accepted_step():
     seen = []
     own = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, progress=seen.append)
     _check_records(seen, 1.5)
-    assert 0 < len(seen) <= own.stats["accepted"].max()
+    assert 0 < len(seen) <= own.stats["accepted"].sum()         # a report needs an accepted step of some member
     assert np.array_equal(own.states, rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl).states)
 
 
