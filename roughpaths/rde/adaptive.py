@@ -36,7 +36,8 @@ query walks only about :math:`\log_2(T/h) + 4` levels of the tree; adaptive step
 spacing in :math:`(h/4, h/2]` (a relative change of the proposed step of at most 1/4, which the error estimate
 then judges). Each member walks the tree on its own there, and a new step end on the coarser grid needs about
 two new tree nodes instead of seven (the splits are most of a per-member query's cost; with shared steps one
-split serves the whole batch, which keeps the finer grid unless it has one member). Save times and ``t1`` are never stepped over. A step at ``dt_min`` whose error ratio exceeds 1 fails its members (``on_failure``).
+split serves the whole batch, which keeps the finer grid unless it has one member). Save times and ``t1`` are never
+stepped over. A step at ``dt_min`` whose error ratio exceeds 1 fails its members (``on_failure``).
 
 What is exact and what is approximate
 -------------------------------------
