@@ -86,7 +86,10 @@ def test_adaptive_steps_are_a_declared_capability():
     assert heun.final.shape == (3,)
     a = rp.solve(V, tree, Y0, Declared(), step_control=ctrl, save_at="end")
     b = rp.solve(V, tree, Y0, rp.Davie(), step_control=ctrl, save_at="end")
-    assert np.array_equal(a.final, b.final) and a.stats["accepted"] == b.stats["accepted"]
+    # the same scheme by two routes (Davie's own takes the members' times in one call): equal to round-off,
+    # not bitwise (the routes' array products may run other vector kernels on another CPU)
+    np.testing.assert_allclose(a.final, b.final, rtol=1e-12, atol=0)
+    assert a.stats["accepted"] == b.stats["accepted"]
 
 
 def test_objects_outside_the_contract_are_refused_by_name():
