@@ -46,41 +46,49 @@ KBLOCK = 16
 
 @njit(cache=True, inline="always")
 def _row(y, yo, x, xo, c, z, zo, n):
-    """``y[yo + p] = x[xo + p] * c + z[zo + p]`` for ``p < n`` (packed rows of LANES, then one by one)."""
+    """``y[yo + p] = x[xo + p] * c + z[zo + p]`` for ``p < n``, in whole packed rows of LANES.
+
+    The last packed row runs past ``n`` by up to ``LANES - 1`` entries: it reads what follows ``x`` and
+    ``z`` and writes garbage after ``y[yo + n - 1]``. The callers keep that harmless: ``y`` is never
+    ``z`` nor ``x`` (no update in place), rows are written in increasing order (row ``q + 1``, written
+    next, overwrites what row ``q`` spilled), and every region ends in ``LANES`` entries of slack.
+    """
     L = np.uint64(LANES)
-    n1 = n - n % L
     cv = vsplat(c)
-    for p in range(np.uint64(0), n1, L):
+    for p in range(np.uint64(0), n, L):
         vstore(y, yo + p, vadd(vmul(vload(x, xo + p), cv), vload(z, zo + p)))
-    for p in range(n1, n):
-        y[yo + p] = x[xo + p] * c + z[zo + p]
 
 
 @njit(cache=True, inline="always")
-def _fused_d(s, delta, d, m, offsets, fac, cb, tb, to):
+def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
     """Levels ``1..m-1`` advance one segment, and ``tb[to:to + d^(m-1)] = T^m_{m-1}`` (old levels).
 
+    The lower levels are double-buffered in ``lw``: read at ``so``, the new ones written at ``sn``.
     Every level's Horner chain at once, level ``j`` of ``S`` read once: ``C^l_1 = D/l + S_1`` and
-    ``C^l_j = C^l_{j-1} ⊗ D/(l - j + 1) + S_j`` for the levels ``l > j`` (``cb``: two rows of
-    ``d^(m-2)`` per ``l``), then ``S_j <- S_j + C^j_{j-1} ⊗ D``: the operations of
+    ``C^l_j = C^l_{j-1} ⊗ D/(l - j + 1) + S_j`` for the levels ``l > j`` (``cb``: two regions of
+    ``hs`` entries per ``l``), then ``S_j <- S_j + C^j_{j-1} ⊗ D``: the operations of
     :func:`~roughpaths.signatures._lanes._horner_step` in another order (the same bits;
-    ``fac[k] = 1.0 / k``).
+    ``fac[k] = 1.0 / k``). Every row is whole packed rows (:func:`_row`): no loop ends one entry at a
+    time, whatever ``d``.
     """
     ud = np.uint64(d)
-    half = np.uint64(d ** max(m - 2, 1))
-    # C^l_j lives at cb[(2 l + j % 2) half ...]
+    uh = np.uint64(hs)
+    # C^l_j lives at cb[(2 l + j % 2) hs ...]
     for lev in range(2, m):
         inv = fac[lev]
-        o = np.uint64(2 * lev + 1) * half
+        o = np.uint64(2 * lev + 1) * uh
         for i in range(ud):
-            cb[o + i] = delta[i] * inv + s[i]
+            cb[o + i] = delta[i] * inv + lw[so + i]
     inv = fac[m]
-    o = np.uint64(to) if m == 2 else np.uint64(2 * m + 1) * half
-    dst = tb if m == 2 else cb
+    if m == 2:
+        for i in range(ud):
+            tb[to + i] = delta[i] * inv + lw[so + i]
+    else:
+        o = np.uint64(2 * m + 1) * uh
+        for i in range(ud):
+            cb[o + i] = delta[i] * inv + lw[so + i]
     for i in range(ud):
-        dst[o + i] = delta[i] * inv + s[i]
-    for i in range(ud):
-        s[i] += delta[i]
+        lw[sn + i] = lw[so + i] + delta[i]
     size = ud                                       # d^(j-1)
     for j in range(2, m):
         oj = np.uint64(offsets[j])
@@ -92,27 +100,35 @@ def _fused_d(s, delta, d, m, offsets, fac, cb, tb, to):
             row = oj + base
             for lev in range(j + 1, m if top else m + 1):
                 c = delta[q] * fac[lev - j + 1]
-                src = (np.uint64(2 * lev) + rd) * half
-                dst = (np.uint64(2 * lev) + wr) * half + base
-                _row(cb, dst, cb, src, c, s, row, size)
+                src = (np.uint64(2 * lev) + rd) * uh
+                dst = (np.uint64(2 * lev) + wr) * uh + base
+                _row(cb, dst, cb, src, c, lw, so + row, size)
             if top:
                 c = delta[q] * fac[2]
-                src = (np.uint64(2 * m) + rd) * half
-                _row(tb, np.uint64(to) + base, cb, src, c, s, row, size)
-            src = (np.uint64(2 * j) + rd) * half
-            _row(s, row, cb, src, delta[q], s, row, size)
+                src = (np.uint64(2 * m) + rd) * uh
+                _row(tb, to + base, cb, src, c, lw, so + row, size)
+            src = (np.uint64(2 * j) + rd) * uh
+            _row(lw, sn + row, cb, src, delta[q], lw, so + row, size)
         size *= ud
 
 
 @njit(cache=True, inline="always")
-def _top_sweep(s, ok, n, d, tb, dl, nk):
-    """``S_m[p + n q] += sum_k tb[k n + p] dl[k d + q]``, the products added one segment after another."""
+def _top_sweep(s, ok, n, d, tb, dl, nk, w):
+    """``S_m[p + n q] += sum_k tb[k n + p] dl[k d + q]``, the products added one segment after another.
+
+    The first ``n - n mod 4 LANES`` entries of every row go in tiles of 4 packed rows; the rest of each
+    row (fewer than ``4 LANES``) is copied into the zero-padded rows of the scratch ``w``
+    (``d x 4 LANES``) and swept there by whole packed rows, four rows ``q`` at a time so that four
+    independent sums advance together (summed one entry at a time, each entry's ``K`` additions
+    form a chain of dependent adds: ~10x slower a product). ``tb`` needs ``LANES`` readable entries
+    past its last segment (the padded lanes read them and are never copied back). Every entry gets
+    the same operations in the same order on either path.
+    """
     L = np.uint64(LANES)
     un = np.uint64(n)
     ud = np.uint64(d)
     unk = np.uint64(nk)
     n4 = un - un % (4 * L)
-    n1 = un - un % L
     for p in range(np.uint64(0), n4, 4 * L):             # a tile of K x 4 LANES products stays in L1
         for q in range(ud):
             r = np.uint64(ok) + q * un + p
@@ -131,29 +147,61 @@ def _top_sweep(s, ok, n, d, tb, dl, nk):
             vstore(s, r + L, a1)
             vstore(s, r + 2 * L, a2)
             vstore(s, r + 3 * L, a3)
+    rest = un - n4
+    if rest == 0:
+        return
+    wn = (rest + L - np.uint64(1)) // L * L                  # scratch row: whole packed rows
     for q in range(ud):
-        row = np.uint64(ok) + q * un
-        for p in range(n4, n1, L):
-            r = row + p
-            a0 = vload(s, r)
+        row = np.uint64(ok) + q * un + n4
+        for p in range(rest):
+            w[q * wn + p] = s[row + p]
+        for p in range(rest, wn):
+            w[q * wn + p] = 0.0
+    q4 = ud - ud % np.uint64(4)
+    for c in range(np.uint64(0), wn, L):
+        p = n4 + c
+        for q in range(np.uint64(0), q4, np.uint64(4)):
+            r = q * wn + c
+            a0 = vload(w, r)
+            a1 = vload(w, r + wn)
+            a2 = vload(w, r + 2 * wn)
+            a3 = vload(w, r + 3 * wn)
+            for k in range(unk):
+                t = vload(tb, k * un + p)
+                e = k * ud + q
+                a0 = vadd(a0, vmul(t, vsplat(dl[e])))
+                a1 = vadd(a1, vmul(t, vsplat(dl[e + 1])))
+                a2 = vadd(a2, vmul(t, vsplat(dl[e + 2])))
+                a3 = vadd(a3, vmul(t, vsplat(dl[e + 3])))
+            vstore(w, r, a0)
+            vstore(w, r + wn, a1)
+            vstore(w, r + 2 * wn, a2)
+            vstore(w, r + 3 * wn, a3)
+        for q in range(q4, ud):
+            r = q * wn + c
+            a0 = vload(w, r)
             for k in range(unk):
                 a0 = vadd(a0, vmul(vload(tb, k * un + p), vsplat(dl[k * ud + q])))
-            vstore(s, r, a0)
-        for p in range(n1, un):
-            a = s[row + p]
-            for k in range(unk):
-                a += tb[k * un + p] * dl[k * ud + q]
-            s[row + p] = a
+            vstore(w, r, a0)
+    for q in range(ud):
+        row = np.uint64(ok) + q * un + n4
+        for p in range(rest):
+            s[row + p] = w[q * wn + p]
 
 
 @njit(cache=True, inline="always")
-def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, tb, dl, delta):
-    """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 2``)."""
+def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls):
+    """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 2``); the
+    lower levels run in ``lw`` (two copies ``ls`` apart) and are copied into ``s`` at the end."""
     ud = np.uint64(d)
     n = np.uint64(d ** (m - 1))
     ok = offsets[m]
-    for r in range(s.shape[0]):
+    for r in range(ok, s.shape[0]):
         s[r] = 0.0
+    for r in range(ok):
+        lw[r] = 0.0
+    so = np.uint64(0)
+    sn = np.uint64(ls)
     for t0 in range(k0, k1, KBLOCK):
         nk = min(KBLOCK, k1 - t0)
         for k in range(nk):
@@ -162,8 +210,11 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, tb, dl, delta):
                 v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
                 dl[kk * ud + i] = v
                 delta[i] = v
-            _fused_d(s, delta, d, m, offsets, fac, buf, tb, kk * n)
-        _top_sweep(s, ok, n, d, tb, dl, nk)
+            _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
+            so, sn = sn, so
+        _top_sweep(s, ok, n, d, tb, dl, nk, w)
+    for r in range(ok):
+        s[r] = lw[so + r]
 
 
 def block_key(d: int, m: int) -> tuple:
@@ -186,18 +237,22 @@ def _block_units_kernel(D: int, M: int):
     def block_units_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
         d = D if D else x.shape[2]
         mm = M if M else m
-        buf = np.empty((2 * mm + 2) * d ** max(mm - 2, 1))      # the chains C^l_j (_fused_d)
+        hs = (d ** max(mm - 2, 1) + 2 * LANES - 1) // LANES * LANES   # a chain's region, with slack
+        buf = np.zeros((2 * mm + 2) * hs)                       # the chains C^l_j (_fused_d)
+        ls = (offsets[mm] + 2 * LANES - 1) // LANES * LANES     # the lower levels, with slack
+        lw = np.zeros(2 * ls)
         most = 1
         for u in range(lo, hi):
             most = max(most, uhi[u] - ulo[u])
-        tb = np.empty(min(KBLOCK, most) * d ** (mm - 1))        # a short path's block: its segments
+        tb = np.zeros(min(KBLOCK, most) * d ** (mm - 1) + LANES)   # a short path's block: its segments
+        w = np.empty(d * 4 * LANES)                             # the rows' ends (_top_sweep)
         dl = np.empty(KBLOCK * d)
         delta = np.empty(d)
         fac = np.empty(mm + 1)
         for k in range(1, mm + 1):
             fac[k] = 1.0 / k
         for u in range(lo, hi):
-            _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, tb, dl, delta)
+            _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls)
 
     return block_units_variant
 
