@@ -1,7 +1,7 @@
 """One-unit signature kernel with the top level deferred over blocks of segments (private).
 
-Called by :mod:`roughpaths.signatures._engine` for the units that run alone (every ``d >= 6``, and
-lane groups with few units). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
+Called by :mod:`roughpaths.signatures._engine` for the units that run alone (every ``d >= 8``, d = 6, 7
+beyond depth 3, and lane groups with few units). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
 (reversed word order, the Horner–Chen update with every product rounded, then every sum).
 
 The top level of the Horner update of segment ``k`` is a rank-one update,
@@ -21,12 +21,22 @@ operations per loaded value instead of one load and one store per product, so it
 machine's multiply/add rate instead of its load/store rate, and a top level larger than the L1 (or
 the L2) cache is streamed once a block instead of once a segment.
 
+*Any width.* No loop ends one entry at a time, so a run-time ``d`` that is not a multiple of
+``LANES`` costs no scalar tails: the lower levels advance in a private double buffer (read the old
+copy, write the new one: never in place), every row of them is whole packed rows whose last one may
+spill past the row (into the next row, written next, or into slack) (:func:`_row`), and the ends of
+the top level's rows are swept in a zero-padded scratch, four rows at a time (:func:`_top_sweep`).
+Before, those ends were scalar loops, and the top level's a chain of dependent adds per entry:
+d = 6, 7, 10, 14 at depth 3 took 127, 148, 198, 437 ns a segment, now 68, 95, 148, 298 (one thread,
+16 x 256 points; pysiglib 4.0 ``n_jobs=1`` 61, 89, 161, 399).
+
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
-0.125 at 2 GHz); per segment d = 8 depth 3 about 120 ns (the one-segment kernel: 290), depth 4
-about 1300 (1900), d = 6 depth 4 400 (760), d = 20 depth 3 1400 (2800). d = 8 at depths 3 and
-4, d = 6 at depth 4 and d = 20 at depth 3 are compiled with constant ``d`` and ``m`` (loops
-unrolled: the lower levels 30% faster), d = 4 with a constant ``d``.
+0.125 at 2 GHz); per segment d = 8 depth 3 about 70 ns, depth 4 about 450-600, d = 6 depth 4
+220, d = 20 depth 3 780 (run-time ``d``). d = 8 at depths 3 and 4 and d = 6 at depth 4 are
+compiled with constant ``d`` and ``m`` (loops unrolled: at d = 8, depth 3 the lower levels take
+40 ns a segment against 57 with a run-time ``d``), d = 4 with a constant ``d``. Compile cost (cold,
+empty cache, one variant, CPU): about 4 s for the run-time variant, 3.6 s for (8, 3).
 """
 
 from __future__ import annotations
@@ -118,11 +128,11 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
 
     The first ``n - n mod 4 LANES`` entries of every row go in tiles of 4 packed rows; the rest of each
     row (fewer than ``4 LANES``) is copied into the zero-padded rows of the scratch ``w``
-    (``d x 4 LANES``) and swept there by whole packed rows, four rows ``q`` at a time so that four
-    independent sums advance together (summed one entry at a time, each entry's ``K`` additions
+    (``(d + 3) x 4 LANES``) and swept there by whole packed rows, four rows ``q`` at a time so that
+    four independent sums advance together (summed one entry at a time, each entry's ``K`` additions
     form a chain of dependent adds: ~10x slower a product). ``tb`` needs ``LANES`` readable entries
-    past its last segment (the padded lanes read them and are never copied back). Every entry gets
-    the same operations in the same order on either path.
+    past its last segment and ``dl`` 3 past its last (the padded lanes and rows read them and are never
+    copied back). Every entry gets the same operations in the same order on either path.
     """
     L = np.uint64(LANES)
     un = np.uint64(n)
@@ -148,19 +158,15 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             vstore(s, r + 2 * L, a2)
             vstore(s, r + 3 * L, a3)
     rest = un - n4
-    if rest == 0:
-        return
-    wn = (rest + L - np.uint64(1)) // L * L                  # scratch row: whole packed rows
-    for q in range(ud):
+    wn = (rest + L - np.uint64(1)) // L * L                  # scratch row: whole packed rows (0 if none)
+    nq = (ud + np.uint64(3)) // np.uint64(4) * np.uint64(4)  # rows d .. nq - 1 of w are slack
+    for q in range(nq if rest else np.uint64(0)):
         row = np.uint64(ok) + q * un + n4
-        for p in range(rest):
-            w[q * wn + p] = s[row + p]
-        for p in range(rest, wn):
-            w[q * wn + p] = 0.0
-    q4 = ud - ud % np.uint64(4)
+        for p in range(wn):
+            w[q * wn + p] = s[row + p] if q < ud and p < rest else 0.0
     for c in range(np.uint64(0), wn, L):
         p = n4 + c
-        for q in range(np.uint64(0), q4, np.uint64(4)):
+        for q in range(np.uint64(0), ud, np.uint64(4)):
             r = q * wn + c
             a0 = vload(w, r)
             a1 = vload(w, r + wn)
@@ -177,13 +183,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             vstore(w, r + wn, a1)
             vstore(w, r + 2 * wn, a2)
             vstore(w, r + 3 * wn, a3)
-        for q in range(q4, ud):
-            r = q * wn + c
-            a0 = vload(w, r)
-            for k in range(unk):
-                a0 = vadd(a0, vmul(vload(tb, k * un + p), vsplat(dl[k * ud + q])))
-            vstore(w, r, a0)
-    for q in range(ud):
+    for q in range(ud if rest else np.uint64(0)):
         row = np.uint64(ok) + q * un + n4
         for p in range(rest):
             s[row + p] = w[q * wn + p]
@@ -221,10 +221,10 @@ def block_key(d: int, m: int) -> tuple:
     """``(D, M)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time).
 
     Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
-    (d, m) = (8, 3), (8, 4), (6, 4), (20, 3), and d = 4 at any depth. Each variant is its own kernel,
+    (d, m) = (8, 3), (8, 4), (6, 4), and d = 4 at any depth. Each variant is its own kernel,
     compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
     """
-    if (d, m) in ((8, 3), (8, 4), (6, 4), (20, 3)):
+    if (d, m) in ((8, 3), (8, 4), (6, 4)):
         return d, m
     return (4, 0) if d == 4 else (0, 0)
 
@@ -245,8 +245,8 @@ def _block_units_kernel(D: int, M: int):
         for u in range(lo, hi):
             most = max(most, uhi[u] - ulo[u])
         tb = np.zeros(min(KBLOCK, most) * d ** (mm - 1) + LANES)   # a short path's block: its segments
-        w = np.empty(d * 4 * LANES)                             # the rows' ends (_top_sweep)
-        dl = np.empty(KBLOCK * d)
+        w = np.zeros((d + 3) * 4 * LANES)                       # the rows' ends (_top_sweep)
+        dl = np.zeros(KBLOCK * d + 3)
         delta = np.empty(d)
         fac = np.empty(mm + 1)
         for k in range(1, mm + 1):

@@ -25,9 +25,12 @@ d = 3, 5.
 *One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step`, whose loops
 run over the first letters of a level (contiguous, packed ``LANES`` first letters at a time or
 vectorised by LLVM; for d = 6..15 :func:`_wide_step`, the same operations with less loop
-control): the same bits as the lanes. The engine uses it for every d >= 6 (``LANES``
-signatures of a wide path no longer fit in the L1/L2 caches, and one unit's rows are long enough
-to fill the vector registers) and for a lane group that would hold at most two units.
+control): the same bits as the lanes. The engine's one-unit kernel is the blocked one
+(:mod:`roughpaths.signatures._blocked`, the same bits again), used for every d >= 8, for d = 6, 7
+beyond depth 3 and for d = 4, 5 where ``LANES`` signatures take more than 64 KiB (they no longer
+fit in the L1 cache, and one unit's rows are long enough to fill the vector registers), and for a
+lane group that would hold at most two units. d = 6, 7 at depth 3 run on lanes with a run-time
+``d`` (:func:`lane_key` ``(0, 0)``).
 
 Measured (one thread, CPU time per unit and segment, this 2-core machine): d = 3 at depths
 3/4/5 about 10/23/58 ns, d = 5 at depths 3/4/5 about 25/140/660 ns, 4-9x less than the same
