@@ -32,11 +32,12 @@ d = 6, 7, 10, 14 at depth 3 took 127, 148, 198, 437 ns a segment, now 68, 95, 14
 
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
-0.125 at 2 GHz); per segment d = 8 depth 3 about 70 ns, depth 4 about 450-600, d = 6 depth 4
-220, d = 20 depth 3 780 (run-time ``d``). d = 8 at depths 3 and 4 and d = 6 at depth 4 are
-compiled with constant ``d`` and ``m`` (loops unrolled: at d = 8, depth 3 the lower levels take
-40 ns a segment against 57 with a run-time ``d``), d = 4 with a constant ``d``. Compile cost (cold,
-empty cache, one variant, CPU): about 4 s for the run-time variant, 3.6 s for (8, 3).
+0.125 at 2 GHz; tiles of 2 packed rows x 4 rows: 0.04-0.06); per segment (16 x 256 points, one
+thread, interleaved with pysiglib 4.0 ``n_jobs=1``) d = 8 depth 3 58 ns (pysiglib 130), depth 4
+500 (590-890), d = 6 depth 4 230 (300), d = 20 depth 3 780 (2000). d = 8 at depth 3 is compiled
+with constant ``d`` and ``m`` (loops unrolled: 58 ns a segment against 85 with a run-time ``d``),
+d = 4 with a constant ``d``; every other width runs the run-time variant. Compile cost (cold, empty
+cache, one variant, CPU): about 4 s for the run-time variant, 3.6 s for (8, 3).
 """
 
 from __future__ import annotations
@@ -126,10 +127,13 @@ def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
 def _top_sweep(s, ok, n, d, tb, dl, nk, w):
     """``S_m[p + n q] += sum_k tb[k n + p] dl[k d + q]``, the products added one segment after another.
 
-    The first ``n - n mod 4 LANES`` entries of every row go in tiles of 4 packed rows; the rest of each
-    row (fewer than ``4 LANES``) is copied into the zero-padded rows of the scratch ``w``
-    (``(d + 3) x 4 LANES``) and swept there by whole packed rows, four rows ``q`` at a time so that
-    four independent sums advance together (summed one entry at a time, each entry's ``K`` additions
+    The first ``n - n mod 2 LANES`` entries of every row go in tiles of 2 packed rows x 4 rows ``q``:
+    eight independent sums advance together, and each packed row of ``tb`` loaded serves four
+    products (measured alone at d = 8, depth 4: 0.06 ns an entry and segment, against 0.14 for tiles
+    of 4 packed rows x 1 row ``q``, whose four sums wait on the adds' latency); the last ``d mod 4``
+    rows go in tiles of 4 (or 2) packed rows. The rest of each row (fewer than ``2 LANES``) is copied
+    into the zero-padded rows of the scratch ``w`` (``(d + 3) x 2 LANES``) and swept there by whole
+    packed rows, four rows ``q`` at a time (summed one entry at a time, each entry's ``K`` additions
     form a chain of dependent adds: ~10x slower a product). ``tb`` needs ``LANES`` readable entries
     past its last segment and ``dl`` 3 past its last (the padded lanes and rows read them and are never
     copied back). Every entry gets the same operations in the same order on either path.
@@ -138,10 +142,49 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
     un = np.uint64(n)
     ud = np.uint64(d)
     unk = np.uint64(nk)
-    n4 = un - un % (4 * L)
-    for p in range(np.uint64(0), n4, 4 * L):             # a tile of K x 4 LANES products stays in L1
-        for q in range(ud):
+    n2 = un - un % (2 * L)
+    q4 = ud - ud % np.uint64(4)
+    for p in range(np.uint64(0), n2, 2 * L):            # tiles of 2 packed rows x 4 rows q: 8 sums at once
+        for q in range(np.uint64(0), q4, np.uint64(4)):
             r = np.uint64(ok) + q * un + p
+            a0 = vload(s, r)
+            a1 = vload(s, r + L)
+            b0 = vload(s, r + un)
+            b1 = vload(s, r + un + L)
+            c0 = vload(s, r + 2 * un)
+            c1 = vload(s, r + 2 * un + L)
+            e0 = vload(s, r + 3 * un)
+            e1 = vload(s, r + 3 * un + L)
+            for k in range(unk):
+                t = k * un + p
+                t0 = vload(tb, t)
+                t1 = vload(tb, t + L)
+                e = k * ud + q
+                c = vsplat(dl[e])
+                a0 = vadd(a0, vmul(t0, c))
+                a1 = vadd(a1, vmul(t1, c))
+                c = vsplat(dl[e + 1])
+                b0 = vadd(b0, vmul(t0, c))
+                b1 = vadd(b1, vmul(t1, c))
+                c = vsplat(dl[e + 2])
+                c0 = vadd(c0, vmul(t0, c))
+                c1 = vadd(c1, vmul(t1, c))
+                c = vsplat(dl[e + 3])
+                e0 = vadd(e0, vmul(t0, c))
+                e1 = vadd(e1, vmul(t1, c))
+            vstore(s, r, a0)
+            vstore(s, r + L, a1)
+            vstore(s, r + un, b0)
+            vstore(s, r + un + L, b1)
+            vstore(s, r + 2 * un, c0)
+            vstore(s, r + 2 * un + L, c1)
+            vstore(s, r + 3 * un, e0)
+            vstore(s, r + 3 * un + L, e1)
+    n4 = n2 - n2 % (4 * L)
+    for q in range(q4, ud):                             # the last d mod 4 rows: 4 packed rows at once
+        row = np.uint64(ok) + q * un
+        for p in range(np.uint64(0), n4, 4 * L):
+            r = row + p
             a0 = vload(s, r)
             a1 = vload(s, r + L)
             a2 = vload(s, r + 2 * L)
@@ -157,15 +200,26 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             vstore(s, r + L, a1)
             vstore(s, r + 2 * L, a2)
             vstore(s, r + 3 * L, a3)
-    rest = un - n4
+        for p in range(n4, n2, 2 * L):                  # at most one tile of 2
+            r = row + p
+            a0 = vload(s, r)
+            a1 = vload(s, r + L)
+            for k in range(unk):
+                c = vsplat(dl[k * ud + q])
+                t = k * un + p
+                a0 = vadd(a0, vmul(vload(tb, t), c))
+                a1 = vadd(a1, vmul(vload(tb, t + L), c))
+            vstore(s, r, a0)
+            vstore(s, r + L, a1)
+    rest = un - n2
     wn = (rest + L - np.uint64(1)) // L * L                  # scratch row: whole packed rows (0 if none)
     nq = (ud + np.uint64(3)) // np.uint64(4) * np.uint64(4)  # rows d .. nq - 1 of w are slack
     for q in range(nq if rest else np.uint64(0)):
-        row = np.uint64(ok) + q * un + n4
+        row = np.uint64(ok) + q * un + n2
         for p in range(wn):
             w[q * wn + p] = s[row + p] if q < ud and p < rest else 0.0
     for c in range(np.uint64(0), wn, L):
-        p = n4 + c
+        p = n2 + c
         for q in range(np.uint64(0), ud, np.uint64(4)):
             r = q * wn + c
             a0 = vload(w, r)
@@ -184,7 +238,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             vstore(w, r + 2 * wn, a2)
             vstore(w, r + 3 * wn, a3)
     for q in range(ud if rest else np.uint64(0)):
-        row = np.uint64(ok) + q * un + n4
+        row = np.uint64(ok) + q * un + n2
         for p in range(rest):
             s[row + p] = w[q * wn + p]
 
@@ -221,10 +275,12 @@ def block_key(d: int, m: int) -> tuple:
     """``(D, M)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time).
 
     Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
-    (d, m) = (8, 3), (8, 4), (6, 4), and d = 4 at any depth. Each variant is its own kernel,
-    compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
+    (d, m) = (8, 3) (the lower levels 40 against 57 ns a segment), and d = 4 at any depth. Every other
+    width runs the run-time variant: (8, 4), (6, 4) and (20, 3) had variants of their own until the
+    run-time one came within 10 % of them. Each variant is its own kernel, compiled on first use (a
+    few seconds of CPU, then cached), so a call compiles only the one it runs.
     """
-    if (d, m) in ((8, 3), (8, 4), (6, 4)):
+    if (d, m) == (8, 3):
         return d, m
     return (4, 0) if d == 4 else (0, 0)
 
