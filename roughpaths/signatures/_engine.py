@@ -32,10 +32,10 @@ _MAX_CHUNKS_L2 = 16
 
 
 #: Below 2 _MIN_CHUNK segments, a path with d <= 4 at depth <= 4 is cut into up to LANES chunks of at
-#: least this many segments (when that makes more than _FEW chunks), so that a lone path (or a few) fills a lane group instead of leaving
-#: lanes empty (a lone 1000 x 3 path at depth 4: 0.13 ms instead of 0.31). The price, the glue and
-#: the copy-out of 8x more units, is about 10% on large batches of such paths (measured on
-#: 200 x 1000 x 3); at d = 5 or depth 5 it grows, and those paths stay whole.
+#: least this many segments (when that makes more than _FEW chunks), so that a lone path (or a few)
+#: fills a lane group instead of leaving lanes empty (a lone 1000 x 3 path at depth 4: 0.13 ms instead
+#: of 0.31). The price, the glue and the copy-out of 8x more units, is about 10% on large batches of
+#: such paths (measured on 200 x 1000 x 3); at d = 5 or depth 5 it grows, and those paths stay whole.
 _LANE_CHUNK = 100
 
 
