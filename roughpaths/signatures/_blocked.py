@@ -293,14 +293,27 @@ def _block_units_kernel(D: int, M: int):
     def block_units_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
         d = D if D else x.shape[2]
         mm = M if M else m
-        hs = (d ** max(mm - 2, 1) + 2 * LANES - 1) // LANES * LANES   # a chain's region, with slack
-        buf = np.zeros((2 * mm + 2) * hs)                       # the chains C^l_j (_fused_d)
-        ls = (offsets[mm] + 2 * LANES - 1) // LANES * LANES     # the lower levels, with slack
-        lw = np.zeros(2 * ls)
+        # Scratch from np.empty (np.zeros of a large array costs a memset of it on every call, measured
+        # +40 % on a lone 10 x 4 path at depth 8); only the windows that packed rows read past valid
+        # entries before anything is written there are zeroed (no garbage, e.g. subnormals, in the lanes).
+        L = LANES
+        hs = (d ** max(mm - 2, 1) + 2 * L - 1) // L * L         # a chain's region, with slack
+        buf = np.empty((2 * mm + 2) * hs)                       # the chains C^l_j (_fused_d)
+        for r in range(2 * mm + 2):
+            for j in range(mm - 1):
+                buf[r * hs + d ** j:r * hs + d ** j + L] = 0.0
+        ls = (offsets[mm] + 2 * L - 1) // L * L                 # the lower levels, with slack
+        lw = np.empty(2 * ls)
+        lw[offsets[mm]:ls] = 0.0
+        lw[ls + offsets[mm]:] = 0.0
         most = 1
         for u in range(lo, hi):
             most = max(most, uhi[u] - ulo[u])
-        tb = np.zeros(min(KBLOCK, most) * d ** (mm - 1) + LANES)   # a short path's block: its segments
+        rows = min(KBLOCK, most)
+        n1 = d ** (mm - 1)
+        tb = np.empty(rows * n1 + L)                            # a short path's block: its segments
+        for r in range(1, rows + 1):
+            tb[r * n1:r * n1 + L] = 0.0
         w = np.zeros((d + 3) * 4 * LANES)                       # the rows' ends (_top_sweep)
         dl = np.zeros(KBLOCK * d + 3)
         delta = np.empty(d)
