@@ -34,10 +34,12 @@ Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
 0.125 at 2 GHz; tiles of 2 packed rows x 4 rows: 0.04-0.06); per segment (16 x 256 points, one
 thread, interleaved with pysiglib 4.0 ``n_jobs=1``) d = 8 depth 3 58 ns (pysiglib 130), depth 4
-500 (590-890), d = 6 depth 4 230 (300), d = 20 depth 3 780 (2000). d = 8 at depth 3 is compiled
-with constant ``d`` and ``m`` (loops unrolled: 58 ns a segment against 85 with a run-time ``d``),
-d = 4 with a constant ``d``; every other width runs the run-time variant. Compile cost (cold, empty
-cache, one variant, CPU): about 4 s for the run-time variant, 3.6 s for (8, 3).
+450-500 (590-890), d = 6 depth 4 200-230 (300), d = 20 depth 3 780 (2000). d = 8 at depths 3 and
+4 and d = 6 at depth 4 are compiled with constant ``d`` and ``m`` (loops unrolled: at d = 8, depth 3
+58 ns a segment against 85 with a run-time ``d``), d = 4 with a constant ``d``; every other width runs
+the run-time variant. Compile
+cost (cold, empty cache, one variant, CPU, with the import): 4.6 s for the run-time variant (2.8 s
+before the packed row ends and the 2 x 4 tiles), 4.0 s for (8, 3) (2.5 s).
 """
 
 from __future__ import annotations
@@ -275,12 +277,13 @@ def block_key(d: int, m: int) -> tuple:
     """``(D, M)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time).
 
     Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
-    (d, m) = (8, 3) (the lower levels 40 against 57 ns a segment), and d = 4 at any depth. Every other
-    width runs the run-time variant: (8, 4), (6, 4) and (20, 3) had variants of their own until the
-    run-time one came within 10 % of them. Each variant is its own kernel, compiled on first use (a
+    (d, m) = (8, 3) (the lower levels 40 against 57 ns a segment), (8, 4) and (6, 4) (cells (d) and (h)
+    of ``benchmarks/bench_signatures.py``: the run-time variant measured 10 % and 15-25 % slower there),
+    and d = 4 at any depth. Every other width runs the run-time variant: (20, 3) had a variant of its
+    own until the run-time one came within 5-8 % of it (cell (e)). Each variant is its own kernel, compiled on first use (a
     few seconds of CPU, then cached), so a call compiles only the one it runs.
     """
-    if (d, m) == (8, 3):
+    if (d, m) in ((8, 3), (8, 4), (6, 4)):
         return d, m
     return (4, 0) if d == 4 else (0, 0)
 

@@ -2,8 +2,8 @@
 
 * ``signature`` equals ``iisignature.sig`` to 1e-12 on paths longer than a block (so the top level, or
   at depth 2 the table of areas (``_level2``, d >= 6, 16 points a sweep),
-  is added in several sweeps, the last one partial), at the compiled width (d = 8 at depth 3) and at
-  run-time ones (d = 6, 7, 20; d = 8 at depth 4; d = 4 at depth 6, a lone path);
+  is added in several sweeps, the last one partial), at the compiled widths (d = 8 at depths 3/4, d = 6
+  at depth 4) and at run-time ones (d = 6 at depth 3, 7, 20; d = 4 at depth 6, a lone path);
 * :func:`_blocked.block_units` gives the bits of the segment-by-segment kernel
   (``_lanes.scalar_units``), whatever the block and the number of segments: the deferred sweep adds
   every product in the order of the segments;
