@@ -32,8 +32,20 @@ signatures); the stream's build and query times for several block sizes against 
 sub-paths; ``windowed_signature`` against a batched direct computation; ``signature_coefficients``
 against the full signature and iisignature.
 
+Width sweep (issue 41, ``--sweep``, alone): every alphabet size d = 2..20 at depths 2..6, batches of
+16 x 256 and 64 x 256 points (a Brownian walk scaled by 1/16), signature and log-signature (and, with
+``--sweep-kinds``, the signature's VJP), ours against pysiglib ``n_jobs=1`` (one thread, CPU time) and
+``n_jobs=-1`` (all threads, wall time), medians of interleaved pairs, printing the ratios and, at the
+end, the cells above 1.0 (one thread) and 1.1 (parallel). Cells whose signature exceeds
+``--sweep-max-sigdim`` floats per path (default 2e6; d = 20 at depth 5, d >= 12 at depth 6) are
+skipped and listed. ``--sweep-d 2,6-9``, ``--sweep-depths 3,4``, ``--sweep-batches 16`` and
+``--sweep-kinds sig,logsig,sig vjp`` select a subset; ``--sweep-modes 1`` runs the one-thread mode only.
+A timed sample of a small cell is a loop of calls lasting about 2 ms (divided back to one call).
+
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
-[--depths 3,4] [--only-streams]`` (the cells, kinds and depths select peer-table cells and skip the rest).
+[--depths 3,4] [--only-streams] [--sweep [--sweep-d 2-20] [--sweep-depths 2-6] [--sweep-batches 16,64]
+[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6]]`` (the cells, kinds and depths
+select peer-table cells and skip the rest).
 """
 
 from __future__ import annotations
@@ -227,6 +239,104 @@ def peer_table(cases: dict, args, rng) -> None:
     print()
 
 
+def _int_list(text: str) -> list:
+    """``'2,5-7'`` -> ``[2, 5, 6, 7]``."""
+    out = []
+    for part in text.split(","):
+        part = part.strip()
+        if "-" in part:
+            lo, hi = part.split("-")
+            out.extend(range(int(lo), int(hi) + 1))
+        elif part:
+            out.append(int(part))
+    return out
+
+
+def width_sweep(args) -> None:
+    """Issue 41: ours against pysiglib for every d = 2..20 at depths 2..6, one thread and all threads."""
+    import numba
+    import pysiglib
+
+    from roughpaths import logsignature, signature, signature_vjp
+
+    threads = numba.get_num_threads()
+    ds = _int_list(args.sweep_d)
+    depths = _int_list(args.sweep_depths)
+    batches = _int_list(args.sweep_batches)
+    kinds = [k.strip() for k in args.sweep_kinds.split(",") if k.strip()]
+    modes = {m.strip() for m in args.sweep_modes.split(",")}
+    rng = np.random.default_rng(41)
+
+    def looped(fns):
+        """Each function called often enough that one timed sample takes about 2 ms (small cells are noisy)."""
+        t0 = time.perf_counter()
+        fns[0]()
+        reps = max(1, min(50, int(2e-3 / max(time.perf_counter() - t0, 1e-6))))
+        return [(lambda f=f: [f() for _ in range(reps)]) for f in fns], reps
+
+    def timed(fns, clock):
+        many, reps = looped(fns)
+        return [t / reps for t in paired(many, args.repeats, clock)]
+
+    print(f"width sweep: numba threads {threads}, load average {os.getloadavg()[0]:.1f}, median of "
+          f"{args.repeats} interleaved pairs; ms; ratio = ours / pysiglib (1t: set_num_threads(1) against "
+          f"n_jobs=1, CPU time; {threads}t: default threads against n_jobs=-1, wall time)")
+    print(f"{'batch':>8}{'d':>4}{'lvl':>4}  {'what':<9}{'ours 1t':>10}{'peer 1t':>10}{'ratio 1t':>9}"
+          f"{'ours ' + str(threads) + 't':>10}{'peer -1':>10}{'ratio':>7}")
+    skipped, over1, over_n, worst = [], [], [], []
+    for nb in batches:
+        for d in ds:
+            x = np.cumsum(rng.standard_normal((nb, 256, d)), axis=-2) / 16
+            for m in depths:
+                dim = sum(d ** k for k in range(1, m + 1))
+                if dim > args.sweep_max_sigdim:
+                    skipped.append(f"{nb}x256 d={d} depth {m} (sigdim {dim:.3g})")
+                    continue
+                g = rng.standard_normal((nb, dim))
+                g1 = np.concatenate([np.zeros((nb, 1)), g], axis=-1)
+                if "logsig" in kinds and m > 1:
+                    pysiglib.prepare_log_sig(d, m, method=2)
+                cells = {
+                    "sig": (lambda: signature(x, m), lambda j: pysiglib.sig(x, m, n_jobs=j)),
+                    "logsig": (lambda: logsignature(x, m), lambda j: pysiglib.log_sig(x, m, method=2, n_jobs=j)),
+                    "sig vjp": (lambda: signature_vjp(x, m, g),
+                                lambda j: pysiglib.sig_backprop(x, pysiglib.sig(x, m, scalar_term=True, n_jobs=j),
+                                                                g1, m, n_jobs=j)),
+                }
+                for kind in kinds:
+                    ours, peer = cells[kind]
+                    row = f"{str(nb) + 'x256':>8}{d:>4}{m:>4}  {kind:<9}"
+                    if "1" in modes:
+                        numba.set_num_threads(1)
+                        try:
+                            t_o1, t_p1 = timed((ours, lambda: peer(1)), time.process_time)
+                        finally:
+                            numba.set_num_threads(threads)
+                        r1 = t_o1 / t_p1
+                        row += f"{1e3 * t_o1:>10.3f}{1e3 * t_p1:>10.3f}{r1:>9.2f}"
+                        worst.append((r1, f"{nb}x256 d={d} depth {m}", kind))
+                        if r1 > 1.0:
+                            over1.append(f"{nb}x256 d={d} depth {m} {kind}: {r1:.2f}")
+                    else:
+                        row += f"{'':>28}"
+                    if "n" in modes:
+                        t_on, t_pn = timed((ours, lambda: peer(-1)), time.perf_counter)
+                        rn = t_on / t_pn
+                        row += f"{1e3 * t_on:>10.3f}{1e3 * t_pn:>10.3f}{rn:>7.2f}"
+                        if rn > 1.1:
+                            over_n.append(f"{nb}x256 d={d} depth {m} {kind}: {rn:.2f}")
+                    print(row, flush=True)
+    print(f"\nload average at the end: {' '.join(f'{v:.1f}' for v in os.getloadavg())} (1, 5, 15 min)")
+    if skipped:
+        print(f"skipped (sigdim > {args.sweep_max_sigdim:.3g} floats per path): {'; '.join(skipped)}")
+    print(f"cells above 1.0 on one thread ({len(over1)}): {'; '.join(over1) if over1 else 'none'}")
+    print(f"cells above 1.1 in parallel mode ({len(over_n)}): {'; '.join(over_n) if over_n else 'none'}")
+    if worst:
+        r, where, kind = max(worst)
+        print(f"worst one-thread ratio: {r:.2f} ({where} {kind})")
+    print()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
@@ -237,7 +347,18 @@ def main() -> None:
     parser.add_argument("--kinds", default="", help="peer-table kinds to run (e.g. 'sig,log vjp')")
     parser.add_argument("--depths", default="", help="peer-table depths to run (e.g. '3,4')")
     parser.add_argument("--only-streams", action="store_true", help="print the streams-and-words section only")
+    parser.add_argument("--sweep", action="store_true", help="run the width sweep only (d = 2..20, depths 2..6)")
+    parser.add_argument("--sweep-d", default="2-20", help="sweep alphabet sizes (e.g. '2,6-9')")
+    parser.add_argument("--sweep-depths", default="2-6", help="sweep depths (e.g. '3,4')")
+    parser.add_argument("--sweep-batches", default="16,64", help="sweep batch sizes of 256-point paths")
+    parser.add_argument("--sweep-kinds", default="sig,logsig", help="sweep kinds: sig, logsig, sig vjp")
+    parser.add_argument("--sweep-modes", default="1,n", help="sweep modes: 1 (one thread), n (all threads)")
+    parser.add_argument("--sweep-max-sigdim", type=float, default=2e6,
+                        help="skip sweep cells with more signature floats per path")
     args = parser.parse_args()
+    if args.sweep:
+        width_sweep(args)
+        return
     if args.only_streams:
         streams_section(args)
         return

@@ -1,7 +1,7 @@
 """One-unit signature kernel with the top level deferred over blocks of segments (private).
 
-Called by :mod:`roughpaths.signatures._engine` for the units that run alone (every ``d >= 6``, and
-lane groups with few units). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
+Called by :mod:`roughpaths.signatures._engine` for the units that run alone (every ``d >= 8``, d = 6, 7
+beyond depth 3, and lane groups with few units). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
 (reversed word order, the Horner–Chen update with every product rounded, then every sum).
 
 The top level of the Horner update of segment ``k`` is a rank-one update,
@@ -21,12 +21,25 @@ operations per loaded value instead of one load and one store per product, so it
 machine's multiply/add rate instead of its load/store rate, and a top level larger than the L1 (or
 the L2) cache is streamed once a block instead of once a segment.
 
+*Any width.* No loop ends one entry at a time, so a run-time ``d`` that is not a multiple of
+``LANES`` costs no scalar tails: the lower levels advance in a private double buffer (read the old
+copy, write the new one: never in place), every row of them is whole packed rows whose last one may
+spill past the row (into the next row, written next, or into slack) (:func:`_row`), and the ends of
+the top level's rows are swept in a zero-padded scratch, four rows at a time (:func:`_top_sweep`).
+Before, those ends were scalar loops, and the top level's a chain of dependent adds per entry:
+d = 6, 7, 10, 14 at depth 3 took 127, 148, 198, 437 ns a segment, now 68, 95, 148, 298 (one thread,
+16 x 256 points; pysiglib 4.0 ``n_jobs=1`` 61, 89, 161, 399).
+
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
-0.125 at 2 GHz); per segment d = 8 depth 3 about 120 ns (the one-segment kernel: 290), depth 4
-about 1300 (1900), d = 6 depth 4 400 (760), d = 20 depth 3 1400 (2800). d = 8 at depths 3 and
-4, d = 6 at depth 4 and d = 20 at depth 3 are compiled with constant ``d`` and ``m`` (loops
-unrolled: the lower levels 30% faster), d = 4 with a constant ``d``.
+0.125 at 2 GHz; tiles of 2 packed rows x 4 rows: 0.04-0.06); per segment (16 x 256 points, one
+thread, interleaved with pysiglib 4.0 ``n_jobs=1``) d = 8 depth 3 58 ns (pysiglib 130), depth 4
+450-500 (590-890), d = 6 depth 4 200-230 (300), d = 20 depth 3 780 (2000). d = 8 at depths 3 and
+4 and d = 6 at depth 4 are compiled with constant ``d`` and ``m`` (loops unrolled: at d = 8, depth 3
+58 ns a segment against 85 with a run-time ``d``), d = 4 with a constant ``d``; every other width runs
+the run-time variant. Compile
+cost (cold, empty cache, one variant, CPU, with the import): 4.6 s for the run-time variant (2.8 s
+before the packed row ends and the 2 x 4 tiles), 4.0 s for (8, 3) (2.5 s).
 """
 
 from __future__ import annotations
@@ -46,41 +59,49 @@ KBLOCK = 16
 
 @njit(cache=True, inline="always")
 def _row(y, yo, x, xo, c, z, zo, n):
-    """``y[yo + p] = x[xo + p] * c + z[zo + p]`` for ``p < n`` (packed rows of LANES, then one by one)."""
+    """``y[yo + p] = x[xo + p] * c + z[zo + p]`` for ``p < n``, in whole packed rows of LANES.
+
+    The last packed row runs past ``n`` by up to ``LANES - 1`` entries: it reads what follows ``x`` and
+    ``z`` and writes garbage after ``y[yo + n - 1]``. The callers keep that harmless: ``y`` is never
+    ``z`` nor ``x`` (no update in place), rows are written in increasing order (row ``q + 1``, written
+    next, overwrites what row ``q`` spilled), and every region ends in ``LANES`` entries of slack.
+    """
     L = np.uint64(LANES)
-    n1 = n - n % L
     cv = vsplat(c)
-    for p in range(np.uint64(0), n1, L):
+    for p in range(np.uint64(0), n, L):
         vstore(y, yo + p, vadd(vmul(vload(x, xo + p), cv), vload(z, zo + p)))
-    for p in range(n1, n):
-        y[yo + p] = x[xo + p] * c + z[zo + p]
 
 
 @njit(cache=True, inline="always")
-def _fused_d(s, delta, d, m, offsets, fac, cb, tb, to):
+def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
     """Levels ``1..m-1`` advance one segment, and ``tb[to:to + d^(m-1)] = T^m_{m-1}`` (old levels).
 
+    The lower levels are double-buffered in ``lw``: read at ``so``, the new ones written at ``sn``.
     Every level's Horner chain at once, level ``j`` of ``S`` read once: ``C^l_1 = D/l + S_1`` and
-    ``C^l_j = C^l_{j-1} ⊗ D/(l - j + 1) + S_j`` for the levels ``l > j`` (``cb``: two rows of
-    ``d^(m-2)`` per ``l``), then ``S_j <- S_j + C^j_{j-1} ⊗ D``: the operations of
+    ``C^l_j = C^l_{j-1} ⊗ D/(l - j + 1) + S_j`` for the levels ``l > j`` (``cb``: two regions of
+    ``hs`` entries per ``l``), then ``S_j <- S_j + C^j_{j-1} ⊗ D``: the operations of
     :func:`~roughpaths.signatures._lanes._horner_step` in another order (the same bits;
-    ``fac[k] = 1.0 / k``).
+    ``fac[k] = 1.0 / k``). Every row is whole packed rows (:func:`_row`): no loop ends one entry at a
+    time, whatever ``d``.
     """
     ud = np.uint64(d)
-    half = np.uint64(d ** max(m - 2, 1))
-    # C^l_j lives at cb[(2 l + j % 2) half ...]
+    uh = np.uint64(hs)
+    # C^l_j lives at cb[(2 l + j % 2) hs ...]
     for lev in range(2, m):
         inv = fac[lev]
-        o = np.uint64(2 * lev + 1) * half
+        o = np.uint64(2 * lev + 1) * uh
         for i in range(ud):
-            cb[o + i] = delta[i] * inv + s[i]
+            cb[o + i] = delta[i] * inv + lw[so + i]
     inv = fac[m]
-    o = np.uint64(to) if m == 2 else np.uint64(2 * m + 1) * half
-    dst = tb if m == 2 else cb
+    if m == 2:
+        for i in range(ud):
+            tb[to + i] = delta[i] * inv + lw[so + i]
+    else:
+        o = np.uint64(2 * m + 1) * uh
+        for i in range(ud):
+            cb[o + i] = delta[i] * inv + lw[so + i]
     for i in range(ud):
-        dst[o + i] = delta[i] * inv + s[i]
-    for i in range(ud):
-        s[i] += delta[i]
+        lw[sn + i] = lw[so + i] + delta[i]
     size = ud                                       # d^(j-1)
     for j in range(2, m):
         oj = np.uint64(offsets[j])
@@ -92,30 +113,80 @@ def _fused_d(s, delta, d, m, offsets, fac, cb, tb, to):
             row = oj + base
             for lev in range(j + 1, m if top else m + 1):
                 c = delta[q] * fac[lev - j + 1]
-                src = (np.uint64(2 * lev) + rd) * half
-                dst = (np.uint64(2 * lev) + wr) * half + base
-                _row(cb, dst, cb, src, c, s, row, size)
+                src = (np.uint64(2 * lev) + rd) * uh
+                dst = (np.uint64(2 * lev) + wr) * uh + base
+                _row(cb, dst, cb, src, c, lw, so + row, size)
             if top:
                 c = delta[q] * fac[2]
-                src = (np.uint64(2 * m) + rd) * half
-                _row(tb, np.uint64(to) + base, cb, src, c, s, row, size)
-            src = (np.uint64(2 * j) + rd) * half
-            _row(s, row, cb, src, delta[q], s, row, size)
+                src = (np.uint64(2 * m) + rd) * uh
+                _row(tb, to + base, cb, src, c, lw, so + row, size)
+            src = (np.uint64(2 * j) + rd) * uh
+            _row(lw, sn + row, cb, src, delta[q], lw, so + row, size)
         size *= ud
 
 
 @njit(cache=True, inline="always")
-def _top_sweep(s, ok, n, d, tb, dl, nk):
-    """``S_m[p + n q] += sum_k tb[k n + p] dl[k d + q]``, the products added one segment after another."""
+def _top_sweep(s, ok, n, d, tb, dl, nk, w):
+    """``S_m[p + n q] += sum_k tb[k n + p] dl[k d + q]``, the products added one segment after another.
+
+    The first ``n - n mod 2 LANES`` entries of every row go in tiles of 2 packed rows x 4 rows ``q``:
+    eight independent sums advance together, and each packed row of ``tb`` loaded serves four
+    products (measured alone at d = 8, depth 4: 0.06 ns an entry and segment, against 0.14 for tiles
+    of 4 packed rows x 1 row ``q``, whose four sums wait on the adds' latency); the last ``d mod 4``
+    rows go in tiles of 4 (or 2) packed rows. The rest of each row (fewer than ``2 LANES``) is copied
+    into the zero-padded rows of the scratch ``w`` (``(d + 3) x 2 LANES``) and swept there by whole
+    packed rows, four rows ``q`` at a time (summed one entry at a time, each entry's ``K`` additions
+    form a chain of dependent adds: ~10x slower a product). ``tb`` needs ``LANES`` readable entries
+    past its last segment and ``dl`` 3 past its last (the padded lanes and rows read them and are never
+    copied back). Every entry gets the same operations in the same order on either path.
+    """
     L = np.uint64(LANES)
     un = np.uint64(n)
     ud = np.uint64(d)
     unk = np.uint64(nk)
-    n4 = un - un % (4 * L)
-    n1 = un - un % L
-    for p in range(np.uint64(0), n4, 4 * L):             # a tile of K x 4 LANES products stays in L1
-        for q in range(ud):
+    n2 = un - un % (2 * L)
+    q4 = ud - ud % np.uint64(4)
+    for p in range(np.uint64(0), n2, 2 * L):            # tiles of 2 packed rows x 4 rows q: 8 sums at once
+        for q in range(np.uint64(0), q4, np.uint64(4)):
             r = np.uint64(ok) + q * un + p
+            a0 = vload(s, r)
+            a1 = vload(s, r + L)
+            b0 = vload(s, r + un)
+            b1 = vload(s, r + un + L)
+            c0 = vload(s, r + 2 * un)
+            c1 = vload(s, r + 2 * un + L)
+            e0 = vload(s, r + 3 * un)
+            e1 = vload(s, r + 3 * un + L)
+            for k in range(unk):
+                t = k * un + p
+                t0 = vload(tb, t)
+                t1 = vload(tb, t + L)
+                e = k * ud + q
+                c = vsplat(dl[e])
+                a0 = vadd(a0, vmul(t0, c))
+                a1 = vadd(a1, vmul(t1, c))
+                c = vsplat(dl[e + 1])
+                b0 = vadd(b0, vmul(t0, c))
+                b1 = vadd(b1, vmul(t1, c))
+                c = vsplat(dl[e + 2])
+                c0 = vadd(c0, vmul(t0, c))
+                c1 = vadd(c1, vmul(t1, c))
+                c = vsplat(dl[e + 3])
+                e0 = vadd(e0, vmul(t0, c))
+                e1 = vadd(e1, vmul(t1, c))
+            vstore(s, r, a0)
+            vstore(s, r + L, a1)
+            vstore(s, r + un, b0)
+            vstore(s, r + un + L, b1)
+            vstore(s, r + 2 * un, c0)
+            vstore(s, r + 2 * un + L, c1)
+            vstore(s, r + 3 * un, e0)
+            vstore(s, r + 3 * un + L, e1)
+    n4 = n2 - n2 % (4 * L)
+    for q in range(q4, ud):                             # the last d mod 4 rows: 4 packed rows at once
+        row = np.uint64(ok) + q * un
+        for p in range(np.uint64(0), n4, 4 * L):
+            r = row + p
             a0 = vload(s, r)
             a1 = vload(s, r + L)
             a2 = vload(s, r + 2 * L)
@@ -131,29 +202,62 @@ def _top_sweep(s, ok, n, d, tb, dl, nk):
             vstore(s, r + L, a1)
             vstore(s, r + 2 * L, a2)
             vstore(s, r + 3 * L, a3)
-    for q in range(ud):
-        row = np.uint64(ok) + q * un
-        for p in range(n4, n1, L):
+        for p in range(n4, n2, 2 * L):                  # at most one tile of 2
             r = row + p
             a0 = vload(s, r)
+            a1 = vload(s, r + L)
             for k in range(unk):
-                a0 = vadd(a0, vmul(vload(tb, k * un + p), vsplat(dl[k * ud + q])))
+                c = vsplat(dl[k * ud + q])
+                t = k * un + p
+                a0 = vadd(a0, vmul(vload(tb, t), c))
+                a1 = vadd(a1, vmul(vload(tb, t + L), c))
             vstore(s, r, a0)
-        for p in range(n1, un):
-            a = s[row + p]
+            vstore(s, r + L, a1)
+    rest = un - n2
+    wn = (rest + L - np.uint64(1)) // L * L                  # scratch row: whole packed rows (0 if none)
+    nq = (ud + np.uint64(3)) // np.uint64(4) * np.uint64(4)  # rows d .. nq - 1 of w are slack
+    for q in range(nq if rest else np.uint64(0)):
+        row = np.uint64(ok) + q * un + n2
+        for p in range(wn):
+            w[q * wn + p] = s[row + p] if q < ud and p < rest else 0.0
+    for c in range(np.uint64(0), wn, L):
+        p = n2 + c
+        for q in range(np.uint64(0), ud, np.uint64(4)):
+            r = q * wn + c
+            a0 = vload(w, r)
+            a1 = vload(w, r + wn)
+            a2 = vload(w, r + 2 * wn)
+            a3 = vload(w, r + 3 * wn)
             for k in range(unk):
-                a += tb[k * un + p] * dl[k * ud + q]
-            s[row + p] = a
+                t = vload(tb, k * un + p)
+                e = k * ud + q
+                a0 = vadd(a0, vmul(t, vsplat(dl[e])))
+                a1 = vadd(a1, vmul(t, vsplat(dl[e + 1])))
+                a2 = vadd(a2, vmul(t, vsplat(dl[e + 2])))
+                a3 = vadd(a3, vmul(t, vsplat(dl[e + 3])))
+            vstore(w, r, a0)
+            vstore(w, r + wn, a1)
+            vstore(w, r + 2 * wn, a2)
+            vstore(w, r + 3 * wn, a3)
+    for q in range(ud if rest else np.uint64(0)):
+        row = np.uint64(ok) + q * un + n2
+        for p in range(rest):
+            s[row + p] = w[q * wn + p]
 
 
 @njit(cache=True, inline="always")
-def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, tb, dl, delta):
-    """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 2``)."""
+def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls):
+    """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 2``); the
+    lower levels run in ``lw`` (two copies ``ls`` apart) and are copied into ``s`` at the end."""
     ud = np.uint64(d)
     n = np.uint64(d ** (m - 1))
     ok = offsets[m]
-    for r in range(s.shape[0]):
+    for r in range(ok, s.shape[0]):
         s[r] = 0.0
+    for r in range(ok):
+        lw[r] = 0.0
+    so = np.uint64(0)
+    sn = np.uint64(ls)
     for t0 in range(k0, k1, KBLOCK):
         nk = min(KBLOCK, k1 - t0)
         for k in range(nk):
@@ -162,18 +266,24 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, tb, dl, delta):
                 v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
                 dl[kk * ud + i] = v
                 delta[i] = v
-            _fused_d(s, delta, d, m, offsets, fac, buf, tb, kk * n)
-        _top_sweep(s, ok, n, d, tb, dl, nk)
+            _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
+            so, sn = sn, so
+        _top_sweep(s, ok, n, d, tb, dl, nk, w)
+    for r in range(ok):
+        s[r] = lw[so + r]
 
 
 def block_key(d: int, m: int) -> tuple:
     """``(D, M)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time).
 
     Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
-    (d, m) = (8, 3), (8, 4), (6, 4), (20, 3), and d = 4 at any depth. Each variant is its own kernel,
-    compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
+    (d, m) = (8, 3) (the lower levels 40 against 57 ns a segment), (8, 4) and (6, 4) (cells (d) and (h)
+    of ``benchmarks/bench_signatures.py``: the run-time variant measured 10 % and 15-25 % slower there),
+    and d = 4 at any depth. Every other width runs the run-time variant: (20, 3) had a variant of its
+    own until the run-time one came within 5-8 % of it (cell (e)). Each variant is its own kernel, compiled on first use (a
+    few seconds of CPU, then cached), so a call compiles only the one it runs.
     """
-    if (d, m) in ((8, 3), (8, 4), (6, 4), (20, 3)):
+    if (d, m) in ((8, 3), (8, 4), (6, 4)):
         return d, m
     return (4, 0) if d == 4 else (0, 0)
 
@@ -186,18 +296,35 @@ def _block_units_kernel(D: int, M: int):
     def block_units_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
         d = D if D else x.shape[2]
         mm = M if M else m
-        buf = np.empty((2 * mm + 2) * d ** max(mm - 2, 1))      # the chains C^l_j (_fused_d)
+        # Scratch from np.empty (np.zeros of a large array costs a memset of it on every call, measured
+        # +40 % on a lone 10 x 4 path at depth 8); only the windows that packed rows read past valid
+        # entries before anything is written there are zeroed (no garbage, e.g. subnormals, in the lanes).
+        L = LANES
+        hs = (d ** max(mm - 2, 1) + 2 * L - 1) // L * L         # a chain's region, with slack
+        buf = np.empty((2 * mm + 2) * hs)                       # the chains C^l_j (_fused_d)
+        for r in range(2 * mm + 2):
+            for j in range(mm - 1):
+                buf[r * hs + d ** j:r * hs + d ** j + L] = 0.0
+        ls = (offsets[mm] + 2 * L - 1) // L * L                 # the lower levels, with slack
+        lw = np.empty(2 * ls)
+        lw[offsets[mm]:ls] = 0.0
+        lw[ls + offsets[mm]:] = 0.0
         most = 1
         for u in range(lo, hi):
             most = max(most, uhi[u] - ulo[u])
-        tb = np.empty(min(KBLOCK, most) * d ** (mm - 1))        # a short path's block: its segments
-        dl = np.empty(KBLOCK * d)
+        rows = min(KBLOCK, most)
+        n1 = d ** (mm - 1)
+        tb = np.empty(rows * n1 + L)                            # a short path's block: its segments
+        for r in range(1, rows + 1):
+            tb[r * n1:r * n1 + L] = 0.0
+        w = np.zeros((d + 3) * 4 * LANES)                       # the rows' ends (_top_sweep)
+        dl = np.zeros(KBLOCK * d + 3)
         delta = np.empty(d)
         fac = np.empty(mm + 1)
         for k in range(1, mm + 1):
             fac[k] = 1.0 / k
         for u in range(lo, hi):
-            _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, tb, dl, delta)
+            _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls)
 
     return block_units_variant
 

@@ -32,10 +32,10 @@ _MAX_CHUNKS_L2 = 16
 
 
 #: Below 2 _MIN_CHUNK segments, a path with d <= 4 at depth <= 4 is cut into up to LANES chunks of at
-#: least this many segments, so that a lone path (or a few) fills a lane group instead of leaving
-#: lanes empty (a lone 1000 x 3 path at depth 4: 0.13 ms instead of 0.31). The price, the glue and
-#: the copy-out of 8x more units, is about 10% on large batches of such paths (measured on
-#: 200 x 1000 x 3); at d = 5 or depth 5 it grows, and those paths stay whole.
+#: least this many segments (when that makes more than _FEW chunks), so that a lone path (or a few)
+#: fills a lane group instead of leaving lanes empty (a lone 1000 x 3 path at depth 4: 0.13 ms instead
+#: of 0.31). The price, the glue and the copy-out of 8x more units, is about 10% on large batches of
+#: such paths (measured on 200 x 1000 x 3); at d = 5 or depth 5 it grows, and those paths stay whole.
 _LANE_CHUNK = 100
 
 
@@ -43,7 +43,9 @@ def _horner_chunks(n: int, d: int, depth: int) -> int:
     """Work units per path for the depth >= 3 kernels: a function of ``n``, ``d`` and ``depth`` only."""
     if n - 1 >= 2 * _MIN_CHUNK or d > 4 or depth > 4:
         return _n_chunks(n, _MAX_CHUNKS, _MIN_CHUNK)
-    return max(1, min(_lanes.LANES, (n - 1) // _LANE_CHUNK))
+    c = (n - 1) // _LANE_CHUNK
+    # at most _FEW chunks would not fill a lane group (they run alone): the path stays whole
+    return min(_lanes.LANES, c) if c > _FEW else 1
 
 
 def _n_chunks(n: int, target: int, min_chunk: int) -> int:
@@ -143,9 +145,11 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 #: From this width on every unit runs alone (:func:`_blocked.block_units`, the same bits as the lanes):
-#: ``LANES`` signatures of d >= 6 at depth >= 4 no longer fit in the L2 cache, and the one-unit loops
-#: over the first letters are long enough to vectorise on their own.
-_WIDE = 6
+#: the one-unit rows over the first letters fill whole packed rows (d = 8: one) and its blocked top level
+#: beats the lanes' per-segment one. Below it, d = 6, 7 run on lanes (the run-time ``d`` variant) where the
+#: ``LANES`` signatures take at most :data:`_LANE_BYTES` (depth 3): measured at 16 x 256 points, depth 3,
+#: one thread, 48 / 73 ns a segment against 68 / 95 alone (pysiglib: 61 / 89).
+_WIDE = 8
 #: A lane group with at most this many units runs them one at a time instead (the empty lanes of a
 #: group cost as much as full ones; one unit alone costs about a quarter of a group, measured at d = 3).
 _FEW = 2
@@ -208,6 +212,10 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
+#: Outputs of at most this many floats are permuted by numpy's gather (no kernel call, no threads).
+_SMALL_PERMUTE = 2 ** 14
+
+
 def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     """Signatures of a validated ``(B, n, d)`` C-contiguous batch, shape ``(B, sigdim)``."""
     nb, n, d = x.shape
@@ -228,6 +236,8 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if flipped:
         return out
     perm = _reversed_to_rowmajor(d, depth)
+    if out.size <= _SMALL_PERMUTE:
+        return out[:, perm]
     res = np.empty_like(out)
     _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
                  _threads.ranges(nb, 4 * perm.shape[0]))

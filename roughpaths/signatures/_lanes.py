@@ -20,14 +20,17 @@ does not depend on its lane, its neighbours, the grouping or the thread. A unit'
 copied out at its own last segment; lanes with no segment left get zero increments. The increments
 of a group are gathered and transposed into a ``(BLOCK, d, LANES)`` block first, and the kernel is
 specialised (loops over the letters unrolled) for d = 2..5, and also on the depth for depth 3 with
-d = 3, 5.
+d = 2, 3, 5.
 
 *One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step`, whose loops
 run over the first letters of a level (contiguous, packed ``LANES`` first letters at a time or
 vectorised by LLVM; for d = 6..15 :func:`_wide_step`, the same operations with less loop
-control): the same bits as the lanes. The engine uses it for every d >= 6 (``LANES``
-signatures of a wide path no longer fit in the L1/L2 caches, and one unit's rows are long enough
-to fill the vector registers) and for a lane group that would hold at most two units.
+control): the same bits as the lanes. The engine's one-unit kernel is the blocked one
+(:mod:`roughpaths.signatures._blocked`, the same bits again), used for every d >= 8, for d = 6, 7
+beyond depth 3 and for d = 4, 5 where ``LANES`` signatures take more than 64 KiB (they no longer
+fit in the L1 cache, and one unit's rows are long enough to fill the vector registers), and for a
+lane group that would hold at most two units. d = 6, 7 at depth 3 run on lanes with a run-time
+``d`` (:func:`lane_key` ``(0, 0)``).
 
 Measured (one thread, CPU time per unit and segment, this 2-core machine): d = 3 at depths
 3/4/5 about 10/23/58 ns, d = 5 at depths 3/4/5 about 25/140/660 ns, 4-9x less than the same
@@ -326,13 +329,14 @@ def _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk):
 def lane_key(d: int, m: int) -> tuple:
     """``(D, M)``: the compile-time alphabet size and depth of the lane kernel's variant (0: at run time).
 
-    A compile-time ``d`` lets LLVM unroll the loops over the letters (d = 2..5); depth 3 with d = 3 or 5
-    also gets a compile-time ``m``, which unrolls the loops over the levels (about 10 % faster). Each
+    A compile-time ``d`` lets LLVM unroll the loops over the letters (d = 2..5); depth 3 with d = 2, 3 or 5
+    also gets a compile-time ``m``, which unrolls the loops over the levels (about 10 % faster at d = 3;
+    at d = 2, 16 x 256 points, 15 us against 44, where pysiglib ``n_jobs=1`` takes 60). Each
     variant is its own kernel, compiled on its first use and then cached on disk, so a call compiles only
     the variant it runs (a first d = 3 signature at depths 2-4 compiles two lane variants and the level-2
     kernels: 9.0 s of CPU in all, import included, in ``benchmarks/bench_first_call.py``).
     """
-    return (d if 2 <= d <= 5 else 0, 3 if m == 3 and d in (3, 5) else 0)
+    return (d if 2 <= d <= 5 else 0, 3 if m == 3 and d in (2, 3, 5) else 0)
 
 
 @variants

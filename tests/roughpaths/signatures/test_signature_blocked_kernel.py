@@ -2,11 +2,13 @@
 
 * ``signature`` equals ``iisignature.sig`` to 1e-12 on paths longer than a block (so the top level, or
   at depth 2 the table of areas (``_level2``, d >= 6, 16 points a sweep),
-  is added in several sweeps, the last one partial), at the compiled widths (d = 6, 8, 20 at depths
-  3/4) and at run-time ones (d = 7; d = 4 at depth 6, a lone path);
+  is added in several sweeps, the last one partial), at the compiled widths (d = 8 at depths 3/4, d = 6
+  at depth 4) and at run-time ones (d = 6 at depth 3, 7, 20; d = 4 at depth 6, a lone path);
 * :func:`_blocked.block_units` gives the bits of the segment-by-segment kernel
   (``_lanes.scalar_units``), whatever the block and the number of segments: the deferred sweep adds
   every product in the order of the segments;
+* a path gets the same bits in a lane group of the run-time-``d`` lane kernel (d = 6, 7 at depth 3) as
+  alone in the blocked kernel, whose rows at such widths end in partial packed rows;
 * the tiled layout permutation equals numpy's gather (``src[:, perm]``) on a level large enough to
   be tiled.
 
@@ -32,7 +34,7 @@ def test_blocked_signature_matches_iisignature(rng, d, m):
     np.testing.assert_allclose(signature(x, m), iisignature.sig(x, m), rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("d,m", [(6, 4), (8, 3), (20, 3), (5, 3), (3, 5)])
+@pytest.mark.parametrize("d,m", [(6, 4), (8, 3), (20, 3), (5, 3), (3, 5), (10, 3), (9, 4), (13, 2)])
 def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     n = 2 * _blocked.KBLOCK + 5
     x = np.cumsum(rng.standard_normal((3, n, d)), axis=-2)
@@ -43,6 +45,15 @@ def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     _lanes.scalar_units(x, *units, m, off, 0, 6, a)
     _blocked.block_units(x.shape[2], m)(x, *units, m, off, 0, 6, b)
     assert a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("d,m", [(7, 3), (6, 3)])
+def test_lanes_and_lone_units_give_the_same_bits_at_run_time_widths(rng, d, m):
+    # 10 paths: one lane group of 8 (the run-time-d lane kernel) and 2 paths alone (the blocked kernel)
+    x = np.cumsum(rng.standard_normal((10, 2 * _blocked.KBLOCK + 9, d)) * 0.1, axis=-2)
+    whole = signature(x, m)
+    for b in (0, 7, 8, 9):
+        assert signature(x[b:b + 1], m)[0].tobytes() == whole[b].tobytes()
 
 
 @pytest.mark.parametrize("d,m", [(4, 8), (5, 7)])   # 8 x 8 tiles only; tiles and edges (125 x 625)
