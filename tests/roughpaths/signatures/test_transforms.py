@@ -6,16 +6,22 @@ from __future__ import annotations
 
 import math
 
+import zlib
+
 import numpy as np
 import pytest
 
 import roughpaths as rp
 
-RNG = np.random.default_rng(20261127)
+
+@pytest.fixture
+def rng(request):
+    """A generator seeded by the test's own id: its numbers do not depend on which tests ran before it."""
+    return np.random.default_rng(zlib.crc32(request.node.nodeid.encode()))
 
 
-def _paths(batch, n, d):
-    return RNG.normal(size=batch + (n, d)).cumsum(axis=-2)
+def _paths(rng, batch, n, d):
+    return rng.normal(size=batch + (n, d)).cumsum(axis=-2)
 
 
 # ------------------------------------------------------------------------------ naive constructions
@@ -52,8 +58,8 @@ def _each(batch_array, fn, *extra):
 
 
 @pytest.mark.parametrize("batch, n, d", [((), 1, 1), ((), 2, 3), ((2, 3), 7, 2), ((4,), 5, 1)])
-def test_transforms_match_loops(batch, n, d):
-    x = _paths(batch, n, d)
+def test_transforms_match_loops(rng, batch, n, d):
+    x = _paths(rng, batch, n, d)
     t_default = [k / max(n - 1, 1) for k in range(n)]
     np.testing.assert_array_equal(rp.lead_lag(x), _each(x, _naive_lead_lag))
     np.testing.assert_array_equal(rp.time_augment(x), _each(x, lambda p: _naive_time(p, t_default)))
@@ -65,9 +71,9 @@ def test_transforms_match_loops(batch, n, d):
     assert rp.invisibility_reset(x).shape == batch + (n + 2, d + 1)
 
 
-def test_time_augment_with_given_times_batched():
-    x = _paths((3,), 6, 2)
-    t = np.sort(RNG.uniform(size=(3, 6)), axis=-1)
+def test_time_augment_with_given_times_batched(rng):
+    x = _paths(rng, (3,), 6, 2)
+    t = np.sort(rng.uniform(size=(3, 6)), axis=-1)
     got = rp.time_augment(x, t)
     for i in range(3):
         np.testing.assert_array_equal(got[i], _naive_time(x[i], t[i]))
@@ -87,10 +93,10 @@ def _level2(sig, dim):
 
 
 @pytest.mark.parametrize("n, d", [(2, 1), (30, 3), (200, 2)])
-def test_lead_lag_area_is_half_the_quadratic_variation(n, d):
+def test_lead_lag_area_is_half_the_quadratic_variation(rng, n, d):
     """½ (S^{(i, d+j)} - S^{(d+j, i)}) = ½ Σ Δx^i Δx^j + A^{ij}(x): the quadratic (co)variation, plus the
     path's own Lévy area off the diagonal."""
-    x = _paths((), n, d) * 0.3
+    x = _paths(rng, (), n, d) * 0.3
     S2 = _level2(rp.signature(rp.lead_lag(x), 2), 2 * d)
     dx = np.diff(x, axis=0)
     for i in range(d):
@@ -106,10 +112,10 @@ def test_lead_lag_area_is_half_the_quadratic_variation(n, d):
         assert abs(logsig[labels.index(f"[{i + 1},{d + i + 1}]")] - qv[i]) <= 1e-13 * (1 + qv[i])
 
 
-def test_lead_lag_quadratic_variation_of_brownian_motion_is_time():
+def test_lead_lag_quadratic_variation_of_brownian_motion_is_time(rng):
     """On Brownian motion the lead–lag area tends to ½ T (the quadratic variation), one path, fine grid."""
     n, T = 200_001, 2.0
-    w = np.concatenate([[0.0], RNG.normal(scale=math.sqrt(T / (n - 1)), size=n - 1).cumsum()])[:, None]
+    w = np.concatenate([[0.0], rng.normal(scale=math.sqrt(T / (n - 1)), size=n - 1).cumsum()])[:, None]
     area = rp.logsignature(rp.lead_lag(w), 2)[2]
     assert abs(area - 0.5 * T) < 5 * 0.5 * T * math.sqrt(2.0 / (n - 1))     # sd of ½ Σ Δ² is ½ T sqrt(2/N)
 
@@ -123,8 +129,8 @@ def _exp_segment(v, depth):
     return np.concatenate(out)
 
 
-def test_basepoint_signature_is_the_segment_from_the_origin_then_the_path():
-    x = _paths((), 9, 2) + 3.0
+def test_basepoint_signature_is_the_segment_from_the_origin_then_the_path(rng):
+    x = _paths(rng, (), 9, 2) + 3.0
     got = rp.signature(rp.basepoint(x), 3)
     want = rp.tensor_product(_exp_segment(x[0], 3), rp.signature(x, 3), 2)
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
@@ -134,19 +140,19 @@ def test_basepoint_signature_is_the_segment_from_the_origin_then_the_path():
     assert not np.allclose(rp.signature(rp.basepoint(x), 3), rp.signature(rp.basepoint(x + 1.0), 3))
 
 
-def test_time_channel_terms():
+def test_time_channel_terms(rng):
     """S^{(0, i)} = ∫ (t - t_0) dx^i: on a linear step, Δx^i ((t_k + t_{k+1}) / 2 - t_0)."""
-    x = _paths((), 12, 2)
-    t = np.sort(RNG.uniform(0, 5, size=12))
+    x = _paths(rng, (), 12, 2)
+    t = np.sort(rng.uniform(0, 5, size=12))
     S2 = _level2(rp.signature(rp.time_augment(x, t), 2), 3)
     for i in range(2):
         want = sum((x[k + 1, i] - x[k, i]) * (0.5 * (t[k] + t[k + 1]) - t[0]) for k in range(11))
         assert abs(S2[0, 1 + i] - want) <= 1e-12 * (1 + np.abs(x).max() * t[-1])
 
 
-def test_invisibility_reset_terms():
+def test_invisibility_reset_terms(rng):
     """Level 1 is (-1, -x_0); S^{(0, 1+i)} = x^i_{n-1} (the return while invisible), S^{(1+i, 0)} = -(x_{n-1} - x_0)^i."""
-    x = _paths((), 8, 2) + np.array([2.0, -1.0])
+    x = _paths(rng, (), 8, 2) + np.array([2.0, -1.0])
     sig = rp.signature(rp.invisibility_reset(x), 2)
     np.testing.assert_allclose(sig[:3], np.concatenate([[-1.0], -x[0]]), atol=1e-13)
     S2 = _level2(sig, 3)
@@ -189,15 +195,15 @@ def _jacobian(fn, shape):
 
 
 @pytest.mark.parametrize("name", sorted(NP_TRANSFORMS))
-def test_torch_transforms_values_and_gradients(name):
+def test_torch_transforms_values_and_gradients(rng, name):
     torch = pytest.importorskip("torch")
     import roughpaths.torch as rpt
 
-    x = _paths((2,), 4, 3)
+    x = _paths(rng, (2,), 4, 3)
     xt = torch.tensor(x, dtype=torch.float64, requires_grad=True)
     out = getattr(rpt, name)(xt)
     np.testing.assert_array_equal(out.detach().numpy(), NP_TRANSFORMS[name](x))
-    w = RNG.normal(size=out.shape)
+    w = rng.normal(size=out.shape)
     (out * torch.from_numpy(w)).sum().backward()
     J = _jacobian(NP_TRANSFORMS[name], x.shape)
     np.testing.assert_allclose(xt.grad.numpy().ravel(), J.T @ w.ravel(), rtol=1e-14, atol=1e-14)
@@ -209,17 +215,17 @@ def test_torch_transforms_values_and_gradients(name):
 
 
 @pytest.mark.parametrize("name", sorted(NP_TRANSFORMS))
-def test_jax_transforms_values_and_gradients(name):
+def test_jax_transforms_values_and_gradients(rng, name):
     jax = pytest.importorskip("jax")
     import jax.numpy as jnp
 
     import roughpaths.jax as rpj
 
-    x = _paths((2,), 4, 3).astype(np.float32)
+    x = _paths(rng, (2,), 4, 3).astype(np.float32)
     fn = getattr(rpj, name)
     np.testing.assert_allclose(np.asarray(fn(jnp.asarray(x))), NP_TRANSFORMS[name](x), rtol=1e-7, atol=1e-7)
     np.testing.assert_array_equal(np.asarray(jax.jit(fn)(jnp.asarray(x))), np.asarray(fn(jnp.asarray(x))))
-    w = RNG.normal(size=np.shape(fn(jnp.asarray(x)))).astype(np.float32)
+    w = rng.normal(size=np.shape(fn(jnp.asarray(x)))).astype(np.float32)
     g = jax.grad(lambda z: jnp.sum(fn(z) * w))(jnp.asarray(x))
     J = _jacobian(NP_TRANSFORMS[name], x.shape)
     np.testing.assert_allclose(np.asarray(g).ravel(), J.T @ w.ravel().astype(np.float64), rtol=1e-6, atol=1e-6)
@@ -227,12 +233,12 @@ def test_jax_transforms_values_and_gradients(name):
         fn(jnp.ones(3))
 
 
-def test_torch_time_augment_times_and_a_signature_through_it():
+def test_torch_time_augment_times_and_a_signature_through_it(rng):
     torch = pytest.importorskip("torch")
     import roughpaths.torch as rpt
 
-    x = _paths((3,), 5, 2)
-    t = np.sort(RNG.uniform(size=(3, 5)), axis=-1)
+    x = _paths(rng, (3,), 5, 2)
+    t = np.sort(rng.uniform(size=(3, 5)), axis=-1)
     got = rpt.time_augment(torch.from_numpy(x), torch.from_numpy(t)).numpy()
     np.testing.assert_array_equal(got, rp.time_augment(x, t))
     with pytest.raises(ValueError, match="times"):
