@@ -86,13 +86,13 @@ def warm_more_signatures() -> None:
 
 def warm_more_gradients() -> None:
     """For the test suite (``--more``): the backward kernels of lone paths at d = 4 and d = 1, and of wide
-    alphabets cut into blocks (d = 20). Each is one variant of 15-25 s of CPU (a lone d = 1 gradient: 25 s,
+    alphabets cut into blocks (d = 20, and d = 8: the smallest width that runs alone). Each is one variant of 15-25 s of CPU (a lone d = 1 gradient: 25 s,
     load ~8), which the suite otherwise compiles inside its tests. Run in the other process than
     :func:`warm_more_signatures` (balance)."""
     import roughpaths as rp
 
     rng = np.random.default_rng(0)
-    for shape in ((9, 4), (6, 1), (2, 37, 20)):
+    for shape in ((9, 4), (6, 1), (2, 37, 20), (2, 37, 8)):
         x = np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
         rp.signature_vjp(x, 3, np.ones(shape[:-2] + (rp.sigdim(shape[-1], 3),)))
 
@@ -129,6 +129,10 @@ def warm_more_coadjoint() -> None:
     se3c = LiePoissonSystem(LieAlgebra(se3().structure_constants, name="se3 (constants)"), np.diag(np.arange(1.0, 7.0)),
                             0.3 * rng.standard_normal((3, 6)), theta=0.1)
     solve(se3c, BrownianDriver(3, seed=0, dt=0.01, n_steps=2, batch_shape=(2,)), np.ones((2, 6)), ImplicitMidpoint())
+    from mechanics import su                  # the midpoint rule at a dimension read from the arrays (su(3), n = 8)
+    su3 = LiePoissonSystem(LieAlgebra(su(3).structure_constants, name="su3 (constants)"), np.ones(8),
+                           0.3 * rng.standard_normal((3, 8)), theta=0.1)
+    solve(su3, BrownianDriver(3, seed=0, dt=0.01, n_steps=2, batch_shape=(2,)), np.ones((2, 8)), ImplicitMidpoint())
 
 
 def warm_signature_kernels() -> None:

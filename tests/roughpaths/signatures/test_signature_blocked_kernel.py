@@ -26,6 +26,10 @@ from roughpaths.signatures._engine import _reversed_to_rowmajor, _units
 
 CASES = [(6, 3), (6, 4), (8, 3), (8, 4), (20, 3), (7, 3), (4, 6), (7, 2), (20, 2)]   # depth 2: _level2
 
+#: One worker runs the module (``--dist loadgroup``): its cases compile the same wide-alphabet variants (about
+#: a minute of CPU in all), which two workers splitting the cases compiled twice, at the same time.
+pytestmark = pytest.mark.xdist_group("blocked-kernels")
+
 
 @pytest.mark.parametrize("d,m", CASES)
 def test_blocked_signature_matches_iisignature(rng, d, m):
