@@ -84,6 +84,18 @@ def warm_more_signatures() -> None:
     rp.p_variation(lone, 2.5)
 
 
+def warm_more_drivers() -> None:
+    """For the test suite (``--more``): the Brownian driver with every Lévy-area method at d = 2 and 3 (the
+    tests sample with each; the default's kernels are the main job's), a few seconds of CPU each."""
+    import roughpaths as rp
+
+    for d in (2, 3):
+        for area in (None, "davie", "foster", "exact", "fourier", "mrongowius-rossler", "wiktorsson"):
+            if area == "exact" and d != 2:
+                continue
+            rp.BrownianDriver(d, seed=0, dt=0.01, n_steps=4, batch_shape=(2,), levy_area=area).rough_path()
+
+
 def warm_more_gradients() -> None:
     """For the test suite (``--more``): the backward kernels of lone paths at d = 4 and d = 1, and of wide
     alphabets cut into blocks (d = 20, and d = 8: the smallest width that runs alone). Each is one variant of 15-25 s of CPU (a lone d = 1 gradient: 25 s,
@@ -175,7 +187,7 @@ PARTS = {
     "mechanics": (("coadjoint kernels", warm_coadjoint),),
 }
 #: with ``--more`` (``tools/setup_env.sh`` when it installs the test extra): what the test suite reaches besides
-MORE = {"roughpaths": (("more signatures", warm_more_signatures),),
+MORE = {"roughpaths": (("more signatures", warm_more_signatures), ("more drivers", warm_more_drivers)),
         "mechanics": (("more coadjoint schemes", warm_more_coadjoint), ("more signature gradients", warm_more_gradients))}
 
 
