@@ -52,6 +52,7 @@ from roughpaths.validation import parallel_ranges
 from . import _se3_block
 from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1, rare_steps
 from ._soa_rows import (CHORD_FAILED, NON_FINITE, OK, STEPS, ad_star_rows, algebra_tables, eta_rows, eta_rows3,
+                        first_step_sigma,
                         sparse_rows, velocity_rows)
 
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
@@ -278,11 +279,14 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             bool(stop_on_failure), np.zeros(nb, dtype=np.bool_), np.empty((nb, n)))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
     save, flag, sout = args[22], args[27], args[28]
+    sigma = first_step_sigma(system, y, dX, dXX, dts) if code != 2 else None
+    start_full = sigma is not None and bool(np.any(~(np.abs(sigma) @ cnorm <= DEGREE_THETA[-1])))
     if code != 2 and nm == 3 and _se3_block.has_se3_table(ti, tj, tk, tv):   # the same numbers, written out
         kernel, full, block = _se3_block.run_block, _se3_block.run_block_full, _se3_block.B
+        kernel = full if start_full else kernel
     else:
         N = n if code == 2 and n in (3, 6) else 0
-        kernel, full, block = _block_kernel(int(code), N, False, nm == 3), None, BLOCK
+        kernel, full, block = _block_kernel(int(code), N, start_full, nm == 3), None, BLOCK
 
     def run(lo, hi):
         _, k = kernel(*args, lo, hi, 0, *tail)

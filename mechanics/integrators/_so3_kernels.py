@@ -24,6 +24,7 @@ import numpy as np
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
 from roughpaths.validation import parallel_ranges
 from ._so3_scalar import CHORD_FAILED, NON_FINITE, OK, so3_rare_steps, so3_scalar_steps
+from ._soa_rows import first_step_sigma
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 
@@ -346,7 +347,8 @@ def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
             np.ascontiguousarray(system.xi, dtype=np.float64), brk, pi, pj, np.ascontiguousarray(dts, dtype=np.float64),
             coef, code, float(tol), int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
             np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure), bad, eout)
-    kernel = _range_kernel(int(code), False)
+    sigma = first_step_sigma(system, y, dX, dXX, dts) if code != 2 else None
+    kernel = _range_kernel(int(code), sigma is not None and bool(np.any(~(np.sum(sigma * sigma, -1) < SMALL_ANGLE2))))
 
     def run(lo, hi):
         k = kernel(*args, lo, hi, 0)

@@ -39,6 +39,17 @@ def sparse_rows(m):
     return cols.astype(np.int64), np.ascontiguousarray(m[rows, cols]), start
 
 
+def first_step_sigma(system, y, dX, dXX, dts):
+    """The Lie–Euler ``σ = w(μ) dt + e`` of every member's first step, ``(B, n)`` (numpy; ``None`` without steps):
+    the kernels start with their variant that has the exact exponential inline when it already takes a member
+    past the vectorised one (a system whose steps are routinely that large would otherwise compile both)."""
+    if dX.shape[1] == 0:
+        return None
+    levy = None if dXX is None else 0.5 * (dXX[:, 0] - np.swapaxes(dXX[:, 0], -1, -2))
+    with np.errstate(all="ignore"):
+        return system.drift_velocity(y) * float(dts[0]) + system.stochastic_velocity(dX[:, 0], levy)
+
+
 # ---------------------------------------------------------------------- block (structure-of-arrays) operations
 # Every output row is written in passes over the block's members (measured: one non-zero per pass is
 # faster than two per pass here: 2.7 against 4.6 ns per member for so(3)'s ad*, 3.7 with a zeroing pass).

@@ -66,8 +66,9 @@ def test_bitwise_the_generic_kernel(name, area, solver, monkeypatch):
     mu0[2] *= 1e8                                            # a wild member: large θ, the scalar path
     X = _path(3, nb, area)
     kernels = []
-    real = _se3_block.run_block
-    monkeypatch.setattr(_se3_block, "run_block", lambda *a: kernels.append(a[8]) or real(*a))
+    real, real_full = _se3_block.run_block, _se3_block.run_block_full    # the wild member: the variant with the
+    monkeypatch.setattr(_se3_block, "run_block", lambda *a: kernels.append(a[8]) or real(*a))   # exact exponential
+    monkeypatch.setattr(_se3_block, "run_block_full", lambda *a: kernels.append(a[8]) or real_full(*a))
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
