@@ -52,7 +52,7 @@ from roughpaths.validation import parallel_ranges
 from . import _se3_block
 from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, exp1, midpoint1, rare_steps
 from ._soa_rows import (CHORD_FAILED, NON_FINITE, OK, STEPS, ad_star_rows, algebra_tables, eta_rows, eta_rows3,
-                        first_step_sigma,
+                        saw_rare_step, starts_full,
                         sparse_rows, velocity_rows)
 
 #: Members per block (structure-of-arrays rows; the unit of the thread split).
@@ -279,11 +279,13 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             bool(stop_on_failure), np.zeros(nb, dtype=np.bool_), np.empty((nb, n)))
     tail = (start, qs, mts, bool(np.any(f != 0.0)))
     save, flag, sout = args[22], args[27], args[28]
-    sigma = first_step_sigma(system, y, dX, dXX, dts) if code != 2 else None
-    start_full = sigma is not None and bool(np.any(~(np.abs(sigma) @ cnorm <= DEGREE_THETA[-1])))
-    if code != 2 and nm == 3 and _se3_block.has_se3_table(ti, tj, tk, tv):   # the same numbers, written out
-        kernel, full, block = _se3_block.run_block, _se3_block.run_block_full, _se3_block.B
-        kernel = full if start_full else kernel
+    se3 = code != 2 and nm == 3 and _se3_block.has_se3_table(ti, tj, tk, tv)
+    key = ("se3" if se3 else "generic", int(code), nm == 3)
+    start_full = code != 2 and starts_full(key, system, y, dX, dXX, dts,
+                                           lambda sig: np.any(~(np.abs(sig) @ cnorm <= DEGREE_THETA[-1])))
+    if se3:                                                                 # the same numbers, written out
+        full, block = _se3_block.run_block_full, _se3_block.B
+        kernel = full if start_full else _se3_block.run_block
     else:
         N = n if code == 2 and n in (3, 6) else 0
         kernel, full, block = _block_kernel(int(code), N, start_full, nm == 3), None, BLOCK
@@ -294,6 +296,7 @@ def integrate_generic(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_o
             return
         # a step the vectorised Taylor loop left to the exact exponential: do it, then go on with the variant
         # that has it inline
+        saw_rare_step(key)
         nnew = rare_steps(y[lo:hi], sout[lo:hi], flag[lo:hi], ti, tj, tk, tv, cnorm, DEGREE_THETA,
                           first_bad[lo:hi], reason[lo:hi], k)
         if save[k]:

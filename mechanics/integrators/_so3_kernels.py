@@ -24,7 +24,7 @@ import numpy as np
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
 from roughpaths.validation import parallel_ranges
 from ._so3_scalar import CHORD_FAILED, NON_FINITE, OK, so3_rare_steps, so3_scalar_steps
-from ._soa_rows import first_step_sigma
+from ._soa_rows import saw_rare_step, starts_full
 
 _taylor = numba.njit(cache=True, inline="always")(taylor_coefficients)
 
@@ -347,14 +347,16 @@ def integrate_so3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
             np.ascontiguousarray(system.xi, dtype=np.float64), brk, pi, pj, np.ascontiguousarray(dts, dtype=np.float64),
             coef, code, float(tol), int(max_iter), data["q"], lin, data["metric_inv"], float(data["theta"]),
             np.ascontiguousarray(save, dtype=np.bool_), out, first_bad, reason, bool(stop_on_failure), bad, eout)
-    sigma = first_step_sigma(system, y, dX, dXX, dts) if code != 2 else None
-    kernel = _range_kernel(int(code), sigma is not None and bool(np.any(~(np.sum(sigma * sigma, -1) < SMALL_ANGLE2))))
+    key = ("so3", int(code))
+    kernel = _range_kernel(int(code), code != 2 and starts_full(
+        key, system, y, dX, dXX, dts, lambda sig: np.any(~(np.sum(sig * sig, -1) < SMALL_ANGLE2))))
 
     def run(lo, hi):
         k = kernel(*args, lo, hi, 0)
         if k < 0:
             return
         # a step the vector loop left to the exact scalar step: do it, then go on with the variant that has it
+        saw_rare_step(key)
         nnew = so3_rare_steps(y[lo:hi], eout[lo:hi], bad[lo:hi], float(dts[k]), data["q"], lin, data["metric_inv"],
                                float(data["theta"]), int(code), float(tol), int(max_iter), first_bad[lo:hi],
                                reason[lo:hi], k)

@@ -39,15 +39,30 @@ def sparse_rows(m):
     return cols.astype(np.int64), np.ascontiguousarray(m[rows, cols]), start
 
 
-def first_step_sigma(system, y, dX, dXX, dts):
-    """The Lie–Euler ``σ = w(μ) dt + e`` of every member's first step, ``(B, n)`` (numpy; ``None`` without steps):
-    the kernels start with their variant that has the exact exponential inline when it already takes a member
-    past the vectorised one (a system whose steps are routinely that large would otherwise compile both)."""
-    if dX.shape[1] == 0:
-        return None
-    levy = None if dXX is None else 0.5 * (dXX[:, 0] - np.swapaxes(dXX[:, 0], -1, -2))
-    with np.errstate(all="ignore"):
-        return system.drift_velocity(y) * float(dts[0]) + system.stochastic_velocity(dX[:, 0], levy)
+#: Per kernel (a key of the caller's), whether a solve starts with the variant that has the exact step inline.
+_STARTS: dict = {}
+
+
+def starts_full(key, system, y, dX, dXX, dts, past) -> bool:
+    """Whether the solves of kernel ``key`` start with its variant that has the exact exponential inline.
+
+    Decided once a process: by the first solve's first step (``past(sigma)`` on the Lie–Euler ``σ = w(μ) dt + e``
+    of every member, ``(B, n)``, in numpy: a system whose steps are routinely past the vectorised exponential
+    would otherwise compile both variants), and turned on for good by :func:`saw_rare_step`. Not per call:
+    an adaptive solve calls the kernel at every attempt. Members get the same bits from either variant."""
+    if key not in _STARTS:
+        full = False
+        if dX.shape[1] > 0:
+            levy = None if dXX is None else 0.5 * (dXX[:, 0] - np.swapaxes(dXX[:, 0], -1, -2))
+            with np.errstate(all="ignore"):
+                full = bool(past(system.drift_velocity(y) * float(dts[0]) + system.stochastic_velocity(dX[:, 0], levy)))
+        _STARTS[key] = full
+    return _STARTS[key]
+
+
+def saw_rare_step(key) -> None:
+    """A solve of kernel ``key`` needed the exact step: its later solves start with the variant that has it."""
+    _STARTS[key] = True
 
 
 # ---------------------------------------------------------------------- block (structure-of-arrays) operations

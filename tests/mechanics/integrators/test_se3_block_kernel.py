@@ -97,8 +97,9 @@ def test_table_match_is_exact(solver, monkeypatch):
     top = TOPS["theta"]
     c = se3().structure_constants
     taken = []
-    real = _se3_block.run_block
-    monkeypatch.setattr(_se3_block, "run_block", lambda *a: taken.append(a[8]) or real(*a))
+    real, real_full = _se3_block.run_block, _se3_block.run_block_full    # either variant (the process may have
+    monkeypatch.setattr(_se3_block, "run_block", lambda *a: taken.append(a[8]) or real(*a))   # needed the exact
+    monkeypatch.setattr(_se3_block, "run_block_full", lambda *a: taken.append(a[8]) or real_full(*a))   # step)
     mu0 = np.random.default_rng(2).standard_normal((5, 6))
     X = BrownianDriver(3, seed=3, dt=0.02, n_steps=30, batch_shape=(5,)).rough_path()
     save = np.ones(30, dtype=bool)
