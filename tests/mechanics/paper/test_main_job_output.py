@@ -214,8 +214,12 @@ def _check_state(out: Path, ref: dict, note: str) -> None:
         assert not work.exists(), note
     if work.exists():
         names = {p.name for p in work.iterdir()}
-        # marked, or (in the instant between removing the marks and the rename) complete
-        assert "INCOMPLETE.txt" in names or "manifest.json" in names, (note, names)
+        # marked, or (in the instant between removing the marks and the rename) complete, or (in the instant
+        # between creating the folder and renaming its marker into place) holding the marker's temporary file
+        # only: its name says unfinished, and --resume, finding no record, starts over
+        assert ("INCOMPLETE.txt" in names or "manifest.json" in names
+                or (len(names) == 1 and next(iter(names)).startswith(".tmp-")
+                    and next(iter(names)).endswith("-INCOMPLETE.txt"))), (note, names)
 
 
 def _kill_and_resume(tmp_path: Path, only: str, n_kills: int):
