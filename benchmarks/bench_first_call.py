@@ -51,6 +51,10 @@ FAMILIES = {
                                "b = rigid_body([1.0, 2.0, 3.0], sigma=0.1)\n"
                                "rp.solve(b, rp.BrownianDriver(3, seed=0, dt=0.01, n_steps=20, batch_shape=(4,)), "
                                "np.ones((4, 3)), LieHeun())"),
+    "rigid body, large steps": ("", "from mechanics import rigid_body, LieHeun\n"       # the exact-step variants
+                                    "b = rigid_body([1.0, 2.0, 3.0], sigma=2.0)\n"
+                                    "rp.solve(b, rp.BrownianDriver(3, seed=0, dt=0.05, n_steps=20, batch_shape=(4,)), "
+                                    "np.ones((4, 3)), LieHeun())"),
     "user algebra (su2) LieHeun": ("", "from mechanics import LiePoissonSystem, LieHeun\n"
                                        "from mechanics.systems.lie_algebra import su2\n"
                                        "s = LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1)\n"
