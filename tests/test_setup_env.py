@@ -3,8 +3,11 @@
 Claims: with a stamp matching ``pyproject.toml``, the environment's Python version and the requested
 extras, the script prints the environment's python and runs nothing else (no pip, no index); a
 missing extra, a changed ``pyproject.toml`` or Python version, or a missing stamp triggers one
-install of the union of the extras, then the warm-up run (``python -m mechanics --tiny``), then a new
-stamp. The environment is a fake: its ``python`` records its arguments instead of installing.
+install of the union of the extras, then the warm-up (``python -m mechanics --tiny`` and both parts of
+``tools/warm_kernels.py``), then a new stamp. ``--warm-up=background`` (``./run.sh``, which runs the main job
+next) returns before the warm-up, which compiles both parts in one background process and no ``--tiny``
+run; a warm-up that did not finish is done by the next call. The environment is a fake: its ``python``
+records its arguments instead of installing.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -38,14 +42,19 @@ def venv(tmp_path):
     return v
 
 
-def _setup(venv: Path, extras: str = "") -> list[str]:
+def _setup(venv: Path, extras: str = "", *options: str) -> list[str]:
     log = venv / "calls.log"
     if log.exists():
         log.unlink()
-    proc = subprocess.run(["bash", str(SCRIPT), extras], env={**os.environ, "VENV": str(venv)},
+    proc = subprocess.run(["bash", str(SCRIPT), *options, extras], env={**os.environ, "VENV": str(venv)},
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip().splitlines()[-1] == f"{venv}/bin/python"
+    pid_file = venv / ".warm-up.pid"
+    deadline = time.monotonic() + 30
+    while pid_file.exists() and time.monotonic() < deadline:      # a background warm-up: let it end
+        time.sleep(0.05)
+    assert not pid_file.exists()
     return log.read_text().splitlines() if log.exists() else []
 
 
@@ -54,6 +63,9 @@ def test_install_once_then_skip_until_something_changes(venv):
     installs = [c for c in calls if c.startswith("-m pip install") and " -e " in f" {c} "]
     assert installs == ["-m pip install --disable-pip-version-check -e .[test]"], calls
     assert any(c.startswith("-m mechanics --tiny --quiet") for c in calls), calls
+    assert {c for c in calls if c.startswith("tools/warm_kernels.py")} == {
+        "tools/warm_kernels.py --part roughpaths --more", "tools/warm_kernels.py --part mechanics --more"}, calls
+    assert not (venv / ".warm-up-pending").exists()
     assert (venv / ".setup-stamp").read_text().splitlines()[1] == "test"
 
     assert _setup(venv, "test") == []            # nothing changed: nothing runs
@@ -74,3 +86,26 @@ def test_a_damaged_stamp_or_environment_reinstalls(venv):
     assert "-m pip install --disable-pip-version-check -e ." in _setup(venv, "")
     (venv / "bin" / "levy-area-paper").unlink()     # the package was uninstalled by hand
     assert "-m pip install --disable-pip-version-check -e ." in _setup(venv, "")
+
+
+def test_background_warm_up_skips_the_main_job_and_an_interrupted_one_is_redone(venv):
+    calls = _setup(venv, "", "--warm-up=background")
+    assert not any("--tiny" in c for c in calls), calls          # the caller runs the main job itself
+    assert [c for c in calls if c.startswith("tools/warm_kernels.py")] == [
+        "tools/warm_kernels.py --part roughpaths", "tools/warm_kernels.py --part mechanics"], calls
+    assert "Compiled in" in (venv / "warm-up.log").read_text()
+    assert not (venv / ".warm-up-pending").exists()
+    assert _setup(venv, "", "--warm-up=background") == []        # done: nothing runs
+
+    (venv / ".warm-up-pending").touch()                          # as if the warm-up had been killed
+    calls = _setup(venv, "")
+    assert not any(c.startswith("-m pip") for c in calls), calls   # no reinstall, only the warm-up
+    assert any(c.startswith("-m mechanics --tiny") for c in calls), calls
+    assert not (venv / ".warm-up-pending").exists()
+    assert _setup(venv, "") == []
+
+
+def test_an_unknown_warm_up_mode_is_refused(venv):
+    proc = subprocess.run(["bash", str(SCRIPT), "--warm-up=later"], env={**os.environ, "VENV": str(venv)},
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2 and "--warm-up=now or --warm-up=background" in proc.stderr
