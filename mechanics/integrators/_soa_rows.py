@@ -120,7 +120,8 @@ def affine_rows(base, const, cols, vals, start, x, out, bc, use_base):
 @numba.njit(cache=True)
 def velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv, start, bc):
     """out = w(mu) = g + θ M⁻¹ ad*_{g+f} mu, g = Q mu + lin; ``qs``, ``mts``: the non-zeros of Q and θ M⁻¹."""
-    affine_rows(g, lin, qs[0], qs[1], qs[2], mu, g, bc, False)
+    yes = bc >= 0           # True as a plain bool: the literals True and False compile two variants of affine_rows
+    affine_rows(g, lin, qs[0], qs[1], qs[2], mu, g, bc, not yes)
     if theta == 0.0:
         for i in range(mu.shape[0]):
             o, gi = out[i], g[i]
@@ -136,7 +137,7 @@ def velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv,
         ad_star_rows(t1, mu, t2, ti, tk, tv, start, bc)
     else:
         ad_star_rows(g, mu, t2, ti, tk, tv, start, bc)
-    affine_rows(g, mts[3], mts[0], mts[1], mts[2], t2, out, bc, True)
+    affine_rows(g, mts[3], mts[0], mts[1], mts[2], t2, out, bc, yes)
 
 
 @numba.njit(cache=True)

@@ -68,39 +68,36 @@ def _mix(x, y):
     return np.uint32(r ^ (r >> _XSHIFT))
 
 
-@njit(cache=True)
-def _seed_states(entropy, out):
-    """``SeedSequence`` pools and ``generate_state(4, uint64)`` for each row of ``entropy``.
+@njit(cache=True, inline="always")
+def _generate_state(entropy, p, mixer, st32):
+    """``SeedSequence`` pool of ``entropy[p]`` and its ``generate_state(4, uint64)``, as a tuple of four uint64.
 
-    ``entropy`` (P, L) uint32: the assembled entropy words of each stream (``L >= 4``: the run
-    entropy padded to the pool size, then the spawn key). ``out`` (P, 4) uint64 receives
-    ``generate_state(4, np.uint64)``.
+    ``entropy`` (P, L) uint32: the assembled entropy words of each stream (``L >= 4``: the run entropy padded
+    to the pool size, then the spawn key); ``mixer`` (4,) and ``st32`` (8,) uint32 scratch.
     """
-    P, L = entropy.shape
-    mixer = np.empty(4, dtype=np.uint32)
-    st32 = np.empty(8, dtype=np.uint32)
-    for p in range(P):
-        hc = _INIT_A
-        for i in range(4):
-            mixer[i], hc = _hashmix(entropy[p, i], hc)
-        for i_src in range(4):
-            for i_dst in range(4):
-                if i_src != i_dst:
-                    v, hc = _hashmix(mixer[i_src], hc)
-                    mixer[i_dst] = _mix(mixer[i_dst], v)
-        for i_src in range(4, L):
-            for i_dst in range(4):
-                v, hc = _hashmix(entropy[p, i_src], hc)
+    L = entropy.shape[1]
+    hc = _INIT_A
+    for i in range(4):
+        mixer[i], hc = _hashmix(entropy[p, i], hc)
+    for i_src in range(4):
+        for i_dst in range(4):
+            if i_src != i_dst:
+                v, hc = _hashmix(mixer[i_src], hc)
                 mixer[i_dst] = _mix(mixer[i_dst], v)
-        hb = _INIT_B
-        for i in range(8):
-            v = np.uint32(mixer[i % 4] ^ hb)
-            hb = np.uint32(hb * _MULT_B)
-            v = np.uint32(v * hb)
-            v = np.uint32(v ^ (v >> _XSHIFT))
-            st32[i] = v
-        for i in range(4):
-            out[p, i] = np.uint64(st32[2 * i]) | (np.uint64(st32[2 * i + 1]) << np.uint64(32))
+    for i_src in range(4, L):
+        for i_dst in range(4):
+            v, hc = _hashmix(entropy[p, i_src], hc)
+            mixer[i_dst] = _mix(mixer[i_dst], v)
+    hb = _INIT_B
+    for i in range(8):
+        v = np.uint32(mixer[i % 4] ^ hb)
+        hb = np.uint32(hb * _MULT_B)
+        v = np.uint32(v * hb)
+        v = np.uint32(v ^ (v >> _XSHIFT))
+        st32[i] = v
+    w = np.uint64(32)
+    return (np.uint64(st32[0]) | (np.uint64(st32[1]) << w), np.uint64(st32[2]) | (np.uint64(st32[3]) << w),
+            np.uint64(st32[4]) | (np.uint64(st32[5]) << w), np.uint64(st32[6]) | (np.uint64(st32[7]) << w))
 
 
 # ----------------------------------------------------------------------------- PCG64
@@ -138,15 +135,21 @@ def _xsl_rr(sh, sl):
 
 
 @njit(cache=True)
-def _pcg64_seed(seeds, states):
-    """PCG64 states ``(P, 4)`` = (state_hi, state_lo, inc_hi, inc_lo) from ``generate_state(4, uint64)``."""
+def _stream_states(entropy, states):
+    """PCG64 states ``(P, 4)`` = (state_hi, state_lo, inc_hi, inc_lo) of the streams whose ``SeedSequence``
+    entropy words are the rows of ``entropy`` (P, L) uint32 (see :func:`_generate_state`): numpy's
+    ``PCG64(SeedSequence(...))`` seeding from ``generate_state(4, uint64)``. One kernel for both steps (two
+    kernels compiled ~0.15 s longer)."""
     one = np.uint64(1)
-    for p in range(seeds.shape[0]):
-        ih = (seeds[p, 2] << one) | (seeds[p, 3] >> np.uint64(63))
-        il = (seeds[p, 3] << one) | one
+    mixer = np.empty(4, dtype=np.uint32)
+    st32 = np.empty(8, dtype=np.uint32)
+    for p in range(entropy.shape[0]):
+        s0, s1, s2, s3 = _generate_state(entropy, p, mixer, st32)
+        ih = (s2 << one) | (s3 >> np.uint64(63))
+        il = (s3 << one) | one
         sh, sl = _lcg(np.uint64(0), np.uint64(0), ih, il)
-        lo = sl + seeds[p, 1]
-        sh = sh + seeds[p, 0] + (one if lo < sl else np.uint64(0))
+        lo = sl + s1
+        sh = sh + s0 + (one if lo < sl else np.uint64(0))
         sh, sl = _lcg(sh, lo, ih, il)
         states[p, 0] = sh
         states[p, 1] = sl
@@ -216,14 +219,15 @@ def _pcg64_rounds(sh, sl, ih, il, out, buf, left, i):
     return sh, sl
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _pcg64_fill(states, p, out, words):
     """``out`` (1-D) <- the next ``out.size`` normals of PCG64 stream ``states[p]``; the state advances.
 
     Same numbers and end state as :func:`_pcg64_normal` called ``out.size`` times, in two
     passes: the LCG writes raw words into ``words`` (uint64 scratch; a larger one is allocated if
     needed), then :func:`_ziggurat_fill` turns them into normals. Both passes are tight loops
-    without calls (one call per normal measured ~2x slower).
+    without calls (one call per normal measured ~2x slower). Inlined into its callers (as a kernel of its own
+    it compiled for ~0.2 s more).
     """
     zero = np.int64(0)                   # not the literal 0, which numba compiles as a variant of its own
     sh, sl = _pcg64_rounds(states[p, 0], states[p, 1], states[p, 2], states[p, 3], out, words, zero, zero)
@@ -370,16 +374,14 @@ class PathStreams:
             ent = np.empty((P, prefix.size + kint.shape[1]), dtype=np.uint32)
             ent[:, :prefix.size] = prefix
             ent[:, prefix.size:] = kint.astype(np.uint32)
-            seeds = np.empty((P, 4), dtype=np.uint64)
-            _seed_states(ent, seeds)
+            states = np.empty((P, 4), dtype=np.uint64)
+            _stream_states(ent, states)
         else:
-            seeds = np.empty((P, 4), dtype=np.uint64)
+            states = np.empty((P, 4), dtype=np.uint64)
             for j, k in enumerate(keys):
                 spawn = base + [w for v in k for w in _uint32_words(int(v))]
                 r = run + [0] * max(0, 4 - len(run))    # zero padding == numpy's hashmix(0) fill
-                _seed_states(np.array([r + spawn], dtype=np.uint32), seeds[j:j + 1])
-        states = np.empty((P, 4), dtype=np.uint64)
-        _pcg64_seed(seeds, states)
+                _stream_states(np.array([r + spawn], dtype=np.uint32), states[j:j + 1])
         return states
 
     def fill(self, out: np.ndarray) -> None:

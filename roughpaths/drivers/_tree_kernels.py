@@ -46,7 +46,7 @@ import numpy as np
 from numba import njit
 
 from ._bridge import _pair_solve
-from ._random import _fast_streams_ok, _pcg64_normals, _pcg64_seed, _seed_states, stream_prefix
+from ._random import _fast_streams_ok, _pcg64_normals, _stream_states, stream_prefix
 
 __all__ = ["split_width", "refine_segments", "refine_segments_fast", "polygon_area", "reduce_node",
            "antisym_from_normals", "seed_prefix", "split_seeded"]
@@ -351,10 +351,8 @@ def _split_seeded_nb(prefix, paths, tag, depth, index, width, w, G, delta, fine,
         ent[r, m + 2] = depth
         ent[r, m + 3] = index >> 32
         ent[r, m + 4] = index & 0xFFFFFFFF
-    seeds = np.empty((P, 4), dtype=np.uint64)
-    _seed_states(ent, seeds)
     states = np.empty((P, 4), dtype=np.uint64)
-    _pcg64_seed(seeds, states)
+    _stream_states(ent, states)
     z = np.empty((P, width))
     _pcg64_normals(states, z)
     _refine_segments_nb(w, G, delta, z, fine, GL, GR)

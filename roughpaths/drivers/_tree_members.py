@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._random import _pcg64_fill, _pcg64_seed, _seed_states
+from ._random import _pcg64_fill, _stream_states
 from ._tree_kernels import _refine_segments_nb, split_width
 
 __all__ = ["member_cells"]
@@ -47,7 +47,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
     caching = cidx.shape[0] > 0
     sd, si = np.empty(L + 4, dtype=np.int64), np.empty(L + 4, dtype=np.int64)
     ent = np.empty((1, m + 5), dtype=np.uint32)
-    seeds, states = np.empty((1, 4), dtype=np.uint64), np.empty((1, 4), dtype=np.uint64)
+    states = np.empty((1, 4), dtype=np.uint64)
     z, Wn, An = np.empty((1, width)), np.empty(d), np.empty((d, d))
     words = np.empty(width + 64, dtype=np.uint64)
     kidx = np.empty(1 if caching else L + 1, dtype=np.int64)         # reset per row below
@@ -119,8 +119,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 ent[0, m + 2] = depth
                 ent[0, m + 3] = index >> 32
                 ent[0, m + 4] = index & 0xFFFFFFFF
-                _seed_states(ent, seeds)
-                _pcg64_seed(seeds, states)
+                _stream_states(ent, states)
                 _pcg64_fill(states, zero, z[0], words)    # _pcg64_normals of one row, without its pair kernel
                 _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z,
                                     rw[depth].reshape((1, 2 * nseg, d)), rG[depth, 0:1], rG[depth, 1:2])
