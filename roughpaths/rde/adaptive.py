@@ -131,7 +131,7 @@ class _TreeSteps:
         self.shared = (not self.vector if shared is None else bool(shared)) or P == 0
         self.lanes = n = 1 if self.shared else P
         self.lane_of = np.zeros(P, dtype=np.int64) if self.shared else np.arange(P)     # the lane of each member
-        self.lane_members = [np.arange(P)] if self.shared else [np.array([m]) for m in range(P)]
+        self.lane_members = np.arange(P)[None] if self.shared else np.arange(P)[:, None]   # (lanes, members)
         self.paths = np.broadcast_to(np.arange(tree.n_paths).reshape(tree.batch_shape), run.batch).ravel()
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
         order = solver.error_order if solver.error_order is not None else solver.order
@@ -143,7 +143,8 @@ class _TreeSteps:
         # step ends snapped to spacing (h/4, h/2] per path, adaptive; else (h/16, h/8] (module docstring)
         self.fine = 1 if control.adaptive and (not self.shared or P == 1) else 3
         keep0 = self.save_all or 0 in self.save_idx
-        self.saved = [([t0], [run.y[m].copy()]) if keep0 else ([], []) for m in self.lane_members]
+        # the saved states, a row per iteration: (lanes, their times, their members' states (lanes, members, e))
+        self.saved = [(np.arange(n), np.full(n, t0), run.y[self.lane_members])] if keep0 else []
         self.n_saved = n if keep0 else 0                   # states saved so far, over all lanes
         self.y_new, self.err = np.empty_like(run.y), np.zeros(P)
         self.progress_total, self.reached = (T, "solve (adaptive)", "time"), 0.0
@@ -244,10 +245,8 @@ class _TreeSteps:
             at = self.i[lanes]
             lanes = lanes[at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else
                           np.isin(at, self.save_list)]
-        for k in lanes.tolist():
-            ik = int(self.i[k])
-            self.saved[k][0].append(self.t0 + ik * cell if ik < self.end else self.t1)
-            self.saved[k][1].append(run.y[self.lane_members[k]].copy())
+        at = self.i[lanes]
+        self.saved.append((lanes, np.where(at < self.end, self.t0 + at * cell, self.t1), run.y[self.lane_members[lanes]]))
         self.n_saved += lanes.size
         run.check_saves(self.n_saved // self.lanes, growing=True)
         reached = float(np.min(self.i)) * cell           # exact: cell = T / 2^L, and end * cell == T
@@ -266,14 +265,20 @@ class _TreeSteps:
     def finish(self):
         """``(times, states, stats)``: one time axis for shared steps and for save times; per member otherwise."""
         run = self.run
-        if self.shared or not self.save_all:
-            times = np.array(self.saved[0][0])
-            states = np.concatenate([np.stack(ys, axis=-2) if ys else np.empty((len(m), 0, run.e))
-                                     for (_, ys), m in zip(self.saved, self.lane_members)])
+        lanes, times, states = (np.concatenate(v) for v in zip(*self.saved)) if self.saved else (
+            np.empty(0, dtype=np.int64), np.empty(0), np.empty((0,) + self.lane_members.shape[1:] + (run.e,)))
+        order = np.argsort(lanes, kind="stable")           # lane by lane, in the order saved
+        times, states = times[order], states[order]
+        counts = np.bincount(lanes, minlength=self.lanes)
+        if self.shared or not self.save_all:               # every lane saved at the same times
+            S = int(counts[0]) if counts.size else 0
+            times = times[:S]
+            states = states.reshape((self.lanes, S) + states.shape[1:]).swapaxes(1, 2).reshape(-1, S, run.e)
         else:          # each member its own step ends; shorter rows repeat their last time (t1) and state
-            K = max(len(ts) for ts, _ in self.saved)
-            times = np.array([ts + ts[-1:] * (K - len(ts)) for ts, _ in self.saved]).reshape(run.batch + (K,))
-            states = np.stack([np.concatenate(ys + ys[-1:] * (K - len(ys))) for _, ys in self.saved])
+            K = int(counts.max())
+            first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+            idx = first[:, None] + np.minimum(np.arange(K), counts[:, None] - 1)
+            times, states = times[idx].reshape(run.batch + (K,)), states[idx][:, :, 0]
         stats = {k: (int(v[0]) if self.shared else v.reshape(run.batch))
                  for k, v in (("accepted", self.accepted), ("rejected", self.rejected), ("at_dt_min", self.at_min))}
         stats.update(step_control=repr(self.control), n_steps=stats["accepted"], shared_steps=self.shared)
