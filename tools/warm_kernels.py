@@ -23,9 +23,10 @@ xdist workers may compile the same kernel). ``SUITE_PROFILE`` (``tests/conftest.
 
 Usage: ``python tools/warm_kernels.py [--part roughpaths|mechanics] [--more]`` (prints the time each family
 took).
-``tools/setup_env.sh`` runs the two parts in two processes at once, one on each core. The few kernels both
-reach (the Brownian driver's random streams) may be compiled by both; numba replaces its cache files
-atomically, so the worst case is an entry compiled once more on a later first call.
+``tools/setup_env.sh`` runs the two parts in two processes at once, one on each core (before ``./test.sh``), or
+one after the other in a background process while ``./run.sh``'s main job compiles its own kernels. The few
+kernels two processes reach (the Brownian driver's random streams) may be compiled by both; numba replaces its
+cache files atomically, so the worst case is an entry compiled once more on a later first call.
 """
 
 from __future__ import annotations
