@@ -121,7 +121,7 @@ def _velocity(wb, out, lin, f, theta, qs, mts, bc, yes):
     affine_rows(g, mts[3], mts[0], mts[1], mts[2], _rows(wb, _T2), out, bc, yes)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _tile3(dX, dXX, area, lo, bc, k0, kc, xt):
     """``xt[kk, :, p]`` = ``dX_0, dX_1, dX_2`` and (with the area) ``A_01, A_02, A_12``, ``A = ½(XX − XXᵀ)``, of member
     ``lo + p`` at step ``k0 + kk`` (member by member: the driver's arrays are read in order)."""
@@ -137,7 +137,7 @@ def _tile3(dX, dXX, area, lo, bc, k0, kc, xt):
                 xt[kk, 5, p] = 0.5 * (dXX[lo + p, k, 1, 2] - dXX[lo + p, k, 2, 1])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _eta3(x, wb, bc, xi, brk):
     """Rows ``_E`` = the stochastic velocities Σ_r dX_r ξ_r + Σ_{i<j} A_ij [ξ_i, ξ_j] of one step of the tile ``x``
     (6, B): the sums of :func:`._soa_rows.eta_rows` for three noise components, in its order. Without the area
@@ -194,7 +194,7 @@ def _sigma(wb, heun, pred, dt, c, l1, l2, bc):
         _set6(wb, _A1, p, (m0, m1, m2, m3, m4, m5))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _theta_max(wb, lim, big, bc):
     """``big[p]`` = not θ_p ≤ ``lim`` (NaN too: the scalar path diagnoses it); returns (their number, the largest
     θ of the others)."""
@@ -210,7 +210,7 @@ def _theta_max(wb, lim, big, bc):
     return nbig, thmax
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _accept(wb, big, bc):
     """μ = the Taylor sum (rows ``_A1``) for every member that is not ``big``."""
     for i in range(6):
@@ -218,7 +218,7 @@ def _accept(wb, big, bc):
             wb[_MU + i * B + p] = wb[_A1 + i * B + p] if not big[p] else wb[_MU + i * B + p]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _taylor_degrees(wb, inv1, inv2, two, l1, l2, bc):
     """Taylor degrees r and (with ``two``) r + 1: term ← ad*_σ(term) · ``inv`` (1 / r, 1 / (r + 1)), sum ← sum + term
     where the member's θ exceeds the level of the degree (the generic kernel's ``select``)."""
