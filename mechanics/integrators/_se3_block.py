@@ -264,9 +264,10 @@ def _kernel(full: bool):
         One compiled kernel for both schemes (the scheme is a value: Lie–Euler merely skips the predictor), so the
         heavy top's second scheme compiles nothing. Compile cost: the heavy top's first Lie–Heun solve with an empty
         numba cache takes 6.5 s of CPU (this kernel and the passes it calls; with the generic kernel it replaces:
-        6.9 s), its first Lie–Euler solve 6.7 s (6.7 s); minima of 3-4 fresh processes at load 3-6. The passes are
-        compiled functions of their own, called with flags as values rather than literals (numba would compile a
-        variant per literal). The heavy top no longer shares the generic kernel's compiled variants with the other
+        6.9 s), its first Lie–Euler solve 6.7 s (6.7 s); minima of 3-4 fresh processes at load 3-6. The passes called
+        twice (:func:`_velocity`, :func:`_sigma`) are compiled functions of their own, called with flags as values
+        rather than literals (numba would compile a variant per literal); those called once are inlined (as kernels
+        of their own they compiled ~0.5 s longer; inlining ``_sigma`` too cost 1.5-2 s more). The heavy top no longer shares the generic kernel's compiled variants with the other
         algebras, so a process that solves both compiles both: ``tools/warm_kernels.py --part mechanics --more``
         took 57 s of CPU before, 68-79 s with this kernel (two pairs of fresh processes, load 3-6).
         """
