@@ -61,31 +61,38 @@ KBLOCK = 16
 
 
 @njit(cache=True, inline="always")
-def _row(y, yo, x, xo, c, z, zo, n, tail):
+def _row(y, yo, x, xo, c, z, zo, n):
     """``y[yo + p] = x[xo + p] * c + z[zo + p]`` for ``p < n``, in whole packed rows of LANES.
 
-    Without ``tail`` the last packed row runs past ``n`` by up to ``LANES - 1`` entries: it reads what
-    follows ``x`` and ``z`` and writes garbage after ``y[yo + n - 1]``. The callers keep that harmless:
-    ``y`` is never ``z`` nor ``x`` (no update in place), rows are written in increasing order (row
-    ``q + 1``, written next, overwrites what row ``q`` spilled), and every region ends in ``LANES``
-    entries of slack. With ``tail`` the last ``n mod LANES`` entries go one at a time instead (nothing
-    is read or written past ``n``: safe in place, ``y`` is ``z``). The same operations either way.
+    The last packed row runs past ``n`` by up to ``LANES - 1`` entries: it reads what follows ``x`` and
+    ``z`` and writes garbage after ``y[yo + n - 1]``. The callers keep that harmless: ``y`` is never
+    ``z`` nor ``x`` (no update in place), rows are written in increasing order (row ``q + 1``, written
+    next, overwrites what row ``q`` spilled), and every region ends in ``LANES`` entries of slack.
     """
     L = np.uint64(LANES)
-    nw = n - n % L if tail else n + (L - n % L) % L
     cv = vsplat(c)
-    for p in range(np.uint64(0), nw, L):
+    for p in range(np.uint64(0), n, L):
         vstore(y, yo + p, vadd(vmul(vload(x, xo + p), cv), vload(z, zo + p)))
-    for p in range(nw, n):
+
+
+@njit(cache=True, inline="always")
+def _row_tail(y, yo, x, xo, c, z, zo, n):
+    """:func:`_row` writing nothing past ``n`` (the last ``n mod LANES`` entries one at a time): safe in
+    place (``y`` is ``z``)."""
+    L = np.uint64(LANES)
+    n1 = n - n % L
+    cv = vsplat(c)
+    for p in range(np.uint64(0), n1, L):
+        vstore(y, yo + p, vadd(vmul(vload(x, xo + p), cv), vload(z, zo + p)))
+    for p in range(n1, n):
         y[yo + p] = x[xo + p] * c + z[zo + p]
 
 
 @njit(cache=True, inline="always")
-def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to, tail):
+def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
     """Levels ``1..m-1`` advance one segment, and ``tb[to:to + d^(m-1)] = T^m_{m-1}`` (old levels).
 
-    The lower levels are double-buffered in ``lw``: read at ``so``, the new ones written at ``sn``; with
-    ``tail`` the rows end one entry at a time (:func:`_row`) and ``so == sn`` may update them in place.
+    The lower levels are double-buffered in ``lw``: read at ``so``, the new ones written at ``sn``.
     Every level's Horner chain at once, level ``j`` of ``S`` read once: ``C^l_1 = D/l + S_1`` and
     ``C^l_j = C^l_{j-1} ⊗ D/(l - j + 1) + S_j`` for the levels ``l > j`` (``cb``: two regions of
     ``hs`` entries per ``l``), then ``S_j <- S_j + C^j_{j-1} ⊗ D``: the operations of
@@ -124,13 +131,52 @@ def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to, tail):
                 c = delta[q] * fac[lev - j + 1]
                 src = (np.uint64(2 * lev) + rd) * uh
                 dst = (np.uint64(2 * lev) + wr) * uh + base
-                _row(cb, dst, cb, src, c, lw, so + row, size, tail)
+                _row(cb, dst, cb, src, c, lw, so + row, size)
             if top:
                 c = delta[q] * fac[2]
                 src = (np.uint64(2 * m) + rd) * uh
-                _row(tb, to + base, cb, src, c, lw, so + row, size, tail)
+                _row(tb, to + base, cb, src, c, lw, so + row, size)
             src = (np.uint64(2 * j) + rd) * uh
-            _row(lw, sn + row, cb, src, delta[q], lw, so + row, size, tail)
+            _row(lw, sn + row, cb, src, delta[q], lw, so + row, size)
+        size *= ud
+
+
+@njit(cache=True, inline="always")
+def _fused_inplace(s, delta, d, m, offsets, fac, cb, hs, tb, to):
+    """:func:`_fused_d` with the lower levels updated in place in ``s`` (the same operations in the same
+    order: a row of level ``j`` is read, by the chains and by its own update, before it is written), its
+    rows ending one entry at a time (:func:`_row_tail`)."""
+    ud = np.uint64(d)
+    uh = np.uint64(hs)
+    for lev in range(2, m):
+        inv = fac[lev]
+        o = np.uint64(2 * lev + 1) * uh
+        for i in range(ud):
+            cb[o + i] = delta[i] * inv + s[i]
+    inv = fac[m]
+    o = np.uint64(to) if m == 2 else np.uint64(2 * m + 1) * uh
+    dst = tb if m == 2 else cb
+    for i in range(ud):
+        dst[o + i] = delta[i] * inv + s[i]
+    for i in range(ud):
+        s[i] += delta[i]
+    size = ud
+    for j in range(2, m):
+        oj = np.uint64(offsets[j])
+        rd = np.uint64((j + 1) % 2)
+        wr = np.uint64(j % 2)
+        top = j == m - 1
+        for q in range(ud):
+            base = q * size
+            row = oj + base
+            for lev in range(j + 1, m if top else m + 1):
+                c = delta[q] * fac[lev - j + 1]
+                _row_tail(cb, (np.uint64(2 * lev) + wr) * uh + base, cb, (np.uint64(2 * lev) + rd) * uh, c, s,
+                          row, size)
+            if top:
+                _row_tail(tb, np.uint64(to) + base, cb, (np.uint64(2 * m) + rd) * uh, delta[q] * fac[2], s, row,
+                          size)
+            _row_tail(s, row, cb, (np.uint64(2 * j) + rd) * uh, delta[q], s, row, size)
         size *= ud
 
 
@@ -275,7 +321,7 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, 
                 v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
                 dl[kk * ud + i] = v
                 delta[i] = v
-            _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * n, False)
+            _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
             so, sn = sn, so
         _top_sweep(s, ok, n, d, tb, dl, nk, w)
     for r in range(ok):
@@ -284,13 +330,12 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, 
 
 @njit(cache=True, inline="always")
 def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w):
-    """:func:`_unit_d` with the lower levels updated in place in ``s`` (rows end one entry at a time)."""
+    """:func:`_unit_d` with the lower levels updated in place in ``s`` (:func:`_fused_inplace`)."""
     ud = np.uint64(d)
     n = np.uint64(d ** (m - 1))
     ok = offsets[m]
     for r in range(s.shape[0]):
         s[r] = 0.0
-    z = np.uint64(0)
     for t0 in range(k0, k1, KBLOCK):
         nk = min(KBLOCK, k1 - t0)
         for k in range(nk):
@@ -299,7 +344,7 @@ def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w
                 v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
                 dl[kk * ud + i] = v
                 delta[i] = v
-            _fused_d(s, z, z, delta, d, m, offsets, fac, buf, hs, tb, kk * n, True)
+            _fused_inplace(s, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
         _top_sweep(s, ok, n, d, tb, dl, nk, w)
 
 
@@ -320,6 +365,9 @@ def block_key(d: int, m: int) -> tuple:
     against 749-780 double-buffered (the kernel before the double buffer: 726-784); a lone 10 x 4 path at
     depth 8 183-222 us against 231-273 (before: 194-245); d = 4 at depth 8, 1 x 257 points 4.9-5.1 ms
     against 5.2-5.4. d = 4 at depths 5 and 6 stays double-buffered (in place 5-50 % slower on 17-257 points).
+    A variant compiles one of the two (cold, empty cache, CPU with the import, interleaved with the code
+    before: (6, 4) 5.4-5.9 s against 5.3-5.6, d = 4 at depth 8 5.4-5.9 against 6.1-6.3, the run-time
+    variant unchanged).
     """
     if (d, m) == (6, 4):
         return 6, 4, True
