@@ -365,9 +365,9 @@ def block_key(d: int, m: int) -> tuple:
     against 749-780 double-buffered (the kernel before the double buffer: 726-784); a lone 10 x 4 path at
     depth 8 183-222 us against 231-273 (before: 194-245); d = 4 at depth 8, 1 x 257 points 4.9-5.1 ms
     against 5.2-5.4. d = 4 at depths 5 and 6 stays double-buffered (in place 5-50 % slower on 17-257 points).
-    A variant compiles one of the two (cold, empty cache, CPU with the import, interleaved with the code
-    before: (6, 4) 5.4-5.9 s against 5.3-5.6, d = 4 at depth 8 5.4-5.9 against 6.1-6.3, the run-time
-    variant unchanged).
+    A variant compiles one of the two (cold, empty cache, CPU with the import, two runs interleaved with
+    the code before: (6, 4) 5.9 and 5.4 s against 5.6 and 5.3, d = 4 at depth 8 6.0 and 5.4 against 6.2
+    and 6.1, the run-time variant, whose code is unchanged, 5.7 and 5.2 against 5.3 and 6.0).
     """
     if (d, m) == (6, 4):
         return 6, 4, True
