@@ -29,6 +29,9 @@ the top level's rows are swept in a zero-padded scratch, four rows at a time (:f
 Before, those ends were scalar loops, and the top level's a chain of dependent adds per entry:
 d = 6, 7, 10, 14 at depth 3 took 127, 148, 198, 437 ns a segment, now 68, 95, 148, 298 (one thread,
 16 x 256 points; pysiglib 4.0 ``n_jobs=1`` 61, 89, 161, 399).
+The (6, 4) variant and d = 4 from depth 7 update the lower levels in place instead (rows end one entry
+at a time; no second copy to zero and to copy out), which is faster there (:func:`block_key`); the
+same bits.
 
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
@@ -70,6 +73,19 @@ def _row(y, yo, x, xo, c, z, zo, n):
     cv = vsplat(c)
     for p in range(np.uint64(0), n, L):
         vstore(y, yo + p, vadd(vmul(vload(x, xo + p), cv), vload(z, zo + p)))
+
+
+@njit(cache=True, inline="always")
+def _row_tail(y, yo, x, xo, c, z, zo, n):
+    """:func:`_row` writing nothing past ``n`` (the last ``n mod LANES`` entries one at a time): safe in
+    place (``y`` is ``z``)."""
+    L = np.uint64(LANES)
+    n1 = n - n % L
+    cv = vsplat(c)
+    for p in range(np.uint64(0), n1, L):
+        vstore(y, yo + p, vadd(vmul(vload(x, xo + p), cv), vload(z, zo + p)))
+    for p in range(n1, n):
+        y[yo + p] = x[xo + p] * c + z[zo + p]
 
 
 @njit(cache=True, inline="always")
@@ -122,6 +138,45 @@ def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
                 _row(tb, to + base, cb, src, c, lw, so + row, size)
             src = (np.uint64(2 * j) + rd) * uh
             _row(lw, sn + row, cb, src, delta[q], lw, so + row, size)
+        size *= ud
+
+
+@njit(cache=True, inline="always")
+def _fused_inplace(s, delta, d, m, offsets, fac, cb, hs, tb, to):
+    """:func:`_fused_d` with the lower levels updated in place in ``s`` (the same operations in the same
+    order: a row of level ``j`` is read, by the chains and by its own update, before it is written), its
+    rows ending one entry at a time (:func:`_row_tail`)."""
+    ud = np.uint64(d)
+    uh = np.uint64(hs)
+    for lev in range(2, m):
+        inv = fac[lev]
+        o = np.uint64(2 * lev + 1) * uh
+        for i in range(ud):
+            cb[o + i] = delta[i] * inv + s[i]
+    inv = fac[m]
+    o = np.uint64(to) if m == 2 else np.uint64(2 * m + 1) * uh
+    dst = tb if m == 2 else cb
+    for i in range(ud):
+        dst[o + i] = delta[i] * inv + s[i]
+    for i in range(ud):
+        s[i] += delta[i]
+    size = ud
+    for j in range(2, m):
+        oj = np.uint64(offsets[j])
+        rd = np.uint64((j + 1) % 2)
+        wr = np.uint64(j % 2)
+        top = j == m - 1
+        for q in range(ud):
+            base = q * size
+            row = oj + base
+            for lev in range(j + 1, m if top else m + 1):
+                c = delta[q] * fac[lev - j + 1]
+                _row_tail(cb, (np.uint64(2 * lev) + wr) * uh + base, cb, (np.uint64(2 * lev) + rd) * uh, c, s,
+                          row, size)
+            if top:
+                _row_tail(tb, np.uint64(to) + base, cb, (np.uint64(2 * m) + rd) * uh, delta[q] * fac[2], s, row,
+                          size)
+            _row_tail(s, row, cb, (np.uint64(2 * j) + rd) * uh, delta[q], s, row, size)
         size *= ud
 
 
@@ -273,24 +328,57 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, 
         s[r] = lw[so + r]
 
 
+@njit(cache=True, inline="always")
+def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w):
+    """:func:`_unit_d` with the lower levels updated in place in ``s`` (:func:`_fused_inplace`)."""
+    ud = np.uint64(d)
+    n = np.uint64(d ** (m - 1))
+    ok = offsets[m]
+    for r in range(s.shape[0]):
+        s[r] = 0.0
+    for t0 in range(k0, k1, KBLOCK):
+        nk = min(KBLOCK, k1 - t0)
+        for k in range(nk):
+            kk = np.uint64(k)
+            for i in range(ud):
+                v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
+                dl[kk * ud + i] = v
+                delta[i] = v
+            _fused_inplace(s, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
+        _top_sweep(s, ok, n, d, tb, dl, nk, w)
+
+
 def block_key(d: int, m: int) -> tuple:
-    """``(D, M)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time).
+    """``(D, M, T)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time),
+    and whether its lower levels are updated in place (``T``).
 
     Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
     (d, m) = (8, 3) (the lower levels 40 against 57 ns a segment), (8, 4) and (6, 4) (cells (d) and (h)
     of ``benchmarks/bench_signatures.py``: the run-time variant measured 10 % and 15-25 % slower there),
     and d = 4 at any depth. Every other width runs the run-time variant: (20, 3) had a variant of its
-    own until the run-time one came within 5-8 % of it (cell (e)). Each variant is its own kernel, compiled on first use (a
-    few seconds of CPU, then cached), so a call compiles only the one it runs.
+    own until the run-time one came within 5-8 % of it (cell (e)). Each variant is its own kernel,
+    compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
+
+    In place (:func:`_unit_inplace`, the same bits): (6, 4) and d = 4 from depth 7. There the double
+    buffer's second copy of the lower levels, its zeroing and its copy-out cost more than the rows that
+    end one entry at a time: measured (one thread, interleaved) 16 x 256 points at (6, 4) 663-692 us
+    against 749-780 double-buffered (the kernel before the double buffer: 726-784); a lone 10 x 4 path at
+    depth 8 183-222 us against 231-273 (before: 194-245); d = 4 at depth 8, 1 x 257 points 4.9-5.1 ms
+    against 5.2-5.4. d = 4 at depths 5 and 6 stays double-buffered (in place 5-50 % slower on 17-257 points).
+    A variant compiles one of the two (cold, empty cache, CPU with the import, two runs interleaved with
+    the code before: (6, 4) 5.9 and 5.4 s against 5.6 and 5.3, d = 4 at depth 8 6.0 and 5.4 against 6.2
+    and 6.1, the run-time variant, whose code is unchanged, 5.7 and 5.2 against 5.3 and 6.0).
     """
-    if (d, m) in ((8, 3), (8, 4), (6, 4)):
-        return d, m
-    return (4, 0) if d == 4 else (0, 0)
+    if (d, m) == (6, 4):
+        return 6, 4, True
+    if (d, m) in ((8, 3), (8, 4)):
+        return d, m, False
+    return (4, 0, m >= 7) if d == 4 else (0, 0, False)
 
 
 @variants
-def _block_units_kernel(D: int, M: int):
-    """The compiled :func:`block_units` of variant ``(D, M)`` (:func:`block_key`)."""
+def _block_units_kernel(D: int, M: int, TAIL: bool):
+    """The compiled :func:`block_units` of variant ``(D, M, TAIL)`` (:func:`block_key`)."""
 
     @njit(**_NOGIL)
     def block_units_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
@@ -302,10 +390,10 @@ def _block_units_kernel(D: int, M: int):
         L = LANES
         hs = (d ** max(mm - 2, 1) + 2 * L - 1) // L * L         # a chain's region, with slack
         buf = np.empty((2 * mm + 2) * hs)                       # the chains C^l_j (_fused_d)
-        for r in range(2 * mm + 2):
+        for r in range(0 if TAIL else 2 * mm + 2):              # (rows in place read no further)
             for j in range(mm - 1):
                 buf[r * hs + d ** j:r * hs + d ** j + L] = 0.0
-        ls = (offsets[mm] + 2 * L - 1) // L * L                 # the lower levels, with slack
+        ls = 0 if TAIL else (offsets[mm] + 2 * L - 1) // L * L  # the lower levels, with slack (or in s)
         lw = np.empty(2 * ls)
         lw[offsets[mm]:ls] = 0.0
         lw[ls + offsets[mm]:] = 0.0
@@ -324,7 +412,10 @@ def _block_units_kernel(D: int, M: int):
         for k in range(1, mm + 1):
             fac[k] = 1.0 / k
         for u in range(lo, hi):
-            _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls)
+            if TAIL:
+                _unit_inplace(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w)
+            else:
+                _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls)
 
     return block_units_variant
 
