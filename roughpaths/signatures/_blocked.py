@@ -32,6 +32,11 @@ d = 6, 7, 10, 14 at depth 3 took 127, 148, 198, 437 ns a segment, now 68, 95, 14
 The (6, 4) variant and d = 4 from depth 7 update the lower levels in place instead (rows end one entry
 at a time; no second copy to zero and to copy out), which is faster there (:func:`block_key`); the
 same bits.
+Where ``d^(m-1)`` is a multiple of 512 floats, the block's rows are ``LANES`` entries more apart
+(:func:`_tb_stride`; 64 bytes a row, at most 1 KiB a call): 4 KiB apart, the sweep ran up to 12 % slower in
+some processes (memory placement) than in others. Measured one thread, old and new interleaved in one
+process, 8 processes: 64 x 256 points, d = 8 depth 4 6.1-7.1 ms against 6.4-7.9 (median ratio 0.95,
+0.88-1.01), 16 x 256, d = 16 depth 4 0.87-0.98; the same bits (only the addresses move).
 
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
@@ -181,8 +186,9 @@ def _fused_inplace(s, delta, d, m, offsets, fac, cb, hs, tb, to):
 
 
 @njit(cache=True, inline="always")
-def _top_sweep(s, ok, n, d, tb, dl, nk, w):
-    """``S_m[p + n q] += sum_k tb[k n + p] dl[k d + q]``, the products added one segment after another.
+def _top_sweep(s, ok, n, d, tb, ts, dl, nk, w):
+    """``S_m[p + n q] += sum_k tb[k ts + p] dl[k d + q]``, the products added one segment after another
+    (``tb``'s rows ``ts >= n`` apart: :func:`_tb_stride`).
 
     The first ``n - n mod 2 LANES`` entries of every row go in tiles of 2 packed rows x 4 rows ``q``:
     eight independent sums advance together, and each packed row of ``tb`` loaded serves four
@@ -199,6 +205,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
     un = np.uint64(n)
     ud = np.uint64(d)
     unk = np.uint64(nk)
+    uts = np.uint64(ts)
     n2 = un - un % (2 * L)
     q4 = ud - ud % np.uint64(4)
     for p in range(np.uint64(0), n2, 2 * L):            # tiles of 2 packed rows x 4 rows q: 8 sums at once
@@ -213,7 +220,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             e0 = vload(s, r + 3 * un)
             e1 = vload(s, r + 3 * un + L)
             for k in range(unk):
-                t = k * un + p
+                t = k * uts + p
                 t0 = vload(tb, t)
                 t1 = vload(tb, t + L)
                 e = k * ud + q
@@ -248,7 +255,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             a3 = vload(s, r + 3 * L)
             for k in range(unk):
                 c = vsplat(dl[k * ud + q])
-                t = k * un + p
+                t = k * uts + p
                 a0 = vadd(a0, vmul(vload(tb, t), c))
                 a1 = vadd(a1, vmul(vload(tb, t + L), c))
                 a2 = vadd(a2, vmul(vload(tb, t + 2 * L), c))
@@ -263,7 +270,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             a1 = vload(s, r + L)
             for k in range(unk):
                 c = vsplat(dl[k * ud + q])
-                t = k * un + p
+                t = k * uts + p
                 a0 = vadd(a0, vmul(vload(tb, t), c))
                 a1 = vadd(a1, vmul(vload(tb, t + L), c))
             vstore(s, r, a0)
@@ -284,7 +291,7 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
             a2 = vload(w, r + 2 * wn)
             a3 = vload(w, r + 3 * wn)
             for k in range(unk):
-                t = vload(tb, k * un + p)
+                t = vload(tb, k * uts + p)
                 e = k * ud + q
                 a0 = vadd(a0, vmul(t, vsplat(dl[e])))
                 a1 = vadd(a1, vmul(t, vsplat(dl[e + 1])))
@@ -301,7 +308,15 @@ def _top_sweep(s, ok, n, d, tb, dl, nk, w):
 
 
 @njit(cache=True, inline="always")
-def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls):
+def _tb_stride(n):
+    """The distance between rows of ``n`` entries of the block ``tb``: ``n``, or ``n + LANES`` when ``n`` is a
+    multiple of 512 floats (rows 4 KiB apart share their L1 sets and the low address bits that loads are
+    checked against pending stores by)."""
+    return n + LANES if n % 512 == 0 else n
+
+
+@njit(cache=True, inline="always")
+def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, ts, dl, delta, w, lw, ls):
     """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 2``); the
     lower levels run in ``lw`` (two copies ``ls`` apart) and are copied into ``s`` at the end."""
     ud = np.uint64(d)
@@ -321,15 +336,15 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w, lw, 
                 v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
                 dl[kk * ud + i] = v
                 delta[i] = v
-            _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
+            _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * np.uint64(ts))
             so, sn = sn, so
-        _top_sweep(s, ok, n, d, tb, dl, nk, w)
+        _top_sweep(s, ok, n, d, tb, ts, dl, nk, w)
     for r in range(ok):
         s[r] = lw[so + r]
 
 
 @njit(cache=True, inline="always")
-def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w):
+def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, ts, dl, delta, w):
     """:func:`_unit_d` with the lower levels updated in place in ``s`` (:func:`_fused_inplace`)."""
     ud = np.uint64(d)
     n = np.uint64(d ** (m - 1))
@@ -344,8 +359,8 @@ def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, dl, delta, w
                 v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
                 dl[kk * ud + i] = v
                 delta[i] = v
-            _fused_inplace(s, delta, d, m, offsets, fac, buf, hs, tb, kk * n)
-        _top_sweep(s, ok, n, d, tb, dl, nk, w)
+            _fused_inplace(s, delta, d, m, offsets, fac, buf, hs, tb, kk * np.uint64(ts))
+        _top_sweep(s, ok, n, d, tb, ts, dl, nk, w)
 
 
 def block_key(d: int, m: int) -> tuple:
@@ -402,9 +417,10 @@ def _block_units_kernel(D: int, M: int, TAIL: bool):
             most = max(most, uhi[u] - ulo[u])
         rows = min(KBLOCK, most)
         n1 = d ** (mm - 1)
-        tb = np.empty(rows * n1 + L)                            # a short path's block: its segments
-        for r in range(1, rows + 1):
-            tb[r * n1:r * n1 + L] = 0.0
+        ts = _tb_stride(n1)
+        tb = np.empty(rows * ts + L)                            # a short path's block: its segments
+        for r in range(rows):
+            tb[r * ts + n1:r * ts + n1 + L] = 0.0
         w = np.zeros((d + 3) * 4 * LANES)                       # the rows' ends (_top_sweep)
         dl = np.zeros(KBLOCK * d + 3)
         delta = np.empty(d)
@@ -413,9 +429,11 @@ def _block_units_kernel(D: int, M: int, TAIL: bool):
             fac[k] = 1.0 / k
         for u in range(lo, hi):
             if TAIL:
-                _unit_inplace(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w)
+                _unit_inplace(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, ts, dl, delta,
+                              w)
             else:
-                _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, dl, delta, w, lw, ls)
+                _unit_d(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, tb, ts, dl, delta, w, lw,
+                        ls)
 
     return block_units_variant
 
