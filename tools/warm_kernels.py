@@ -126,6 +126,9 @@ def warm_more_coadjoint() -> None:
         wild = np.ones((2, system.dim))
         wild[1] *= 1e8                 # a step past the vectorised exponential: the rare-step kernels
         for method in (LieEuler(), LieHeun(), ImplicitMidpoint()):
+            # a tame solve first: a process decides on its first solve which variant a kernel starts with
+            # (._soa_rows.starts_full), so this compiles the vectorised one, and the wild solve the other
+            solve(system, X, np.ones((2, system.dim)), method)
             solve(system, X, wild, method, on_failure="mask")
     rng = np.random.default_rng(0)
     times = np.linspace(0.0, 0.02, 3)
