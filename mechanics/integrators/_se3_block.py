@@ -267,8 +267,8 @@ def _kernel(full: bool):
         6.9 s), its first Lie–Euler solve 6.7 s (6.7 s); minima of 3-4 fresh processes at load 3-6. The passes called
         twice (:func:`_velocity`, :func:`_sigma`) are compiled functions of their own, called with flags as values
         rather than literals (numba would compile a variant per literal); those called once are inlined (as kernels
-        of their own they compiled ~0.5 s longer; inlining ``_sigma`` too cost 1.5-2 s more). The heavy top no longer shares the generic kernel's compiled variants with the other
-        algebras, so a process that solves both compiles both: ``tools/warm_kernels.py --part mechanics --more``
+        of their own they compiled ~0.5 s longer; inlining ``_sigma`` too cost 1.5-2 s more). The heavy top no
+        longer shares the generic kernel's compiled variants with the other algebras, so a process that solves both compiles both: ``tools/warm_kernels.py --part mechanics --more``
         took 57 s of CPU before, 68-79 s with this kernel (two pairs of fresh processes, load 3-6).
         """
         n = 6

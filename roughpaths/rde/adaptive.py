@@ -241,11 +241,11 @@ class _TreeSteps:
         run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
         self.accepted[lanes] += 1
         self.i[lanes] = self.j[lanes]
-        if not self.save_all:
-            at = self.i[lanes]
-            lanes = lanes[at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else
-                          np.isin(at, self.save_list)]
         at = self.i[lanes]
+        if not self.save_all:
+            keep = at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else \
+                np.isin(at, self.save_list)
+            lanes, at = lanes[keep], at[keep]
         self.saved.append((lanes, np.where(at < self.end, self.t0 + at * cell, self.t1), run.y[self.lane_members[lanes]]))
         self.n_saved += lanes.size
         run.check_saves(self.n_saved // self.lanes, growing=True)
