@@ -15,7 +15,8 @@ plain numpy calls and can be checked against them):
   into ``out[p]``; successive calls continue the streams, so the numbers do not depend on how a
   stream is cut into calls. Fast path: the ``SeedSequence`` hashing, the ``PCG64`` seeding and
   stepping (128-bit LCG, XSL-RR output) and the ziggurat run in one numba kernel over all paths
-  (no Python per path; seeding costs ~0.2 µs per stream instead of ~35 µs through numpy). Each
+  (no Python per path; seeding costs ~0.2 µs per stream instead of ~35 µs through numpy; up to
+  :data:`_NUMPY_SEEDING` streams are seeded by numpy, which costs less than compiling or loading the kernel). Each
   path's words are generated first and then turned into normals by a branch-free ziggurat loop
   (:func:`_pcg64_fill`): about 5 ns per normal here, against 11 ns for numpy's
   ``standard_normal`` on one stream and 11 ns for the one-call-per-normal version it replaced.
@@ -301,6 +302,24 @@ def stream_prefix(seed_seq: np.random.SeedSequence) -> np.ndarray:
 
 
 _FAST_OK: list = []
+#: Streams up to this many are seeded by numpy itself (about 35 µs a stream): a small batch, what first calls and
+#: tests use, then never compiles the seeding kernel (:func:`_stream_states`, about 0.5 s of CPU), and even
+#: loading the cached kernel in a new process costs more than numpy's seeding of 32 streams.
+_NUMPY_SEEDING = 32
+_SEEDING_CHECKED: list = []
+_MASK64 = (1 << 64) - 1
+
+
+def _numpy_states(seed_seq: np.random.SeedSequence, keys) -> np.ndarray:
+    """PCG64 states ``(P, 4)`` (state hi, lo, increment hi, lo) of the streams of ``keys``, seeded by numpy."""
+    states = np.empty((len(keys), 4), dtype=np.uint64)
+    for j, k in enumerate(keys):
+        st = np.random.PCG64(np.random.SeedSequence(
+            seed_seq.entropy, spawn_key=tuple(seed_seq.spawn_key) + tuple(int(v) for v in k),
+            pool_size=seed_seq.pool_size)).state["state"]
+        states[j] = (st["state"] >> 64, st["state"] & _MASK64, st["inc"] >> 64, st["inc"] & _MASK64)
+    return states
+
 
 
 def _fast_streams_ok() -> bool:
@@ -361,28 +380,29 @@ class PathStreams:
 
     def _fast_states(self) -> np.ndarray:
         ss = self._seed_seq
-        run = _entropy_words(ss)
-        base = [w for v in ss.spawn_key for w in _uint32_words(int(v))]
         keys = self._keys
         P = self.n_streams
-        if P == 0:
-            return np.empty((0, 4), dtype=np.uint64)
+        if P <= _NUMPY_SEEDING:
+            return _numpy_states(ss, keys)
+        run = _entropy_words(ss)
+        base = [w for v in ss.spawn_key for w in _uint32_words(int(v))]
         kint = np.asarray(keys, dtype=np.int64) if keys.dtype != object else None
+        states = np.empty((P, 4), dtype=np.uint64)
         if kint is not None and kint.ndim == 2 and kint.min(initial=0) >= 0 and kint.max(initial=0) < 2**32:
             # the common case: every key element is one 32-bit word, the entropy rows have one length
             prefix = stream_prefix(ss)
             ent = np.empty((P, prefix.size + kint.shape[1]), dtype=np.uint32)
             ent[:, :prefix.size] = prefix
             ent[:, prefix.size:] = kint.astype(np.uint32)
-            states = np.empty((P, 4), dtype=np.uint64)
             _stream_states(ent, states)
         else:
-            states = np.empty((P, 4), dtype=np.uint64)
             for j, k in enumerate(keys):
                 spawn = base + [w for v in k for w in _uint32_words(int(v))]
                 r = run + [0] * max(0, 4 - len(run))    # zero padding == numpy's hashmix(0) fill
                 _stream_states(np.array([r + spawn], dtype=np.uint32), states[j:j + 1])
-        return states
+        if not _SEEDING_CHECKED:                        # once a process: the kernel's first row against numpy's
+            _SEEDING_CHECKED.append(np.array_equal(states[:1], _numpy_states(ss, keys[:1])))
+        return states if _SEEDING_CHECKED[0] else _numpy_states(ss, keys)
 
     def fill(self, out: np.ndarray) -> None:
         """Write the next ``out.shape[1]`` normals of stream ``p`` into ``out[p]`` (``out`` float64 ``(P, n)``)."""

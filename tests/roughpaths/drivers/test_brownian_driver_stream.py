@@ -231,3 +231,14 @@ def test_error_controlled_methods_refuse_substeps_and_other_methods_refuse_an_er
         BrownianDriver(2, seed=1, dt=0.1, n_steps=3, levy_area="mrongowius-rossler", substeps=4)
     with pytest.raises(ValueError, match="levy_area_error applies"):
         BrownianDriver(2, seed=1, dt=0.1, n_steps=3, levy_area="davie", levy_area_error=1e-3)
+
+
+@pytest.mark.parametrize("n_keys", [3, 40])      # numpy's own seeding (a small batch) and the seeding kernel
+def test_stream_states_are_numpy_pcg64_states(n_keys):
+    ss = np.random.SeedSequence(2**70 + 9, spawn_key=(5,))
+    keys = np.stack([np.arange(n_keys) * 7919, np.arange(n_keys) % 3], axis=1)
+    states = PathStreams(ss, keys).states
+    for j in (0, n_keys // 2, n_keys - 1):
+        st = np.random.PCG64(np.random.SeedSequence(2**70 + 9, spawn_key=(5, *map(int, keys[j])))).state["state"]
+        got = [int(v) for v in states[j]]
+        assert (got[0] << 64) | got[1] == st["state"] and (got[2] << 64) | got[3] == st["inc"]
