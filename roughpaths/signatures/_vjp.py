@@ -211,7 +211,7 @@ def _mul_rev(x0, xs, a, d, m, offsets, out):
                 _axpy(out, ok + ni * q, xs, oi, ni, a[oj + q])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _log_vjp_one(a, g, d, m, offsets, ga):
     """``ga <- d/da <g, log(1 + a)>`` (reversed layout), backward through the Horner recursion
     ``r_m = c_m a``, ``r_n = (c_n + r_{n+1}) ⊗ a``, ``log(1 + a) = r_1``. Only levels ``<= m - n + 1``
