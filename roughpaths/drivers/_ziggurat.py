@@ -38,7 +38,7 @@ _RAW_OK: dict = {}
 
 
 # ----------------------------------------------------------------------------- raw-word ziggurat
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ziggurat_slow(raw, pos, idx, rabs, x, ki, wi, fi, r_tail, inv_r):
     """The rare rest of a ziggurat attempt whose first word was rejected by the box test.
 
