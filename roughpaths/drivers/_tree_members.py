@@ -8,15 +8,17 @@ in. A path's answer depends on its own times only, bitwise, whatever the other p
 equals the tree's answer on shared times (``BrownianTree._cells``) to round-off, since the cells there are
 assembled by another order of the same sums.
 
-The children of the last node split at each depth of each path are kept (if 64 MiB hold one such pair per
-depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk starts at
-the deepest kept node that holds all its times and splits only the few nodes near its new times (the same
-nodes, Chen-multiplied in the same order, as a walk from the root). Adaptive steps of the noise-burst
-problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): about 7 µs per path and attempt, of which
-3.7 splits of about 1.5 µs each. Compiling :func:`_walk_nb` (first call, empty cache) costs about 2.7 s of
-CPU after the tree's split kernel (``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive
-solve), of which about 1 s re-optimises that kernel's code linked into the walk (load 3); from numba's
-cache, 0.03 s.
+The children of the last three nodes split at each depth of each path are kept (if 64 MiB hold three such pairs
+per depth for every path of the tree; least recently used first out): consecutive attempts of a path share
+their ancestors, so a walk starts at the deepest kept node that holds all its times and splits only the few
+nodes near its new times (the same nodes, Chen-multiplied in the same order, as a walk from the root). A
+rejected attempt's retry ends between the nodes its halves split, which one slot per depth had overwritten:
+with three slots a path-attempt of the noise-burst problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol
+1e-3) splits 2.65 nodes instead of 3.74 (2.79 with two slots, 2.63 with four), about 5.3 µs per path and
+attempt instead of 7, of which the splits are about 1.5 µs each. Compiling :func:`_walk_nb` (first call, empty
+cache) costs about 2.7 s of CPU after the tree's split kernel (``_refine_segments_nb``, 2.8 s, compiled with it
+on a first adaptive solve), of which about 1 s re-optimises that kernel's code linked into the walk (load 3);
+from numba's cache, 0.03 s.
 """
 
 from __future__ import annotations
@@ -30,29 +32,34 @@ from ._tree_kernels import _refine_segments_nb, split_width
 __all__ = ["member_cells"]
 
 _WALK_CACHE_BYTES = 64 * 2 ** 20
+_SLOTS = 3            # kept splits per depth and row (module docstring)
 
 
 @njit(cache=True, nogil=True)
 def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
     """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children
-    of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none; with
-    ``cidx.shape[0] == 0`` a scratch cache of one row serves each query). A node on the walk's stack is read
-    where it is kept (the root, or its parent's slot of children): the walk is depth first, so a slot is
-    overwritten only after both children in it are done; a split writes its children into their slot. A node
-    inside a cell is reduced here (the arithmetic of ``reduce_node``, one compiled kernel less to link). No
-    array assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
+    of the last ``S`` nodes split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx[r, depth,
+    :S]`` their parents' indices, -1: none, ``cidx[r, depth, S:]`` the slots from the most to the least recently
+    used; with ``cidx.shape[0] == 0`` a scratch cache of one row serves each query). A node on the walk's stack
+    is read where it is kept (the root, or its parent's slot of children): the walk is depth first, so no other
+    node of a depth is split between a split (or a hit) and the reading of both children it holds; a split
+    writes its children into the least recently used slot of its depth. A node inside a cell is reduced here
+    (the arithmetic of ``reduce_node``, one compiled kernel less to link). No array assignments: numba compiles
+    a shape check with a formatted error message for them (about 3 s)."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
     caching = cidx.shape[0] > 0
+    S = cw.shape[2]
     sd, si = np.empty(L + 4, dtype=np.int64), np.empty(L + 4, dtype=np.int64)
     ent = np.empty((1, m + 5), dtype=np.uint32)
     states = np.empty((1, 4), dtype=np.uint64)
     z, Wn, An = np.empty((1, width)), np.empty(d), np.empty((d, d))
     words = np.empty(width + 64, dtype=np.uint64)
-    kidx = np.empty(1 if caching else L + 1, dtype=np.int64)         # reset per row below
+    kidx = np.empty((1 if caching else L + 1, 2 * S), dtype=np.int64)         # reset per row below
     zero = np.int64(0)                # not the literal 0, which numba compiles as a variant of its own
-    kw, kG = np.empty((1 if caching else L + 1, 2, nseg, d)), np.empty((1 if caching else L + 1, 2, d, d))
+    kw = np.empty((1 if caching else L + 1, S, 2, nseg, d))
+    kG = np.empty((1 if caching else L + 1, S, 2, d, d))
     for j in range(m):
         ent[0, j] = prefix[j]
     ent[0, m] = tag
@@ -63,7 +70,9 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
         else:
             ri, rw, rG = kidx, kw, kG
             for j in range(L + 1):
-                ri[j] = -1
+                for u in range(S):
+                    ri[j, u] = -1
+                    ri[j, S + u] = u
         for c in range(n):
             for a in range(d):
                 W[q, c, a] = 0.0
@@ -75,7 +84,12 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
         start = L - 1
         while start > 0 and (first >> (L - start)) != ((last - 1) >> (L - start)):
             start -= 1
-        while start > 0 and ri[start - 1] != (first >> (L - start + 1)):
+        while start > 0:
+            u = 0
+            while u < S and ri[start - 1, u] != (first >> (L - start + 1)):
+                u += 1
+            if u < S:
+                break
             start -= 1
         sd[0], si[0] = start, first >> (L - start)
         top = 1
@@ -89,8 +103,11 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
             if depth == 0:
                 w, G = root_w[r:r + 1], root_G[r:r + 1]
             else:
+                u = 0
+                while ri[depth - 1, u] != (index >> 1):       # the parent's slot (kept, see above)
+                    u += 1
                 h = index & 1
-                w, G = rw[depth - 1, h:h + 1], rG[depth - 1, h:h + 1]
+                w, G = rw[depth - 1, u, h:h + 1], rG[depth - 1, u, h:h + 1]
             k = 0
             while k <= n and idx[q, k] <= lo:
                 k += 1
@@ -114,7 +131,14 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 for a in range(d):
                     W[q, c, a] += Wn[a]
                 continue
-            if ri[depth] != index:
+            pos = 0                                   # the node's slot in the recency order (S - 1: evicted)
+            while pos < S - 1 and ri[depth, ri[depth, S + pos]] != index:
+                pos += 1
+            u = ri[depth, S + pos]
+            for v in range(pos, 0, -1):               # now the most recently used
+                ri[depth, S + v] = ri[depth, S + v - 1]
+            ri[depth, S] = u
+            if ri[depth, u] != index:
                 ent[0, m + 1] = keys[q]
                 ent[0, m + 2] = depth
                 ent[0, m + 3] = index >> 32
@@ -122,8 +146,8 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 _stream_states(ent, states)
                 _pcg64_fill(states, zero, z[0], words)    # _pcg64_normals of one row, without its pair kernel
                 _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z,
-                                    rw[depth].reshape((1, 2 * nseg, d)), rG[depth, 0:1], rG[depth, 1:2])
-                ri[depth] = index
+                                    rw[depth, u].reshape((1, 2 * nseg, d)), rG[depth, u, 0:1], rG[depth, u, 1:2])
+                ri[depth, u] = index
             sd[top], si[top] = depth + 1, 2 * index + 1          # the right child, then the left (popped first)
             sd[top + 1], si[top + 1] = depth + 1, 2 * index
             top += 2
@@ -140,11 +164,12 @@ def member_cells(tree, rows, idx, tag):
     W, A = np.empty((Q, n, d)), np.empty((Q, n, d, d))
     rows = np.ascontiguousarray(rows, dtype=np.int64)
     cache = tree.__dict__.get("_walk_cache")
-    if cache is None:                     # the children of one node per depth and row, if 64 MiB hold them
-        P, D, nseg = tree.n_paths, tree.resolution + 1, w.shape[1]
-        R = P if P * D * (2 * nseg * d + 2 * d * d + 1) * 8.0 <= _WALK_CACHE_BYTES else 0
-        cache = tree._walk_cache = (np.full((R, D), -1, dtype=np.int64), np.empty((R, D, 2, nseg, d)),
-                                    np.empty((R, D, 2, d, d)))
+    if cache is None:            # the children of _SLOTS nodes per depth and row, if 64 MiB hold them
+        P, D, nseg, S = tree.n_paths, tree.resolution + 1, w.shape[1], _SLOTS
+        R = P if P * D * S * (2 * nseg * d + 2 * d * d + 2) * 8.0 <= _WALK_CACHE_BYTES else 0
+        order = np.broadcast_to(np.arange(S), (R, D, S))
+        cache = tree._walk_cache = (np.concatenate([np.full((R, D, S), -1, dtype=np.int64), order], axis=-1),
+                                    np.empty((R, D, S, 2, nseg, d)), np.empty((R, D, S, 2, d, d)))
     _walk_nb(tree._prefix, np.ascontiguousarray(w), np.ascontiguousarray(G), rows, tree._paths[rows],
              np.ascontiguousarray(idx, dtype=np.int64), tree.resolution, float(tree.t1 - tree.t0), tag,
              split_width(w.shape[1], d), W, A, *cache)
