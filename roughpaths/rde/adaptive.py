@@ -149,7 +149,7 @@ class _TreeSteps:
 
     def propose(self):
         """The attempts of every lane not yet at ``t1``, lanes on the same interval together (``[]``: done)."""
-        act = self.act = np.flatnonzero(self.i < self.end)
+        act = self.act = (self.i < self.end).nonzero()[0]
         if act.size == 0:
             return []
         self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
@@ -170,10 +170,8 @@ class _TreeSteps:
         self.floor = np.zeros(self.lanes, dtype=bool)
         self.floor[act] = ((j - i) <= mc) | ((j - i) * cell <= self.dt_min * (1 + 1e-12))
         self.bad, self.tried = np.zeros(self.run.members, dtype=bool), np.zeros(self.run.members, dtype=bool)
-        cols = np.empty((act.size, 3 if self.control.adaptive else 2), dtype=np.int64)
-        cols[:, 0], cols[:, -1] = i, j
-        if self.control.adaptive:
-            cols[:, 1] = (i + j) // 2
+        cols = np.empty((act.size, 3 if self.control.adaptive else 2), dtype=np.int64)      # the ends, in place
+        cols[:, 0], cols[:, -1], cols[:, 1:-1] = i, j, ((i + j) // 2)[:, None]
         ts = self.t0 + cell * cols.astype(np.float64)          # (lanes, 3) or (lanes, 2)
         if self.shared:
             members, ts, h = self.lane_members[0], ts[0], float((j[0] - i[0]) * cell)
@@ -231,15 +229,14 @@ class _TreeSteps:
         t, h = self.t0 + self.i * cell, (self.j - self.i) * cell
         accept = (np.asarray(self.control.adapt(self.state, t, h, r), dtype=bool) | self.floor) & (self.i < self.end)
         self.rejected[act] += ~accept[act]
-        lanes = np.flatnonzero(accept)
+        lanes = accept.nonzero()[0]
         if lanes.size == 0:
             return
-        members = np.flatnonzero(accept[self.lane_of] & self.tried)
+        members = (accept[self.lane_of] & self.tried).nonzero()[0]
         if bad[members].any():
             m = members[bad[members]]
             run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
-        y = self.y_new[members]
-        run.y[members] = y if run.healthy.all() else np.where(run.healthy[members][:, None], y, np.nan)
+        run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
         self.accepted[lanes] += 1
         self.i[lanes] = self.j[lanes]
         at = self.i[lanes]
