@@ -166,22 +166,22 @@ class _TreeSteps:
         j = np.rint((i + h / cell) / unit).astype(np.int64) * unit
         j = np.maximum(np.maximum(j, i + mc), (i // unit + 1) * unit)
         j = np.where((j >= target) | (target - j < mc), target, j)
-        self.j[act] = j
+        self.j[act], hc = j, (j - i) * cell
         self.floor = np.zeros(self.lanes, dtype=bool)
-        self.floor[act] = ((j - i) <= mc) | ((j - i) * cell <= self.dt_min * (1 + 1e-12))
+        self.floor[act] = ((j - i) <= mc) | (hc <= self.dt_min * (1 + 1e-12))
         self.bad, self.tried = np.zeros(self.run.members, dtype=bool), np.zeros(self.run.members, dtype=bool)
         cols = np.empty((act.size, 3 if self.control.adaptive else 2), dtype=np.int64)      # the ends, in place
         cols[:, 0], cols[:, -1], cols[:, 1:-1] = i, j, ((i + j) // 2)[:, None]
         ts = self.t0 + cell * cols.astype(np.float64)          # (lanes, 3) or (lanes, 2)
         if self.shared:
-            members, ts, h = self.lane_members[0], ts[0], float((j[0] - i[0]) * cell)
+            members, ts, h = self.lane_members[0], ts[0], float(hc[0])
             if members.size == 1:               # one member: walked as a path of its own, as per member
                 W, XX = self.tree.increments_and_areas(ts[None], self.paths)
             else:
                 W, XX = self.tree.increments_and_areas(ts, None if self.whole_batch else self.paths)
             W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
         else:
-            members, h = act, (j - i) * cell
+            members, h = act, hc
             W, XX = self.tree.increments_and_areas(ts, self.paths[act])
         if self.shared or self.vector:            # one call: the batch on shared steps, or each member on its own
             return [self._attempt(members, ts, W, XX, h)]
@@ -237,8 +237,8 @@ class _TreeSteps:
             m = members[bad[members]]
             run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
         run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
-        self.accepted[lanes] += 1
-        self.i[lanes] = self.j[lanes]
+        self.accepted += accept                            # the lanes that advance
+        np.copyto(self.i, self.j, where=accept)
         at = self.i[lanes]
         if not self.save_all:
             keep = at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else \
