@@ -73,12 +73,13 @@ def selected_paths(paths, n: int, owner: str) -> np.ndarray:
     if isinstance(paths, range):
         paths = np.arange(paths.start, paths.stop, paths.step)
     idx = np.asarray(paths)
-    if idx.ndim != 1 or not (idx.size == 0 or np.issubdtype(idx.dtype, np.integer)):
+    if idx.ndim != 1 or not (idx.size == 0 or idx.dtype.kind in "iu"):
         raise TypeError(f"paths must be a slice, a range or a 1-D array of integer path indices, got {paths!r}.")
-    if idx.size and (idx.min() < -n or idx.max() >= n):
+    lo, hi = (int(idx.min()), int(idx.max())) if idx.size else (0, -1)
+    if lo < -n or hi >= n:
         raise ValueError(f"paths holds indices outside [0, {n}) (this {owner} has {n} paths), "
                          f"e.g. {int(idx[(idx < -n) | (idx >= n)][0])}.")
-    return np.where(idx < 0, idx + n, idx).astype(np.int64)
+    return (np.where(idx < 0, idx + n, idx) if lo < 0 else idx).astype(np.int64)
 
 
 class SeededDriver(Driver):

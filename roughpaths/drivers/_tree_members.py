@@ -8,15 +8,19 @@ in. A path's answer depends on its own times only, bitwise, whatever the other p
 equals the tree's answer on shared times (``BrownianTree._cells``) to round-off, since the cells there are
 assembled by another order of the same sums.
 
-The children of the last node split at each depth of each path are kept (if 64 MiB hold one such pair per
-depth for every path of the tree): consecutive attempts of a path share their ancestors, so a walk starts at
-the deepest kept node that holds all its times and splits only the few nodes near its new times (the same
-nodes, Chen-multiplied in the same order, as a walk from the root). Adaptive steps of the noise-burst
-problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): about 7 µs per path and attempt, of which
-3.7 splits of about 1.5 µs each. Compiling :func:`_walk_nb` (first call, empty cache) costs about 2.7 s of
-CPU after the tree's split kernel (``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive
-solve), of which about 1 s re-optimises that kernel's code linked into the walk (load 3); from numba's
-cache, 0.03 s.
+The children of the last two nodes split at each depth of each path are kept (if 64 MiB hold two such pairs per
+depth for every path of the tree, else one pair if that fits; the pair used less recently is replaced): consecutive
+attempts of a path share their ancestors, so a walk starts at the deepest kept node that holds all its times and
+splits only the few nodes near its new times (the same nodes, Chen-multiplied in the same order, as a walk from the
+root). A rejected attempt's retry ends between the nodes its halves split, which one pair per depth had
+overwritten. Adaptive steps of the noise-burst problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): 2.79
+splits per path-attempt (3.74 with one pair per depth, 2.65 with three, 2.63 with four), about 5 µs per path and
+attempt (7 with one pair): the splits, about 1.5-2 µs each, and 0.7 µs of walking and Chen products. Compiling
+:func:`_walk_nb` (first call, empty cache) costs about 2.7 s of CPU after the tree's split kernel
+(``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive solve), of which about 1 s re-optimises that
+kernel's code linked into the walk; from numba's cache, 0.03 s. (Measured at load 1.3-1.4: 2.60-2.73 s, against
+2.54-2.62 s with one pair per depth; at load 2.3-2.9, three pairs kept in least-recently-used order took 2.7-3.0 s
+against 2.2-2.4 s, more compile than their 0.03 s per solve is worth.)
 """
 
 from __future__ import annotations
@@ -34,25 +38,30 @@ _WALK_CACHE_BYTES = 64 * 2 ** 20
 
 @njit(cache=True, nogil=True)
 def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
-    """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children
-    of the last node split at each depth of each tree row are kept in ``cidx, cw, cG`` (``cidx`` -1: none; with
-    ``cidx.shape[0] == 0`` a scratch cache of one row serves each query). A node on the walk's stack is read
-    where it is kept (the root, or its parent's slot of children): the walk is depth first, so a slot is
-    overwritten only after both children in it are done; a split writes its children into their slot. A node
-    inside a cell is reduced here (the arithmetic of ``reduce_node``, one compiled kernel less to link). No
-    array assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
+    """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children of
+    the last ``S`` (2, or 1 for a tree too large for two) nodes split at each depth of each tree row are kept in
+    ``cidx, cw, cG``: slots ``S depth .. S depth + S - 1`` of a row (``DS = S (L + 1)`` slots) hold a pair each,
+    ``cidx[r, slot]`` their parent's index (-1: none) and ``cidx[r, DS + depth]`` the slot of the depth used last
+    (one flat axis of slots: numba compiles the indexing of one slot per depth); with ``cidx.shape[0] == 0`` a
+    scratch cache of one row serves each query. A node on the walk's stack is read where it is kept (the root, or
+    its parent's slot of children): the walk is depth first, so no node of a depth is split between a split (or a
+    hit) of its parent and the reading of both children it holds; a split replaces the pair of its depth used less
+    recently. A node inside a cell is reduced here (the arithmetic of ``reduce_node``, one compiled kernel less to
+    link). No array assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
     caching = cidx.shape[0] > 0
+    DS = cw.shape[1]                  # S slots per depth, S (L + 1)
+    S = DS // (L + 1)
     sd, si = np.empty(L + 4, dtype=np.int64), np.empty(L + 4, dtype=np.int64)
     ent = np.empty((1, m + 5), dtype=np.uint32)
     states = np.empty((1, 4), dtype=np.uint64)
     z, Wn, An = np.empty((1, width)), np.empty(d), np.empty((d, d))
     words = np.empty(width + 64, dtype=np.uint64)
-    kidx = np.empty(1 if caching else L + 1, dtype=np.int64)         # reset per row below
+    kidx = np.empty(1 if caching else DS + L + 1, dtype=np.int64)         # reset per row below
     zero = np.int64(0)                # not the literal 0, which numba compiles as a variant of its own
-    kw, kG = np.empty((1 if caching else L + 1, 2, nseg, d)), np.empty((1 if caching else L + 1, 2, d, d))
+    kw, kG = np.empty((1 if caching else DS, 2, nseg, d)), np.empty((1 if caching else DS, 2, d, d))
     for j in range(m):
         ent[0, j] = prefix[j]
     ent[0, m] = tag
@@ -62,8 +71,8 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
             ri, rw, rG = cidx[r], cw[r], cG[r]
         else:
             ri, rw, rG = kidx, kw, kG
-            for j in range(L + 1):
-                ri[j] = -1
+            for j in range(DS + L + 1):
+                ri[j] = -1 if j < DS else 0
         for c in range(n):
             for a in range(d):
                 W[q, c, a] = 0.0
@@ -75,7 +84,8 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
         start = L - 1
         while start > 0 and (first >> (L - start)) != ((last - 1) >> (L - start)):
             start -= 1
-        while start > 0 and ri[start - 1] != (first >> (L - start + 1)):
+        while start > 0 and ri[S * start - S] != (first >> (L - start + 1)) and \
+                ri[S * start - 1] != (first >> (L - start + 1)):
             start -= 1
         sd[0], si[0] = start, first >> (L - start)
         top = 1
@@ -89,8 +99,11 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
             if depth == 0:
                 w, G = root_w[r:r + 1], root_G[r:r + 1]
             else:
+                u = S * depth - S                             # the parent's slot (kept, see above)
+                if ri[u] != (index >> 1):
+                    u += 1
                 h = index & 1
-                w, G = rw[depth - 1, h:h + 1], rG[depth - 1, h:h + 1]
+                w, G = rw[u, h:h + 1], rG[u, h:h + 1]
             k = 0
             while k <= n and idx[q, k] <= lo:
                 k += 1
@@ -114,7 +127,11 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 for a in range(d):
                     W[q, c, a] += Wn[a]
                 continue
-            if ri[depth] != index:
+            u = S * depth                             # the depth's slots: u (and u + 1 if S == 2)
+            if S == 2 and (ri[u + 1] == index or (ri[u] != index and ri[DS + depth] == 0)):
+                u += 1                                # kept there, or a miss and u was used last
+            ri[DS + depth] = u - S * depth            # the slot used last
+            if ri[u] != index:
                 ent[0, m + 1] = keys[q]
                 ent[0, m + 2] = depth
                 ent[0, m + 3] = index >> 32
@@ -122,8 +139,8 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
                 _stream_states(ent, states)
                 _pcg64_fill(states, zero, z[0], words)    # _pcg64_normals of one row, without its pair kernel
                 _refine_segments_nb(w, G, span / float(np.int64(1) << depth) / nseg, z,
-                                    rw[depth].reshape((1, 2 * nseg, d)), rG[depth, 0:1], rG[depth, 1:2])
-                ri[depth] = index
+                                    rw[u].reshape((1, 2 * nseg, d)), rG[u, 0:1], rG[u, 1:2])
+                ri[u] = index
             sd[top], si[top] = depth + 1, 2 * index + 1          # the right child, then the left (popped first)
             sd[top + 1], si[top + 1] = depth + 1, 2 * index
             top += 2
@@ -140,11 +157,13 @@ def member_cells(tree, rows, idx, tag):
     W, A = np.empty((Q, n, d)), np.empty((Q, n, d, d))
     rows = np.ascontiguousarray(rows, dtype=np.int64)
     cache = tree.__dict__.get("_walk_cache")
-    if cache is None:                     # the children of one node per depth and row, if 64 MiB hold them
+    if cache is None:            # the children of two nodes per depth and row (or one) if 64 MiB hold them
         P, D, nseg = tree.n_paths, tree.resolution + 1, w.shape[1]
-        R = P if P * D * (2 * nseg * d + 2 * d * d + 1) * 8.0 <= _WALK_CACHE_BYTES else 0
-        cache = tree._walk_cache = (np.full((R, D), -1, dtype=np.int64), np.empty((R, D, 2, nseg, d)),
-                                    np.empty((R, D, 2, d, d)))
+        fits = [S for S in (2, 1) if P * D * (S * (2 * nseg * d + 2 * d * d + 1) + 1) * 8.0 <= _WALK_CACHE_BYTES]
+        S, R = (fits[0], P) if fits else (1, 0)
+        slots = np.concatenate([np.full(S * D, -1), np.zeros(D)]).astype(np.int64)
+        cache = tree._walk_cache = (np.repeat(slots[None], R, axis=0), np.empty((R, S * D, 2, nseg, d)),
+                                    np.empty((R, S * D, 2, d, d)))
     _walk_nb(tree._prefix, np.ascontiguousarray(w), np.ascontiguousarray(G), rows, tree._paths[rows],
              np.ascontiguousarray(idx, dtype=np.int64), tree.resolution, float(tree.t1 - tree.t0), tag,
              split_width(w.shape[1], d), W, A, *cache)

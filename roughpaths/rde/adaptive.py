@@ -76,16 +76,14 @@ def _step_doubling(solver, fields, y, a):
     """``(y_2, y_1)`` of an attempt ``a`` from ``y``: two solver steps over its halves and one over the whole.
 
     With each member on its own times (``a.times (members, 3)``) the first half and the whole step are one
-    call of the solver on the members stacked twice (a member's arithmetic is its own in any batch), the
-    second half another: two calls instead of three, the same numbers."""
-    no = np.zeros(1, dtype=bool)
+    step of the solver on the members stacked twice (a member's arithmetic is its own in any batch), the
+    second half another: two calls instead of three, the same numbers. They call ``solver.step`` (the
+    contract's ``integrate`` returns what stepping returns) with the arguments ``integrate`` passes it."""
     if a.times.ndim == 2 and isinstance(a.dXX, np.ndarray):
-        n = y.shape[0]
-        both = solver.integrate(fields, np.concatenate([y, y]), np.concatenate([a.times[:, :2], a.times[:, ::2]]),
-                                np.concatenate([a.dX[:, :1], a.whole[0]]), np.concatenate([a.dXX[:, :1], a.whole[1]]),
-                                no, stop_on_failure=False)[0]
-        y2 = solver.integrate(fields, both[:n], a.times[:, 1:], a.dX[:, 1:], a.dXX[:, 1:], no, stop_on_failure=False)[0]
-        return y2, both[n:]
+        n, ts, t = y.shape[0], a.times, a.times[:, :1]
+        both = solver.step(fields, np.concatenate([y, y]), np.concatenate([t, t]), np.concatenate([ts[:, 1:2] - t,
+                           ts[:, 2:] - t]), *(np.concatenate([x[:, 0], w[:, 0]]) for x, w in zip((a.dX, a.dXX), a.whole)))
+        return solver.step(fields, both[:n], ts[:, 1:2], ts[:, 2:] - ts[:, 1:2], a.dX[:, 1], a.dXX[:, 1]), both[n:]
     y2 = solver.integrate(fields, y, a.times, a.dX, a.dXX, a.save, stop_on_failure=a.stop)[0]
     return y2, solver.integrate(fields, y, a.times[..., [0, -1]], *a.whole, a.save[:1], stop_on_failure=False)[0]
 
@@ -138,7 +136,7 @@ class _TreeSteps:
         self.state = control.init(t0, t1, n, order)
         self.dt_min = control.dt_min(T)
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
-        self.i, self.j = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+        self.i, self.j, self.iterations = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), 0
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))
         # step ends snapped to spacing (h/4, h/2] per path, adaptive; else (h/16, h/8] (module docstring)
         self.fine = 1 if control.adaptive and (not self.shared or P == 1) else 3
@@ -151,39 +149,39 @@ class _TreeSteps:
 
     def propose(self):
         """The attempts of every lane not yet at ``t1``, lanes on the same interval together (``[]``: done)."""
-        act = self.act = np.flatnonzero(self.i < self.end)
+        act = self.act = (self.i < self.end).nonzero()[0]
         if act.size == 0:
             return []
-        tries = self.accepted + self.rejected
-        if (tries >= self.control.max_steps).any():
-            k = int(np.argmax(tries))
+        self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
+        if self.iterations > self.control.max_steps and (self.accepted + self.rejected >= self.control.max_steps).any():
+            k = int(np.argmax(self.accepted + self.rejected))
             raise ValueError(f"adaptive solve took {self.control.max_steps} attempts and reached t = "
                              f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
-        L, cell, i, h = self.L, self.cell, self.i[act], self.state["h"][act]
+        L, cell, i, h, mc = self.L, self.cell, self.i[act], self.state["h"][act], self.min_cells
         target = self.end if self.targets.size == 1 else self.targets[np.searchsorted(self.targets, i, side="right")]
-        depth = np.clip(np.ceil(np.log2(self.span / h)).astype(np.int64) + self.fine, 0, L)
+        depth = np.minimum(np.maximum(np.ceil(np.log2(self.span / h)).astype(np.int64) + self.fine, 0), L)
         unit = np.left_shift(np.int64(1), L - depth)
-        j = np.round((i + h / cell) / unit).astype(np.int64) * unit
-        j = np.maximum(np.maximum(j, i + self.min_cells), (i // unit + 1) * unit)
-        j = np.where((j >= target) | (target - j < self.min_cells), target, j)
-        self.j[act] = j
+        j = np.rint((i + h / cell) / unit).astype(np.int64) * unit
+        j = np.maximum(np.maximum(j, i + mc), (i // unit + 1) * unit)
+        j = np.where((j >= target) | (target - j < mc), target, j)
+        self.j[act], hc = j, (j - i) * cell
         self.floor = np.zeros(self.lanes, dtype=bool)
-        self.floor[act] = ((j - i) <= self.min_cells) | ((j - i) * cell <= self.dt_min * (1 + 1e-12))
-        self.bad = np.zeros(self.run.members, dtype=bool)
-        self.tried = np.zeros(self.run.members, dtype=bool)
-        cols = [i, (i + j) // 2, j] if self.control.adaptive else [i, j]
-        ts = self.t0 + cell * np.stack(cols, axis=-1).astype(np.float64)          # (lanes, 3) or (lanes, 2)
+        self.floor[act] = ((j - i) <= mc) | (hc <= self.dt_min * (1 + 1e-12))
+        self.bad, self.tried = np.zeros(self.run.members, dtype=bool), np.zeros(self.run.members, dtype=bool)
+        cols = np.empty((act.size, 3 if self.control.adaptive else 2), dtype=np.int64)      # the ends, in place
+        cols[:, 0], cols[:, -1], cols[:, 1:-1] = i, j, ((i + j) // 2)[:, None]
+        ts = self.t0 + cell * cols.astype(np.float64)          # (lanes, 3) or (lanes, 2)
         if self.shared:
-            members, ts, h = self.lane_members[0], ts[0], float((j[0] - i[0]) * cell)
+            members, ts, h = self.lane_members[0], ts[0], float(hc[0])
             if members.size == 1:               # one member: walked as a path of its own, as per member
                 W, XX = self.tree.increments_and_areas(ts[None], self.paths)
             else:
                 W, XX = self.tree.increments_and_areas(ts, None if self.whole_batch else self.paths)
             W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
         else:
-            members, h = act, (j - i) * cell
+            members, h = act, hc
             W, XX = self.tree.increments_and_areas(ts, self.paths[act])
         if self.shared or self.vector:            # one call: the batch on shared steps, or each member on its own
             return [self._attempt(members, ts, W, XX, h)]
@@ -199,18 +197,18 @@ class _TreeSteps:
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
         self.y_new[a.members] = y_new
         self.tried[a.members] = True
-        self.bad[a.members] = ~np.all(np.isfinite(y_new), axis=-1)
+        self.bad[a.members] = ~np.isfinite(y_new).all(axis=-1)
         if err is not None:
             self.err[a.members] = err
 
-    def _lane_ratios(self, ok):
+    def _lane_ratios(self, ok, bad):
         if self.shared:
             r = np.zeros(1)
             if ok.any():
                 r[0] = np.max(self.err[ok])                             # NaN propagates: never accepted
         else:
             r = np.where(ok, self.err, 0.0)
-        r[self.lane_of[self.bad & self.run.healthy]] = math.inf
+        r[self.lane_of[bad]] = math.inf
         return r
 
     def adapt(self, attempts):
@@ -220,36 +218,38 @@ class _TreeSteps:
         ok = self.tried & run.healthy & ~bad
         r = None
         if self.control.adaptive:
-            unmet = ok & ~(self.err <= 1.0) & self.floor[self.lane_of]
+            unmet = ok & ~(self.err <= 1.0) & self.floor[self.lane_of] if self.floor.any() else ok[:0]
             if unmet.any():                         # the tolerance cannot be met at dt_min: fail, never crawl
                 np.add.at(self.at_min, self.lane_of[unmet], 1)
                 m = np.flatnonzero(unmet)
                 run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t0 + self.i[
                     self.lane_of[m[0]]] * cell, (self.j - self.i)[self.lane_of[m[0]]] * cell, self.control))
                 ok &= ~unmet
-            r = self._lane_ratios(ok)
+            r = self._lane_ratios(ok, bad)
         t, h = self.t0 + self.i * cell, (self.j - self.i) * cell
         accept = (np.asarray(self.control.adapt(self.state, t, h, r), dtype=bool) | self.floor) & (self.i < self.end)
-        self.rejected[act[~accept[act]]] += 1
-        lanes = np.flatnonzero(accept)
+        self.rejected[act] += ~accept[act]
+        lanes = accept.nonzero()[0]
         if lanes.size == 0:
             return
-        members = np.flatnonzero(accept[self.lane_of] & self.tried)
+        members = (accept[self.lane_of] & self.tried).nonzero()[0]
         if bad[members].any():
             m = members[bad[members]]
             run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
         run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
-        self.accepted[lanes] += 1
-        self.i[lanes] = self.j[lanes]
+        self.accepted += accept                            # the lanes that advance
+        np.copyto(self.i, self.j, where=accept)
         at = self.i[lanes]
         if not self.save_all:
             keep = at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else \
                 np.isin(at, self.save_list)
             lanes, at = lanes[keep], at[keep]
-        self.saved.append((lanes, np.where(at < self.end, self.t0 + at * cell, self.t1), run.y[self.lane_members[lanes]]))
-        self.n_saved += lanes.size
-        run.check_saves(self.n_saved // self.lanes, growing=True)
-        reached = float(np.min(self.i)) * cell           # exact: cell = T / 2^L, and end * cell == T
+        if lanes.size:
+            self.saved.append((lanes, np.where(at < self.end, self.t0 + at * cell, self.t1),
+                               run.y[self.lane_members[lanes]]))
+            self.n_saved += lanes.size
+            run.check_saves(self.n_saved // self.lanes, growing=True)
+        reached = float(self.i.min()) * cell           # exact: cell = T / 2^L, and end * cell == T
         if reached > self.reached:
             self.reached = reached
             run.progress(reached)
