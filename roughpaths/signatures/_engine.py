@@ -146,9 +146,10 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 #: From this width on every unit runs alone (:func:`_blocked.block_units`, the same bits as the lanes):
 #: the one-unit rows over the first letters fill whole packed rows (d = 8: one) and its blocked top level
-#: beats the lanes' per-segment one. Below it, d = 6, 7 run on lanes (the run-time ``d`` variant) where the
-#: ``LANES`` signatures take at most :data:`_LANE_BYTES` (depth 3): measured at 16 x 256 points, depth 3,
-#: one thread, 48 / 73 ns a segment against 68 / 95 alone (pysiglib: 61 / 89).
+#: beats the lanes' per-segment one. Below it, d = 6, 7 run on lanes (variants compiled for (6, 3) and (7, 3))
+#: where the ``LANES`` signatures take at most :data:`_LANE_BYTES` (depth 3): measured at 16 x 256 points,
+#: depth 3, one thread, 24-29 / 34 ns a segment (the run-time ``d`` lanes: 48 / 67; alone: 68 / 95; pysiglib:
+#: 61 / 89).
 _WIDE = 8
 #: A lane group with at most this many units runs them one at a time instead (the empty lanes of a
 #: group cost as much as full ones; one unit alone costs about a quarter of a group, measured at d = 3).
@@ -159,6 +160,13 @@ _FEW = 2
 #: 32-200 paths, d = 4 at depth 5 ran 3x faster alone (the one-unit kernel is compiled for d = 4), d = 5 at
 #: depth 5 0-11 % faster; d = 2, 3 stay faster on lanes at every depth tried (up to 10 and 7).
 _LANE_BYTES = 64 * 1024
+
+
+#: Work (in the units of :data:`roughpaths._threads.SERIAL_WORK`, ~flops) a level costs a lane with a run-time
+#: depth per segment beyond its ``1.5 d^m`` flops: at d = 2, depth 4 and 5, 64 x 256 points took 12-18 ns a unit and
+#: segment (one thread), 2-3x what ``1.5 d^m`` estimated, so they ran on one thread (190 / 290 us, where pysiglib
+#: ``n_jobs=-1`` takes 190 / 230). With it they run on two; the cells below ~170 us stay on one.
+_LEVEL_WORK = 12
 
 
 def _split_units(nunits: int, d: int, depth: int) -> tuple:
@@ -185,8 +193,10 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     ngroups, first_alone = _split_units(nunits, d, depth)
     if ngroups:
         lanes = _lanes.lane_groups(d, depth)
+        # a variant with a run-time depth also spends ~_LEVEL_WORK a level on loop control per segment
+        lane_work = per_unit + (n / nchunks) * _LEVEL_WORK * depth * (_lanes.lane_key(d, depth)[1] == 0)
         _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
+                     _threads.ranges(ngroups, lane_work * _lanes.LANES))
     if first_alone < nunits:
         alone = _blocked.block_units(d, depth)
         _threads.run(lambda lo, hi: alone(x, *units, depth, off, first_alone + lo, first_alone + hi, part),
