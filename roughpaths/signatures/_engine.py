@@ -162,13 +162,6 @@ _FEW = 2
 _LANE_BYTES = 64 * 1024
 
 
-#: Work (in the units of :data:`roughpaths._threads.SERIAL_WORK`, ~flops) a level costs a lane with a run-time
-#: depth per segment beyond its ``1.5 d^m`` flops: at d = 2, depth 4 and 5, 64 x 256 points took 12-18 ns a unit and
-#: segment (one thread), 2-3x what ``1.5 d^m`` estimated, so they ran on one thread (190 / 290 us, where pysiglib
-#: ``n_jobs=-1`` takes 190 / 230). With it they run on two; the cells below ~170 us stay on one.
-_LEVEL_WORK = 12
-
-
 def _split_units(nunits: int, d: int, depth: int) -> tuple:
     """``(lane groups, first unit run alone)``: units ``0 .. LANES * groups - 1`` run on lanes, the rest alone.
 
@@ -193,10 +186,10 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     ngroups, first_alone = _split_units(nunits, d, depth)
     if ngroups:
         lanes = _lanes.lane_groups(d, depth)
-        # a variant with a run-time depth also spends ~_LEVEL_WORK a level on loop control per segment
-        lane_work = per_unit + (n / nchunks) * _LEVEL_WORK * depth * (_lanes.lane_key(d, depth)[1] == 0)
+        # ``1.5 d^m`` underestimates d = 2 at depth 4-5 by 2-3x (loop control), so 64 x 256 such paths
+        # (190-290 us) stay on one thread; counted (12 a level), they ran on two 0-18 % slower at load 1.3-2.1
         _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, lane_work * _lanes.LANES))
+                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
     if first_alone < nunits:
         alone = _blocked.block_units(d, depth)
         _threads.run(lambda lo, hi: alone(x, *units, depth, off, first_alone + lo, first_alone + hi, part),
