@@ -189,11 +189,11 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
         # ``1.5 d^m`` underestimates d = 2 at depth 4-5 by 2-3x (loop control), so 64 x 256 such paths
         # (190-290 us) stay on one thread; counted (12 a level), they ran on two 0-18 % slower at load 1.3-2.1
         _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
+                     _threads.ranges(ngroups, per_unit * _lanes.LANES), merge=True)
     if first_alone < nunits:
         alone = _blocked.block_units(d, depth)
         _threads.run(lambda lo, hi: alone(x, *units, depth, off, first_alone + lo, first_alone + hi, part),
-                     _threads.ranges(nunits - first_alone, per_unit))
+                     _threads.ranges(nunits - first_alone, per_unit), merge=True)
     return part
 
 
@@ -207,11 +207,11 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     groups = nb // _lanes.LANES if d >= _l2.LANE_WIDTH else 0      # same bits either way
     if groups:
         _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
-                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES))
+                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES), merge=True)
     first = groups * _lanes.LANES * nchunks
     tasks = _l2.sig2_tasks(d)
     _threads.run(lambda lo, hi: tasks(x, nchunks, first + lo, first + hi, part),
-                 _threads.ranges(nb * nchunks - first, per_task))
+                 _threads.ranges(nb * nchunks - first, per_task), merge=True)
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
@@ -243,7 +243,7 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
         return out[:, perm]
     res = np.empty_like(out)
     _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
-                 _threads.ranges(nb, 4 * perm.shape[0]))
+                 _threads.ranges(nb, 4 * perm.shape[0]), merge=True)
     return res
 
 
