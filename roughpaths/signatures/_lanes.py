@@ -343,9 +343,15 @@ def lane_key(d: int, m: int) -> tuple:
     of the run-time one, at the same cost (cold, empty cache, a first 16 x 256 x 6 signature at depth 3, CPU
     with the import, two runs each interleaved: 2.77 and 2.63 s against 2.65 and 2.78; d = 7 2.81 against
     2.87). The run-time variant stays for d = 1.
+
+    d = 2 at depth 4 gets ``(2, 4)``: 64 x 256 points, one thread, 6.6 ns a unit and segment against 14.7
+    for ``(2, 0)`` (at depth 5 a compile-time depth gained nothing: 22.7 against 23.0; d = 3 at depth 4
+    gained 1.4x but stays on ``(3, 0)``, the variant of the first-call budget's d = 3 gradients).
     """
     if m == 3 and d in (6, 7):
         return d, 3
+    if (d, m) == (2, 4):
+        return 2, 4
     return (d if 2 <= d <= 5 else 0, 3 if m == 3 and d in (2, 3, 5) else 0)
 
 
