@@ -186,8 +186,8 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     ngroups, first_alone = _split_units(nunits, d, depth)
     if ngroups:
         lanes = _lanes.lane_groups(d, depth)
-        # ``1.5 d^m`` underestimates d = 2 at depth 4-5 by 2-3x (loop control), so 64 x 256 such paths
-        # (190-290 us) stay on one thread; counted (12 a level), they ran on two 0-18 % slower at load 1.3-2.1
+        # ``1.5 d^m`` underestimates d = 2 at depth 5 by 2-3x (loop control), so 64 x 256 such paths (~290 us)
+        # stay on one thread; counted (12 a level), they ran on two 0-24 % slower at load 1.3-2.1
         _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
                      _threads.ranges(ngroups, per_unit * _lanes.LANES), merge=True)
     if first_alone < nunits:
