@@ -61,14 +61,23 @@ def ranges(n_items: int, work_per_item: float) -> list:
     return [(lo, min(lo + step, n_items)) for lo in range(0, n_items, step)]
 
 
-def run(fn, parts: list) -> None:
-    """Call ``fn(lo, hi)`` for every range in ``parts``, shared between the caller and the pool."""
+def run(fn, parts: list, *, merge: bool = False) -> None:
+    """Call ``fn(lo, hi)`` for every range in ``parts``, shared between the caller and the pool.
+
+    With ``merge`` (for contiguous ranges, in order, and an ``fn`` whose set-up does not grow with its
+    range) one thread calls ``fn`` once over their union instead: each call of a kernel allocates its
+    scratch and is dispatched anew (16 ranges of the one-unit signature kernel, d = 10 at depth 3,
+    16 x 256 points: ~45 us of 600).
+    """
     if len(parts) <= 1:                     # decided before asking numba (its query costs ~5 us)
         for lo, hi in parts:
             fn(lo, hi)
         return
     threads = numba.get_num_threads()
     if threads <= 1:
+        if merge:
+            fn(parts[0][0], parts[-1][1])
+            return
         for lo, hi in parts:
             fn(lo, hi)
         return

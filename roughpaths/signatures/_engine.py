@@ -146,9 +146,10 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 #: From this width on every unit runs alone (:func:`_blocked.block_units`, the same bits as the lanes):
 #: the one-unit rows over the first letters fill whole packed rows (d = 8: one) and its blocked top level
-#: beats the lanes' per-segment one. Below it, d = 6, 7 run on lanes (the run-time ``d`` variant) where the
-#: ``LANES`` signatures take at most :data:`_LANE_BYTES` (depth 3): measured at 16 x 256 points, depth 3,
-#: one thread, 48 / 73 ns a segment against 68 / 95 alone (pysiglib: 61 / 89).
+#: beats the lanes' per-segment one. Below it, d = 6, 7 run on lanes (variants compiled for (6, 3) and (7, 3))
+#: where the ``LANES`` signatures take at most :data:`_LANE_BYTES` (depth 3): measured at 16 x 256 points,
+#: depth 3, one thread, 24-29 / 34 ns a segment (the run-time ``d`` lanes: 48 / 67; alone: 68 / 95; pysiglib:
+#: 61 / 89).
 _WIDE = 8
 #: A lane group with at most this many units runs them one at a time instead (the empty lanes of a
 #: group cost as much as full ones; one unit alone costs about a quarter of a group, measured at d = 3).
@@ -185,12 +186,14 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
     ngroups, first_alone = _split_units(nunits, d, depth)
     if ngroups:
         lanes = _lanes.lane_groups(d, depth)
+        # ``1.5 d^m`` underestimates d = 2 at depth 5 by 2-3x (loop control), so 64 x 256 such paths (~290 us)
+        # stay on one thread; counted (12 a level), they ran on two 0-24 % slower at load 1.3-2.1
         _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
+                     _threads.ranges(ngroups, per_unit * _lanes.LANES), merge=True)
     if first_alone < nunits:
         alone = _blocked.block_units(d, depth)
         _threads.run(lambda lo, hi: alone(x, *units, depth, off, first_alone + lo, first_alone + hi, part),
-                     _threads.ranges(nunits - first_alone, per_unit))
+                     _threads.ranges(nunits - first_alone, per_unit), merge=True)
     return part
 
 
@@ -204,11 +207,11 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     groups = nb // _lanes.LANES if d >= _l2.LANE_WIDTH else 0      # same bits either way
     if groups:
         _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
-                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES))
+                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES), merge=True)
     first = groups * _lanes.LANES * nchunks
     tasks = _l2.sig2_tasks(d)
     _threads.run(lambda lo, hi: tasks(x, nchunks, first + lo, first + hi, part),
-                 _threads.ranges(nb * nchunks - first, per_task))
+                 _threads.ranges(nb * nchunks - first, per_task), merge=True)
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
@@ -240,7 +243,7 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
         return out[:, perm]
     res = np.empty_like(out)
     _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
-                 _threads.ranges(nb, 4 * perm.shape[0]))
+                 _threads.ranges(nb, 4 * perm.shape[0]), merge=True)
     return res
 
 

@@ -20,7 +20,7 @@ does not depend on its lane, its neighbours, the grouping or the thread. A unit'
 copied out at its own last segment; lanes with no segment left get zero increments. The increments
 of a group are gathered and transposed into a ``(BLOCK, d, LANES)`` block first, and the kernel is
 specialised (loops over the letters unrolled) for d = 2..5, and also on the depth for depth 3 with
-d = 2, 3, 5.
+d = 2, 3, 5; d = 6, 7 (which run on lanes at depth 3 only) on both.
 
 *One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step`, whose loops
 run over the first letters of a level (contiguous, packed ``LANES`` first letters at a time or
@@ -29,8 +29,8 @@ control): the same bits as the lanes. The engine's one-unit kernel is the blocke
 (:mod:`roughpaths.signatures._blocked`, the same bits again), used for every d >= 8, for d = 6, 7
 beyond depth 3 and for d = 4, 5 where ``LANES`` signatures take more than 64 KiB (they no longer
 fit in the L1 cache, and one unit's rows are long enough to fill the vector registers), and for a
-lane group that would hold at most two units. d = 6, 7 at depth 3 run on lanes with a run-time
-``d`` (:func:`lane_key` ``(0, 0)``).
+lane group that would hold at most two units. d = 6, 7 at depth 3 run on lanes with a compile-time
+``d`` and ``m`` (:func:`lane_key`).
 
 Measured (one thread, CPU time per unit and segment, this 2-core machine): d = 3 at depths
 3/4/5 about 10/23/58 ns, d = 5 at depths 3/4/5 about 25/140/660 ns, 4-9x less than the same
@@ -335,7 +335,23 @@ def lane_key(d: int, m: int) -> tuple:
     variant is its own kernel, compiled on its first use and then cached on disk, so a call compiles only
     the variant it runs (a first d = 3 signature at depths 2-4 compiles two lane variants and the level-2
     kernels: 9.0 s of CPU in all, import included, in ``benchmarks/bench_first_call.py``).
+
+    d = 6, 7 reach the lanes at depth 3 only (:func:`roughpaths.signatures._engine._split_units`) and get
+    ``(d, 3)``: the unrolled loops over the last letters keep the increments' rows in registers, and the
+    run-time variant spent half its time on loop control (16 x 256 points, one thread, CPU time a unit and
+    segment: d = 6 24-29 ns against 48-50, d = 7 34 against 67). A first call compiles that variant instead
+    of the run-time one, at the same cost (cold, empty cache, a first 16 x 256 x 6 signature at depth 3, CPU
+    with the import, two runs each interleaved: 2.77 and 2.63 s against 2.65 and 2.78; d = 7 2.81 against
+    2.87). The run-time variant stays for d = 1.
+
+    d = 2 at depth 4 gets ``(2, 4)``: 64 x 256 points, one thread, 6.6 ns a unit and segment against 14.7
+    for ``(2, 0)`` (at depth 5 a compile-time depth gained nothing: 22.7 against 23.0; d = 3 at depth 4
+    gained 1.4x but stays on ``(3, 0)``, the variant of the first-call budget's d = 3 gradients).
     """
+    if m == 3 and d in (6, 7):
+        return d, 3
+    if (d, m) == (2, 4):
+        return 2, 4
     return (d if 2 <= d <= 5 else 0, 3 if m == 3 and d in (2, 3, 5) else 0)
 
 

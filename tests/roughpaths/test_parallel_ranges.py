@@ -126,3 +126,28 @@ def test_forked_child_gets_workers_of_its_own(tmp_path):
     env = dict(os.environ, NUMBA_NUM_THREADS="2")
     res = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300, env=env)
     assert res.returncode == 0 and res.stdout.strip() == "ok", res.stderr
+
+
+def test_merged_ranges_are_one_call_on_one_thread_and_every_item_once_on_all():
+    from roughpaths import _threads
+
+    parts = _threads.ranges(1000, float(_threads.SERIAL_WORK))        # one range per ~RANGE_WORK: many
+    assert len(parts) > 2
+    before = numba.get_num_threads()
+    lock = threading.Lock()
+    try:
+        # one thread: a single call over the union; several: the ranges as given (each item once)
+        for threads, want in ((1, [(0, 1000)]), (before, parts if before > 1 else [(0, 1000)])):
+            numba.set_num_threads(threads)
+            calls, seen = [], np.zeros(1000, dtype=np.int64)
+
+            def fn(lo, hi):
+                with lock:
+                    calls.append((lo, hi))
+                    seen[lo:hi] += 1
+
+            _threads.run(fn, parts, merge=True)
+            assert np.all(seen == 1)
+            assert sorted(calls) == want
+    finally:
+        numba.set_num_threads(before)

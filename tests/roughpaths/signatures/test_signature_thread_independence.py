@@ -42,8 +42,11 @@ def test_one_thread_equals_two_threads(shape, m):
 
 
 @pytest.mark.parametrize("nchunks", [1, 5])
-@pytest.mark.parametrize("d,m", [(2, 5), (3, 4), (5, 3), (6, 3)])   # d <= 5 specialised, 6 generic
-def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m):
+# d <= 5, (2, 4), (6, 3) and (7, 3) specialised (lane_key); key (0, 0): the run-time variant (what d = 1
+# reaches) at d = 6
+@pytest.mark.parametrize("d,m,key", [(2, 4, None), (2, 5, None), (3, 4, None), (5, 3, None), (6, 3, None),
+                                     (7, 3, None), (6, 3, (0, 0))])
+def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m, key):
     # 9 paths: a group of 8 lanes and one of 1; with 5 chunks the last chunk of each path is
     # shorter than the others (units end at different steps); one path is scaled by 1e12
     x = _path((9, 700, d))
@@ -55,8 +58,9 @@ def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m):
     kern.scalar_units(x, *units, m, off, 0, nu, one)
     lanes = np.empty_like(one)
     groups = -(-nu // kern.LANES)
+    lane_kernel = kern.lane_groups(d, m) if key is None else kern._lane_groups_kernel(*key)
     for g in range(groups):                       # one range per group, in reverse order
-        kern.lane_groups(d, m)(x, *units, m, off, groups - 1 - g, groups - g, lanes)
+        lane_kernel(x, *units, m, off, groups - 1 - g, groups - g, lanes)
     assert one.tobytes() == lanes.tobytes()
 
 
