@@ -135,7 +135,7 @@ def _xsl_rr(sh, sl):
     return (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _stream_states(entropy, states):
     """PCG64 states ``(P, 4)`` = (state_hi, state_lo, inc_hi, inc_lo) of the streams whose ``SeedSequence``
     entropy words are the rows of ``entropy`` (P, L) uint32 (see :func:`_generate_state`): numpy's
@@ -261,7 +261,7 @@ def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
     states[q, 0], states[q, 1] = _pcg64_rounds(qh, ql, qih, qil, out_q, words_q, n - used, i)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_normals(states, out):
     """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
     P, n = out.shape

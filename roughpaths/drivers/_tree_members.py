@@ -36,7 +36,7 @@ __all__ = ["member_cells"]
 _WALK_CACHE_BYTES = 64 * 2 ** 20
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
     """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children of
     the last ``S`` (2, or 1 for a tree too large for two) nodes split at each depth of each tree row are kept in

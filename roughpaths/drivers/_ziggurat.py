@@ -103,7 +103,7 @@ def _ziggurat_run(raw, pos, out, i, ki, wi):
     return pos, i
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
     """Fill ``out[start:]`` from ``raw`` (uint64) with numpy's ziggurat; returns (raw consumed, next index).
 
