@@ -135,7 +135,7 @@ def _xsl_rr(sh, sl):
     return (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _stream_states(entropy, states):
     """PCG64 states ``(P, 4)`` = (state_hi, state_lo, inc_hi, inc_lo) of the streams whose ``SeedSequence``
     entropy words are the rows of ``entropy`` (P, L) uint32 (see :func:`_generate_state`): numpy's
@@ -158,7 +158,7 @@ def _stream_states(entropy, states):
         states[p, 3] = il
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_normal(sh, sl, ih, il):
     """One standard normal (numpy's ziggurat) from PCG64 state ``(sh, sl)``; returns ``(x, sh, sl)``.
 
@@ -194,7 +194,7 @@ def _pcg64_normal(sh, sl, ih, il):
                 return x, sh, sl
 
 
-@njit(cache=True, nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_rounds(sh, sl, ih, il, out, buf, left, i):
     """Continue filling ``out[i:]`` from PCG64 state ``(sh, sl)``; ``buf[:left]`` holds words not yet used.
 
@@ -236,7 +236,7 @@ def _pcg64_fill(states, p, out, words):
     states[p, 1] = sl
 
 
-@njit(cache=True, nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
     """:func:`_pcg64_fill` for two streams ``p``, ``q`` and rows of equal length, same numbers.
 

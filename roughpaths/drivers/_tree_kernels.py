@@ -139,7 +139,7 @@ def refine_segments(w, G, delta, z):
     return fine, GL, GR
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _solve_pairs(N, a, y, iu, ju, C):
     """In place: ``y <- (a I + M(N))⁻¹ y`` in pair coordinates (Cholesky; the matrix is a covariance)."""
     p = iu.size
