@@ -27,13 +27,14 @@ plain numpy calls and can be checked against them):
 
 The ziggurat (numpy's tables and algorithm over raw words) is :mod:`roughpaths.drivers._ziggurat`.
 
-Compile cost (first call, empty cache, CPU, quiet machine): the stream kernels of a first tree query or adaptive
+Compile cost (first call, empty cache, CPU, load about 1): the stream kernels of a first tree query or adaptive
 solve take about 0.3-0.5 s each (:func:`_stream_states` 0.45-0.5, :func:`_pcg64_fill2` 0.4, :func:`_pcg64_rounds`
-0.3, :func:`_pcg64_normals` 0.3-0.35, :func:`_pcg64_normal` 0.25). Every kernel of this subpackage compiles with
-the same numba flags (``nogil=True, no_cfunc_wrapper=True``): numba keys its compiled ``@overload``
-implementations (``np.empty`` and the like) by the flags of the kernel being compiled, so mixed flags compiled them
-again, and none of these kernels is used as a first-class function (the cfunc wrapper was lowered and optimised for
-nothing). Together about 0.3 s less per first call of the Brownian-tree and adaptive-solve families.
+0.3, :func:`_pcg64_normals` 0.3-0.35, :func:`_pcg64_normal` 0.25). The kernels of the stream, ziggurat, area,
+Fourier and tree modules compile with one set of numba flags (``nogil=True, no_cfunc_wrapper=True``): numba keys
+its compiled ``@overload`` implementations (``np.empty`` and the like) by the flags of the kernel being compiled,
+so mixed flags compiled some of them twice, and none of these kernels is used as a first-class function (its cfunc
+wrapper was lowered and optimised for nothing). Together 0.2-0.5 s less on the first call of the Brownian-tree and
+adaptive-solve families (medians of interleaved cold runs).
 """
 
 from __future__ import annotations
