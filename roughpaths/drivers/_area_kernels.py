@@ -33,7 +33,7 @@ from numba import njit
 from ._random import _pcg64_fill, _pcg64_fill2, _pcg64_normal
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _scale_accumulate(dW, sqh, x):
     """``dW[p, k] *= sqh[k]`` and ``x[p] += Σ_k dW[p, k]`` in one pass (numpy's middle-axis sum
     measured ~4x the cost of the scaling)."""
@@ -46,7 +46,7 @@ def _scale_accumulate(dW, sqh, x):
                 x[p, j] += v
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _path_normals(states, p, zrows, words):
     """Path ``p``'s normals for the whole block (a row of ``zrows (2, n)``), in stream order.
 
@@ -74,7 +74,7 @@ def _m1_scratch(h, buf, states):
     return np.sqrt(h / 12.0), h / np.sqrt(12.0), draw, na, zrows, words
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _areas_m1(dW, h, buf, states, davie, ito, out):
     """:func:`_block_areas` for ``m = 1`` (Davie's own method, ``A = H ∧ W + λ``, no substeps).
 
@@ -107,7 +107,7 @@ def _areas_m1(dW, h, buf, states, davie, ito, out):
                     q += 1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _areas_m1_d3(dW, h, buf, states, davie, ito, out):
     """:func:`_areas_m1` for ``d = 3``, the loops over the pairs written out (same operations in the same
     order, so the same bits): the general loop nest measured 27 ns per path-step here, this one 12 ns
@@ -150,7 +150,7 @@ def _areas_m1_d3(dW, h, buf, states, davie, ito, out):
             out[p, r, 2, 2] = 0.5 * W2 * W2 - diag
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _block_areas(dW, h, buf, states, m, davie, ito, out):
     """Level-2 step areas of a block ``(P, K)`` of path-steps from the per-step packed normals.
 
@@ -331,7 +331,7 @@ def _table_quantile(table, step, s, z):
     return g
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _exact_areas_d2(dW, h, states, table, step, n_terms, t1, t2, ito, out):
     r"""Exact-in-law d = 2 Lévy areas given the increments, from the per-path area streams.
 

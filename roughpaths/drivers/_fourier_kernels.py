@@ -59,7 +59,7 @@ def step_tables(plan: dict, h) -> tuple:
     return codes[inv], ns[inv], widths[inv], tails[inv]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _fourier_areas(dW, h, codes, ns, widths, tails, states, ito, out):
     """Step areas ``out (P, K, d, d)`` of a block from its increments ``dW (P, K, d)``, step lengths
     ``h (K,)``, the per-step tables of :func:`step_tables` and the paths' area-stream states

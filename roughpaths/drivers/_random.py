@@ -26,6 +26,15 @@ plain numpy calls and can be checked against them):
   numbers, slower.
 
 The ziggurat (numpy's tables and algorithm over raw words) is :mod:`roughpaths.drivers._ziggurat`.
+
+Compile cost (first call, empty cache, CPU, load about 1): the stream kernels of a first tree query or adaptive
+solve take about 0.3-0.5 s each (:func:`_stream_states` 0.45-0.5, :func:`_pcg64_fill2` 0.4, :func:`_pcg64_rounds`
+0.3, :func:`_pcg64_normals` 0.3-0.35, :func:`_pcg64_normal` 0.25). The kernels of the stream, ziggurat, area,
+Fourier and tree modules compile with one set of numba flags (``nogil=True, no_cfunc_wrapper=True``): numba keys
+its compiled ``@overload`` implementations (``np.empty`` and the like) by the flags of the kernel being compiled,
+so mixed flags compiled some of them twice, and none of these kernels is used as a first-class function (its cfunc
+wrapper was lowered and optimised for nothing). Together 0.2-0.5 s less on the first call of the Brownian-tree and
+adaptive-solve families (medians of interleaved cold runs).
 """
 
 from __future__ import annotations
@@ -135,7 +144,7 @@ def _xsl_rr(sh, sl):
     return (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _stream_states(entropy, states):
     """PCG64 states ``(P, 4)`` = (state_hi, state_lo, inc_hi, inc_lo) of the streams whose ``SeedSequence``
     entropy words are the rows of ``entropy`` (P, L) uint32 (see :func:`_generate_state`): numpy's
@@ -158,7 +167,7 @@ def _stream_states(entropy, states):
         states[p, 3] = il
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_normal(sh, sl, ih, il):
     """One standard normal (numpy's ziggurat) from PCG64 state ``(sh, sl)``; returns ``(x, sh, sl)``.
 
@@ -194,7 +203,7 @@ def _pcg64_normal(sh, sl, ih, il):
                 return x, sh, sl
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_rounds(sh, sl, ih, il, out, buf, left, i):
     """Continue filling ``out[i:]`` from PCG64 state ``(sh, sl)``; ``buf[:left]`` holds words not yet used.
 
@@ -236,7 +245,7 @@ def _pcg64_fill(states, p, out, words):
     states[p, 1] = sl
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
     """:func:`_pcg64_fill` for two streams ``p``, ``q`` and rows of equal length, same numbers.
 
@@ -261,7 +270,7 @@ def _pcg64_fill2(states, p, q, out_p, out_q, words_p, words_q):
     states[q, 0], states[q, 1] = _pcg64_rounds(qh, ql, qih, qil, out_q, words_q, n - used, i)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _pcg64_normals(states, out):
     """Row ``p`` of ``out (P, n)`` <- the next ``n`` standard normals of PCG64 stream ``states[p]``."""
     P, n = out.shape

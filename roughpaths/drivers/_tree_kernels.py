@@ -139,7 +139,7 @@ def refine_segments(w, G, delta, z):
     return fine, GL, GR
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _solve_pairs(N, a, y, iu, ju, C):
     """In place: ``y <- (a I + M(N))⁻¹ y`` in pair coordinates (Cholesky; the matrix is a covariance)."""
     p = iu.size
@@ -175,7 +175,7 @@ def _solve_pairs(N, a, y, iu, ju, C):
         y[q] = v / C[q, q]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _refine_segments_nb(w, G, delta, z, fine, GL, GR):
     """:func:`refine_segments` compiled, one path at a time (same formulas; writes ``fine``, ``GL``, ``GR``).
 
@@ -295,7 +295,7 @@ def refine_segments_fast(w, G, delta, z):
     return fine, GL, GR
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _reduce_nb(w, G, W, A):
     """``W = Σ_i w_i`` and ``A = ½ Σ_{i<j} w_i ∧ w_j + G`` per path (compiled :func:`polygon_area` plus ``G``)."""
     P, n, d = w.shape
@@ -338,7 +338,7 @@ def seed_prefix(seed_seq):
     return stream_prefix(seed_seq)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _split_seeded_nb(prefix, paths, tag, depth, index, width, w, G, delta, fine, GL, GR):
     P = w.shape[0]
     m = prefix.size

@@ -20,7 +20,12 @@ attempt (7 with one pair): the splits, about 1.5-2 µs each, and 0.7 µs of walk
 (``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive solve), of which about 1 s re-optimises that
 kernel's code linked into the walk; from numba's cache, 0.03 s. (Measured at load 1.3-1.4: 2.60-2.73 s, against
 2.54-2.62 s with one pair per depth; at load 2.3-2.9, three pairs kept in least-recently-used order took 2.7-3.0 s
-against 2.2-2.4 s, more compile than their 0.03 s per solve is worth.)
+against 2.2-2.4 s, more compile than their 0.03 s per solve is worth.) Measured again at load 1 (exclusive compile
+times from numba's events): ``_walk_nb`` 2.1-2.4 s, ``_refine_segments_nb`` 1.4-1.6 s, its ``_solve_pairs`` 0.45-0.6 s.
+Inlining (``inline="always"``) does not pay here: ``_refine_segments_nb`` inlined into the walk took 5.4 s against
+4.2 s for the three kernels apart (numba copies and re-types the callee's IR per call site, and the code that LLVM
+re-optimises inside the walk is only about a third of a kernel's compile), and ``_stream_states`` or
+``_solve_pairs`` inlined cost 0.3-0.8 s more than compiled apart.
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ __all__ = ["member_cells"]
 _WALK_CACHE_BYTES = 64 * 2 ** 20
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
     """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children of
     the last ``S`` (2, or 1 for a tree too large for two) nodes split at each depth of each tree row are kept in

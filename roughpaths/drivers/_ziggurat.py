@@ -83,7 +83,7 @@ def _abscissa(idx, rabs, neg, wi):
     return float(np.int64(rabs)) * wi[idx] * (1.0 - 2.0 * float(np.int64(neg)))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _ziggurat_run(raw, pos, out, i, ki, wi):
     """The accepted first-word attempts from ``raw[pos:]`` into ``out[i:]``, up to the first rejection or
     the end of either array; returns ``(pos, i)`` there.
@@ -103,7 +103,7 @@ def _ziggurat_run(raw, pos, out, i, ki, wi):
     return pos, i
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _ziggurat_fill(raw, out, start, ki, wi, fi, r_tail, inv_r):
     """Fill ``out[start:]`` from ``raw`` (uint64) with numpy's ziggurat; returns (raw consumed, next index).
 
