@@ -135,7 +135,7 @@ def expm_batched(A) -> np.ndarray:
     return out.reshape(shape)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _expm2(M, out):
     r"""``exp`` of each 2x2 matrix of ``M (B, 2, 2)`` in closed form, into ``out``.
 

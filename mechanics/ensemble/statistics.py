@@ -182,7 +182,7 @@ class LeafReducer:
         return out
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def accumulate(acc, values):
     """``acc[c] += values[c, t]`` for ``t`` in order (sequential in time: the sum of a path does not
     depend on how its steps were split into blocks). ``acc (C, p)``, ``values (C, T, p)``."""
@@ -192,7 +192,7 @@ def accumulate(acc, values):
                 acc[c, j] += values[c, t, j]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def accumulate_moments(acc, states):
     """``acc[c] += moment_observable(states[c, t])`` for ``t`` in order, without the temporary.
     ``acc (C, n + n(n+1)/2)``, ``states (C, T, n)``."""

@@ -73,7 +73,7 @@ def _block_kernel(C: int, N: int, full: bool, M3: bool):
     noise components (:func:`._soa_rows.eta_rows3`, else :func:`._soa_rows.eta_rows`: one of them compiles).
     """
 
-    @numba.njit(cache=True, nogil=True)
+    @numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
     def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
                   degth, save, out, first_bad, reason, stop, flag, sout, lo, hi, k0, start, qs, mts, has_f):
         """Members lo .. hi-1 over the steps from ``k0`` on (``code`` is the scheme the variant was made for, ``C``).

@@ -121,7 +121,7 @@ def theta_bound(s, cnorm, nd=()):
     return th
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def exp1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth, nd=()):
     """out = exp(ad*_s) mu for one member; False if not finite. Vector Taylor for θ ≤ THETA_VECTOR
     (the block path's series, to the degree of the table), else matrix scaling and squaring."""
@@ -230,7 +230,7 @@ def exp_dense1(s, mu, out, A, E, T, term, term2, ti, tj, tk, tv, cnorm, degth, n
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def invert(J, Ji, W, nd=()):
     """Ji = J⁻¹ (n × n) by Gauss–Jordan elimination with partial pivoting; False if singular / not finite."""
     n = dim(nd, J)
@@ -268,7 +268,7 @@ def invert(J, Ji, W, nd=()):
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def chord1(mu, e, s, dt, q, qs, lin, f, mts, theta, tol, max_iter, ti, tj, tk, tv, cnorm, degth, w, nd=()):
     """Chord iteration of the implicit midpoint rule for one member (``s`` in/out, started at
     w(mu) dt + e): J = I - dt/2 Dw(mu) L(mu), frozen; stops when max|Δσ| ≤ tol (1 + |σ|_∞)."""
@@ -340,7 +340,7 @@ def chord1(mu, e, s, dt, q, qs, lin, f, mts, theta, tol, max_iter, ti, tj, tk, t
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def midpoint1(mu, e, s, out, dt, q, qs, lin, f, mts, theta, tol, max_iter, ti, tj, tk, tv, cnorm, degth, w, nd=()):
     """One implicit-midpoint step of one member: ``s = w(mu) dt + e``, the chord iteration, ``out = exp(ad*_s) mu``.
 
@@ -354,7 +354,7 @@ def midpoint1(mu, e, s, out, dt, q, qs, lin, f, mts, theta, tol, max_iter, ti, t
     return exp_dense1(s, mu, out, w[5], w[6], w[7], w[8][6], w[8][7], ti, tj, tk, tv, cnorm, degth, nd), False
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def rare_steps(y, sout, flag, ti, tj, tk, tv, cnorm, degth, first_bad, reason, k):
     """The exact exponential (:func:`exp1`, scaling and squaring) of the flagged members of one
     block, rows ``y`` (B, n) and their step's ``σ`` in ``sout`` (B, n): the steps the vectorised Taylor loop

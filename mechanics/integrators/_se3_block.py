@@ -99,7 +99,7 @@ def _rows(wb, at):
     return wb[at:at + 6 * B].reshape((6, B))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _velocity(wb, out, lin, f, theta, qs, mts, bc, yes):
     """``out`` (6 rows of ``wb``) = w(rows ``_A1``) = g + θ M⁻¹ ad*_{g+f} μ, g = Q μ + lin (rows ``_G``, ``_T2`` are
     work; ``yes`` is True, passed as a value: a literal would compile a variant of :func:`._soa_rows.affine_rows`).
@@ -155,7 +155,7 @@ def _eta3(x, wb, bc, xi, brk):
             wb[_E + i * B + p] = acc
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _sigma(wb, heun, pred, dt, c, l1, l2, bc):
     """Row ``_S`` = σ = w(μ) dt + e (Lie–Euler, and Lie–Heun's predictor step) or, with ``heun``, ½(w(μ) + w(μ*)) dt
     + e; row ``_TH`` = θ = Σ|σ_i| cnorm_i; rows ``_A1`` = the Taylor sum of exp(ad*_σ) μ to degree 2, a degree added
@@ -254,7 +254,7 @@ def _kernel(full: bool):
     """:func:`run_block` (``full=False``) or :func:`run_block_full` (the exact exponential of the rare large steps
     inline): see :func:`._generic_kernels._block_kernel`. ``full`` is a closure constant."""
 
-    @numba.njit(cache=True, nogil=True)
+    @numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
     def run_block(y, dX, dXX, xi, brk, pi, pj, dts, code, q, lin, f, mth, theta, tol, max_iter, ti, tj, tk, tv, cnorm,
                   degth, save, out, first_bad, reason, stop, flag, sout, lo, hi, k0, start, qs, mts, has_f):
         """Members lo .. hi-1 (at most :data:`B`) over the steps from ``k0`` on by Lie–Euler (``code`` 0) or Lie–Heun

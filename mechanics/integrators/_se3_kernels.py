@@ -111,7 +111,7 @@ def _hat_into(M, r0, c0, x0, x1, x2, sign):
     M[r0 + 2, c0], M[r0 + 2, c0 + 1], M[r0 + 2, c0 + 2] = -sign * x1, sign * x0, 0.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _invert6(J, Ji, W):
     """Ji = J⁻¹ (6×6) by Gauss–Jordan elimination with partial pivoting; False if a pivot is zero or
     not finite (the member then fails alone). ``W`` is a (6, 12) work array."""
@@ -149,7 +149,7 @@ def _invert6(J, Ji, W):
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _se3_chord(mu, e, s, dt, q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji, W, g, t1, t2, m1, mid, u):
     """Chord iteration for the implicit midpoint sigma (in ``s``, started at w(mu) dt + e) on se(3)*.
 
@@ -265,7 +265,7 @@ def _finish_step(mu, new, ok, finite_in, p, k, first_bad, reason, save, out, slo
     return finite, slot, nfail
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _se3_midpoint_block(y, dX, dXX, xi, brk, pi, pj, dts, q, lin, f, minv, theta, tol, max_iter, save, out,
                         first_bad, reason, stop, lo, hi):
     """Advance members lo .. hi-1 of y (B, 6) over dX (B, K, d), dXX (B, K, d, d) (or empty) by the implicit

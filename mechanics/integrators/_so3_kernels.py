@@ -159,7 +159,7 @@ def _pairs(nm: int):
 _TILE = 32
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _velocities(dX, dXX, xi, brk, pi, pj, k0, tile):
     """``tile[p, t]`` <- the stochastic velocity of member ``p`` at step ``k0 + t``:
     Σ_i dX_i ξ_i + Σ_{i<j} A_ij [ξ_i, ξ_j], ``A = ½(XX - XXᵀ)`` (no area term when ``dXX`` is empty).
@@ -288,7 +288,7 @@ def _range_kernel(C: int, full: bool):
     step compiles only the first (about 1.4 s of CPU less); one that does compiles both, once per cache."""
     F = bool(full)             # closure constants (ints and bools only: they key numba's cache)
 
-    @numba.njit(cache=True, nogil=True)
+    @numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
     def so3_range(y, dX, dXX, xi, brk, pi, pj, dts, coef, code, tol, max_iter, q, lin, minv, theta, save, out,
                   first_bad, reason, stop, bad, eout, lo, hi, k0):
         """Run :func:`_so3_dx_block` on members ``lo .. hi-1`` of ``y`` (B, 3) from step ``k0`` (one block of the

@@ -59,7 +59,7 @@ def _w3(q, lin, minv, theta, m0, m1, m2):
             g2 + theta * (minv[2, 0] * v0 + minv[2, 1] * v1 + minv[2, 2] * v2))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _so3_chord(m0, m1, m2, e0, e1, e2, s0, s1, s2, dt, q, lin, minv, theta, tol, max_iter):
     """Chord iteration for the implicit midpoint sigma on so(3)*; returns sigma and a convergence flag."""
     # chord Jacobian J = I - dt/2 Dw(mu) L(mu), L(mu) d = ad*_d mu = mu × d; g: the gradient inside
@@ -179,7 +179,7 @@ def so3_scalar_steps(ma, mb, mc, ea, eb, ec, bad, dt, q, lin, minv, theta, code,
     return nnew
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def so3_rare_steps(y, e, bad, dt, q, lin, minv, theta, code, tol, max_iter, first_bad, reason, k):
     """:func:`so3_scalar_steps` on rows ``y`` (B, 3), ``e`` (B, 3) of one block: the steps the vector loop left
     (``|sigma|²`` past the Taylor branch, or non-finite). Its own kernel, compiled only when a solve reaches

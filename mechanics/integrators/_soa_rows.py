@@ -68,7 +68,7 @@ def saw_rare_step(key) -> None:
 # ---------------------------------------------------------------------- block (structure-of-arrays) operations
 # Every output row is written in passes over the block's members (measured: one non-zero per pass is
 # faster than two per pass here: 2.7 against 4.6 ns per member for so(3)'s ad*, 3.7 with a zeroing pass).
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def ad_star_rows(x, mu, out, ti, tk, tv, start, bc):
     """out[j, p] = (ad*_{x[:, p]} mu[:, p])_j for p < bc (terms grouped by j: ``start[j] .. start[j+1]``;
     one pass per non-zero, the first one of a row writing it)."""
@@ -88,7 +88,7 @@ def ad_star_rows(x, mu, out, ti, tk, tv, start, bc):
                     o[p] += va * xa[p] * ma[p]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def affine_rows(base, const, cols, vals, start, x, out, bc, use_base):
     """out[i, p] = ((base[i, p] if use_base) + const[i]) + Σ_t vals[t] x[cols[t], p] over the row's non-zeros
     (one pass per non-zero; the first also writes the constant)."""
@@ -117,7 +117,7 @@ def affine_rows(base, const, cols, vals, start, x, out, bc, use_base):
                     o[p] += va * xa[p]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv, start, bc):
     """out = w(mu) = g + θ M⁻¹ ad*_{g+f} mu, g = Q mu + lin; ``qs``, ``mts``: the non-zeros of Q and θ M⁻¹."""
     yes = bc >= 0           # True as a plain bool: the literals True and False compile two variants of affine_rows
@@ -140,7 +140,7 @@ def velocity_rows(mu, lin, f, has_f, theta, qs, mts, g, t1, t2, out, ti, tk, tv,
     affine_rows(g, mts[3], mts[0], mts[1], mts[2], t2, out, bc, yes)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
     """:func:`eta_rows` for three noise components: the same sums in the same order (the same bits), the
     loops over the components and pairs written out."""
@@ -166,7 +166,7 @@ def eta_rows3(dX, dXX, area, lo, bc, k0, kc, xi, brk, e):
                 e[kk, i, p] = acc
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def eta_rows(dX, dXX, area, lo, bc, k0, kc, xi, brk, pi, pj, e):
     """e[kk, :, p] = Σ_r dX_r ξ_r + Σ_{i<j} A_ij [ξ_i, ξ_j] (A = ½(XX − XXᵀ)) for members lo .. lo+bc-1 and
     steps k0 .. k0+kc-1 (member by member, so each member's increments are read in order). Three noise

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _log_one(a, d, m, offsets, r, t):
     """``r <- log(1 + a)`` (row-major, truncated at ``m``) by Horner, ``t`` scratch of the same size.
 
@@ -47,14 +47,14 @@ def _log_one(a, d, m, offsets, r, t):
                         t[base + q] += rp * a[oj + q]
         for u in range(np.uint64(offsets[kmax + 1])):
             r[u] = t[u]
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _lyndon_one(z, lev_off, lidx, indptr, indices, data, out, out_off):
     for i in range(lidx.shape[0]):
         v = z[lev_off + lidx[i]]
         for t in range(indptr[i], indptr[i + 1]):
             v -= data[t] * out[out_off + indices[t]]
         out[out_off + i] = v
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def lyndon_vjp(gc, out_off, lidx, indptr, indices, data, gz, lev_off):
     """Transpose of one level of the Lyndon projection: ``gz[lidx] = M^{-T} gc`` (back substitution)."""
     n = lidx.shape[0]

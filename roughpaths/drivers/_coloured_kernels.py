@@ -8,7 +8,7 @@ import numpy as np
 from .coloured_noise_law import _K_UV, _K_XU, _K_XV
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _ou_lift_kernel(y, z, Phi, L, Ainv, D, eps, delta, inc, area, ygrid, binc, barea):  # pragma: no cover
     """Advance ``y`` (P, n) over S coarse steps of ``msub`` sub-steps each (z: (P, S, msub, n+m))."""
     P, S, msub, k = z.shape

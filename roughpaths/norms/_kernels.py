@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def holder_sups(incx, areax, incy, areay, times, alpha, level2, diff, lagw):
     r"""Squared Hölder quotients of a batch (or of a difference of two batches).
 
@@ -89,7 +89,7 @@ def holder_sups(incx, areax, incy, areay, times, alpha, level2, diff, lagw):
     return sup1, sup2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _box_reach(pj, lo, hi, d):
     """Largest Euclidean distance from ``pj`` to a point of the box ``[lo, hi]``."""
     s = 0.0
@@ -101,7 +101,7 @@ def _box_reach(pj, lo, hi, d):
     return np.sqrt(s)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def pvar_level1(paths, p, prune, block):
     r"""Exact p-variation (to the power p) of each path over all partitions by grid points.
 
@@ -175,7 +175,7 @@ def pvar_level1(paths, p, prune, block):
     return out, prev_all
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def pvar_level2(inc, areas, q):
     r"""Exact ``sup Σ |XX_{t_i t_{i+1}}|_F^q`` over partitions by grid points (``q = p / 2``).
 
@@ -218,7 +218,7 @@ def pvar_level2(inc, areas, q):
     return out, prev_all
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def holder_level1_pruned(paths, times, alpha, block):
     r"""``sup_{i<j} |P_j - P_i|^2 / (t_j - t_i)^{2α}`` per path, with branch-and-bound.
 

@@ -59,7 +59,7 @@ from .._variants import variants
 
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 #: Segments whose top-level products are added in one sweep.
 KBLOCK = 16

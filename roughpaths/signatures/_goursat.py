@@ -34,7 +34,7 @@ import numpy as np
 
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
-_OPTS = dict(cache=True, nogil=True, error_model="numpy", boundscheck=False)
+_OPTS = dict(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", boundscheck=False)
 L = LANES
 
 

@@ -25,10 +25,10 @@ from numba import njit
 
 from ._lanes import mul_inplace
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _exp_lie2(x, a, d, m, offsets, out, p, q):
     """``out <- exp(x + a) - 1`` truncated at depth ``m`` (reversed layout).
 

@@ -47,7 +47,7 @@ from .._variants import variants
 
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 #: Segments per transposed block of increments.
 BLOCK = 64
@@ -82,7 +82,7 @@ def _addto(y, yo, x, xo, n):
         y[u + p] += x[v + p]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def mul_inplace(s, e, d, m, offsets):
     """In place Chen product ``s <- s ⊗ e`` of group-like elements (implicit 1, reversed layout)."""
     for k in range(m, 0, -1):
@@ -399,7 +399,7 @@ def lane_groups(d: int, m: int):
     return _lane_groups_kernel(*lane_key(d, m))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _glue(part, nchunks, b, m, offsets, out):
     d = offsets[2]
     dim = offsets[m + 1]

@@ -16,10 +16,10 @@ from .._variants import variants
 
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _area_chunk_d2(x, b, lo, hi, out):
     x0, x1 = x[b, lo, 0], x[b, lo, 1]
     p0 = 0.0
@@ -35,7 +35,7 @@ def _area_chunk_d2(x, b, lo, hi, out):
     out[2] = a01
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _area_chunk_d3(x, b, lo, hi, out):
     x0, x1, x2 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2]
     p0 = 0.0
@@ -60,7 +60,7 @@ def _area_chunk_d3(x, b, lo, hi, out):
     out[5] = a12
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _area_chunk_d4(x, b, lo, hi, out):
     x0, x1, x2, x3 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2], x[b, lo, 3]
     p0, p1, p2, p3 = 0.0, 0.0, 0.0, 0.0
@@ -90,7 +90,7 @@ def _area_chunk_d4(x, b, lo, hi, out):
     out[9] = a23
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _area_chunk_d5(x, b, lo, hi, out):
     x0, x1, x2, x3, x4 = x[b, lo, 0], x[b, lo, 1], x[b, lo, 2], x[b, lo, 3], x[b, lo, 4]
     p0, p1, p2, p3, p4 = 0.0, 0.0, 0.0, 0.0, 0.0
@@ -134,7 +134,7 @@ def _area_chunk_d5(x, b, lo, hi, out):
 _KB2 = 16
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _area_chunk_generic(x, b, lo, hi, out):
     # the d x d table above its diagonal, acc[i, j] += y_{k-1}[i] y_k[j] - y_{k-1}[j] y_k[i] (the same
     # expression per pair i < j as the d = 2..5 kernels), for _KB2 points at a time: each packed row
@@ -286,7 +286,7 @@ def sig2_lane_tasks(x, nchunks, lo, hi, part):
                 row[d + q] = acc[q * LANES + l]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _glue_total(part, b, nchunks, d, tot):
     """``tot <- (increment, twice the Lévy area over i<j)`` of path ``b``, chunks glued by Chen in order."""
     for r in range(tot.shape[0]):

@@ -14,10 +14,10 @@ from ._kernels import _exp_lie2
 from ._lanes import mul_inplace
 from ._vjp import _lcon, _mul_rev, _rcon
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _rough_vjp_one(inc, lev, s, g, d, m, offsets, ginc, glev):
     """Backward through ``S = prod_k exp(inc_k + lev_k)`` for one path (reversed layout).
 

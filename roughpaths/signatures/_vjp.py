@@ -23,7 +23,7 @@ from .._variants import variants
 from ._lanes import BLOCK, _addto, _axpy, _horner_step, _lane_step_d, mul_inplace, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 
 @njit(cache=True, inline="always")
@@ -54,7 +54,7 @@ def _dot_wide(a, ao, b, bo, n):
     return (s0 + s1) + (s2 + s3)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _lcon(x0, s, g, d, m, offsets, out):
     """``out <- (x0 + s) ▷ g``: ``out_j[w] = x0 g_j[w] + sum_{i>=1} sum_u s_i[u] g_{i+j}[u w]``.
 
@@ -72,7 +72,7 @@ def _lcon(x0, s, g, d, m, offsets, out):
                 out[oj + w] += _dot_wide(s, oi, g, ok + ni * w, ni)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _rcon(x0, g, e, d, m, offsets, out):
     """``out <- g ◁ (x0 + e)``: ``out_i[p] = x0 g_i[p] + sum_{j>=1} sum_q g_{i+j}[p q] e_j[q]``."""
     for i in range(1, m + 1):
@@ -179,7 +179,7 @@ def _unit_vjp(x, b, lo, hi, s, g, K, V, d, m, offsets, gd):
             g[r] = gn[r]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
     """Cotangent of unit ``u``'s signature: ``P ▷ (G ◁ Q)``, P/Q the products of the units before/after."""
     dim = offsets[m + 1]
@@ -196,7 +196,7 @@ def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
     _lcon(1.0, pre, tmp, d, m, offsets, g)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _mul_rev(x0, xs, a, d, m, offsets, out):
     """``out <- (x0 + xs) ⊗ a`` (``a`` with no scalar), reversed layout, levels 1..m."""
     for k in range(1, m + 1):

@@ -30,7 +30,7 @@ from ._lanes import _horner_step, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 from ._vjp import _dot_wide, _step_vjp_d, _tb_row, _unit_cotangent
 
-_NOGIL = dict(cache=True, nogil=True)
+_NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
 #: Segments whose top-level products with ``G_m`` are formed in one sweep.
 KB = 16

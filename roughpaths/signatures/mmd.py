@@ -70,7 +70,7 @@ class MMDTestResult:
                 f"n_permutations={self.n_permutations}, null_statistics={summary})")
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _mmd_stats(K, labels, a, b):
     """Unbiased MMD² for each labelling (``labels[r, i] = 1``: pooled path ``i`` in the first sample).
 

@@ -36,7 +36,7 @@ from ..validation import as_float_array, check_memory, check_work
 __all__ = ["signature_coefficients"]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _word_rows(x, letters, lengths, lo, hi, out):
     """``out[b, w]`` for the rows ``r = b * W + w`` in ``lo..hi-1``: the Horner recursion of the module.
 
