@@ -75,6 +75,8 @@ def warm_more_signatures() -> None:
             rp.signature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.sigdim(np.shape(x)[-1], m),)))
             rp.logsignature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.logsigdim(np.shape(x)[-1], m),)))
     rp.signature(path(2 * 8192 + 8, 3), 2)                 # level 2, chunked
+    rp.signature(path(9, 700, 7), 3)                        # the lanes' (7, 3) variant
+    rp.signature(path(9, 700, 1), 3)                        # the lanes' run-time variant (d = 1 reaches it)
     X = rp.RoughPath.from_path(path(10, 9, 3))
     for m in (2, 3):
         s = rp.rough_path_signature(X, m)
