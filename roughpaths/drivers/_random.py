@@ -30,11 +30,11 @@ The ziggurat (numpy's tables and algorithm over raw words) is :mod:`roughpaths.d
 Compile cost (first call, empty cache, CPU, load about 1): the stream kernels of a first tree query or adaptive
 solve take about 0.3-0.5 s each (:func:`_stream_states` 0.45-0.5, :func:`_pcg64_fill2` 0.4, :func:`_pcg64_rounds`
 0.3, :func:`_pcg64_normals` 0.3-0.35, :func:`_pcg64_normal` 0.25). The kernels of the stream, ziggurat, area,
-Fourier and tree modules compile with one set of numba flags (``nogil=True, no_cfunc_wrapper=True``): numba keys
-its compiled ``@overload`` implementations (``np.empty`` and the like) by the flags of the kernel being compiled,
-so mixed flags compiled some of them twice, and none of these kernels is used as a first-class function (its cfunc
-wrapper was lowered and optimised for nothing). Together 0.2-0.5 s less on the first call of the Brownian-tree and
-adaptive-solve families (medians of interleaved cold runs).
+Fourier and tree modules compile with the library's one set of numba flags (``docs/architecture.md``,
+``tests/test_kernel_flags.py``): numba keys its compiled ``@overload`` implementations (``np.empty`` and the like)
+by the flags of the kernel being compiled, so mixed flags compiled some of them twice, and none of these kernels
+is used as a first-class function (its cfunc wrapper was lowered and optimised for nothing). Together 0.2-0.5 s
+less on the first call of the Brownian-tree and adaptive-solve families (medians of interleaved cold runs).
 """
 
 from __future__ import annotations
@@ -328,7 +328,6 @@ def _numpy_states(seed_seq: np.random.SeedSequence, keys) -> np.ndarray:
             pool_size=seed_seq.pool_size)).state["state"]
         states[j] = (st["state"] >> 64, st["state"] & _MASK64, st["inc"] >> 64, st["inc"] & _MASK64)
     return states
-
 
 
 def _fast_streams_ok() -> bool:

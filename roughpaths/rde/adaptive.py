@@ -80,10 +80,11 @@ def _step_doubling(solver, fields, y, a):
     second half another: two calls instead of three, the same numbers. They call ``solver.step`` (the
     contract's ``integrate`` returns what stepping returns) with the arguments ``integrate`` passes it."""
     if a.times.ndim == 2 and isinstance(a.dXX, np.ndarray):
-        n, ts, t = y.shape[0], a.times, a.times[:, :1]
-        both = solver.step(fields, np.concatenate([y, y]), np.concatenate([t, t]), np.concatenate([ts[:, 1:2] - t,
-                           ts[:, 2:] - t]), *(np.concatenate([x[:, 0], w[:, 0]]) for x, w in zip((a.dX, a.dXX), a.whole)))
-        return solver.step(fields, both[:n], ts[:, 1:2], ts[:, 2:] - ts[:, 1:2], a.dX[:, 1], a.dXX[:, 1]), both[n:]
+        n, (t0, tm, t1) = y.shape[0], np.split(a.times, 3, axis=1)              # (members, 1) each
+        dX, dXX = np.concatenate([a.dX[:, 0], a.whole[0][:, 0]]), np.concatenate([a.dXX[:, 0], a.whole[1][:, 0]])
+        both = solver.step(fields, np.concatenate([y, y]), np.concatenate([t0, t0]),
+                           np.concatenate([tm - t0, t1 - t0]), dX, dXX)                # first half; whole step
+        return solver.step(fields, both[:n], tm, t1 - tm, a.dX[:, 1], a.dXX[:, 1]), both[n:]
     y2 = solver.integrate(fields, y, a.times, a.dX, a.dXX, a.save, stop_on_failure=a.stop)[0]
     return y2, solver.integrate(fields, y, a.times[..., [0, -1]], *a.whole, a.save[:1], stop_on_failure=False)[0]
 

@@ -205,7 +205,8 @@ class PIController(StepController):
 
     def error_ratio(self, y, y_new, y_err, h, span):
         scale = self.atol + self.rtol * np.maximum(np.abs(y), np.abs(y_new))
-        return np.sqrt(np.add.reduce((y_err / scale) ** 2, axis=-1) / y.shape[-1]) * np.sqrt(span / h)  # np.mean
+        ms = np.add.reduce((y_err / scale) ** 2, axis=-1) / y.shape[-1]    # np.mean's sum and division, unwrapped
+        return np.sqrt(ms) * np.sqrt(span / h)
 
     def adapt(self, state, t, h, r):
         accept = r <= 1.0
