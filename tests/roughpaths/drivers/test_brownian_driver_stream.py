@@ -233,10 +233,13 @@ def test_error_controlled_methods_refuse_substeps_and_other_methods_refuse_an_er
         BrownianDriver(2, seed=1, dt=0.1, n_steps=3, levy_area="davie", levy_area_error=1e-3)
 
 
-@pytest.mark.parametrize("n_keys", [3, 40])      # numpy's own seeding (a small batch) and the seeding kernel
-def test_stream_states_are_numpy_pcg64_states(n_keys):
+# numpy's own seeding (a small batch) and the seeding kernel, on one-word keys and on keys past 2^32 (the
+# kernel's row-by-row branch)
+@pytest.mark.parametrize("first", [0, 2**33 + 5])
+@pytest.mark.parametrize("n_keys", [3, 40])
+def test_stream_states_are_numpy_pcg64_states(n_keys, first):
     ss = np.random.SeedSequence(2**70 + 9, spawn_key=(5,))
-    keys = np.stack([np.arange(n_keys) * 7919, np.arange(n_keys) % 3], axis=1)
+    keys = np.stack([first + np.arange(n_keys) * 7919, np.arange(n_keys) % 3], axis=1)
     states = PathStreams(ss, keys).states
     for j in (0, n_keys // 2, n_keys - 1):
         st = np.random.PCG64(np.random.SeedSequence(2**70 + 9, spawn_key=(5, *map(int, keys[j])))).state["state"]
