@@ -14,7 +14,8 @@ import numpy as np
 
 
 def chord_solve(system, mu, dt, eta, tol, max_iter):
-    """Return ``(sigma (..., n), converged (...) bool)`` for states ``mu`` and stochastic velocities ``eta``.
+    """Return ``(sigma (..., n), converged (...) bool)`` for states ``mu``, steps ``dt`` (a float, or ``(..., 1)``
+    per member) and stochastic velocities ``eta``.
 
     ``mu`` and ``eta`` broadcast to a common batch; a member that does not converge within
     ``max_iter`` iterations (or becomes non-finite) gets ``converged = False`` and NaN ``sigma``.
@@ -24,9 +25,13 @@ def chord_solve(system, mu, dt, eta, tol, max_iter):
     n = shape[-1]
     mu = mu.reshape(-1, n)
     eta = eta.reshape(-1, n)
+    member_dt = np.ndim(dt) > 0                 # dt (..., 1) per member, else one float
+    if member_dt:
+        dt = np.broadcast_to(np.asarray(dt, dtype=np.float64), shape[:-1] + (1,)).reshape(-1, 1)
     alg = system.algebra
     w0 = system.drift_velocity(mu)
-    jac = np.eye(n) - 0.5 * dt * (system.drift_velocity_jacobian(mu) @ alg.coadjoint_orbit_tangent(mu))
+    jac = np.eye(n) - 0.5 * (dt[..., None] if member_dt else dt) * (
+        system.drift_velocity_jacobian(mu) @ alg.coadjoint_orbit_tangent(mu))
     jinv = _member_inverses(jac)
     sigma = w0 * dt + eta
     done = np.zeros(mu.shape[0], dtype=bool)
@@ -45,7 +50,7 @@ def chord_solve(system, mu, dt, eta, tol, max_iter):
             if active.size == 0:
                 break
         with np.errstate(all="ignore"):
-            resid = s_a - system.drift_velocity(0.5 * (mu_a + mu1)) * dt - eta[active]
+            resid = s_a - system.drift_velocity(0.5 * (mu_a + mu1)) * (dt[active] if member_dt else dt) - eta[active]
             delta = (jinv[active] @ resid[..., None])[..., 0]
             s_a = s_a - delta
         sigma[active] = s_a

@@ -56,6 +56,12 @@ Hamiltonian) a batched numpy loop (``Ad*exp`` in closed form for so(3)/se(3), :f
 per member otherwise). Either way a batch member's result depends on its own data only; a member that
 fails is reported through ``first_bad`` (contract item 8).
 
+Steps per member (contract item 10, ``member_times``): ``integrate`` also takes ``times (..., K + 1)``, one grid
+per member, and ``step`` a ``dt (..., 1)``; both run the numpy path (the compiled kernels take one time grid),
+member by member in one call. Adaptive solves (:func:`roughpaths.solve` with ``step_control=PIController(...)``)
+use it by default, each member with steps of its own; the stochastic rigid body at ``rtol = 3·10⁻³``, 1000 paths:
+0.51 s of CPU, of which the tree's walk is 0.30 s and the numpy steps 0.18 s.
+
 Threads: the compiled kernels split the paths into blocks and run them on numba's threads; set their
 number with ``numba.set_num_threads(k)`` (or the environment variable ``NUMBA_NUM_THREADS`` before the
 first import). The isospectral steps share blocks of members between as many Python threads (numpy releases
@@ -87,6 +93,14 @@ __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordC
            "check_on_orbit"]
 
 
+def _member_dt(dt, shape):
+    """A step's ``dt``: a float (one step for the batch), or an array ``(..., 1)`` of steps per member broadcast to
+    ``shape[:-1] + (1,)`` (contract item 10)."""
+    if np.ndim(dt) == 0:
+        return float(dt)
+    return np.broadcast_to(np.asarray(dt, dtype=np.float64), shape[:-1] + (1,))
+
+
 class ChordConvergenceError(RuntimeError):
     """The implicit midpoint's chord iteration did not converge (the message names the step and members)."""
 
@@ -111,6 +125,8 @@ class CoadjointSolver(Solver):
     increment_level = 2
     #: strong order on Brownian rough paths with a level-2 driver (½ with a level-1 driver, non-commuting ξ)
     order = 1.0
+    #: steps per member in one call (contract item 10): adaptive steps per member, on the numpy path
+    member_times = True
 
     def __init__(self, **unexpected):
         if unexpected:
@@ -153,12 +169,13 @@ class CoadjointSolver(Solver):
         live = np.all(np.isfinite(mu), axis=-1) & np.all(np.isfinite(eta), axis=-1)
         new = np.full(mu.shape, np.nan)
         conv = None
+        dt = _member_dt(dt, mu.shape)
         if np.all(live):                        # members are computed alone or as a subset: same bits
-            mu_l, eta_l = mu, eta
+            mu_l, eta_l, dt_l = mu, eta, dt
         else:
-            mu_l, eta_l = mu[live], eta[live]
+            mu_l, eta_l, dt_l = mu[live], eta[live], dt if isinstance(dt, float) else dt[live]
         with np.errstate(all="ignore"):
-            sigma, conv_l = self._sigma(system, mu_l, dt, eta_l)
+            sigma, conv_l = self._sigma(system, mu_l, dt_l, eta_l)
             sig_ok = np.all(np.isfinite(sigma), axis=-1)
             if not np.all(sig_ok):
                 sigma = np.where(sig_ok[..., None], sigma, 0.0)
@@ -182,10 +199,11 @@ class CoadjointSolver(Solver):
         dx = np.broadcast_to(np.asarray(dx, dtype=np.float64), batch + (m,))
         dxx = None if dxx is None else np.broadcast_to(np.asarray(dxx, dtype=np.float64), batch + (m, m))
         live = np.all(np.isfinite(mu), axis=-1) & np.all(np.isfinite(eta), axis=-1) & np.all(np.isfinite(dx), axis=-1)
-        sub = (lambda a: a) if np.all(live) else (lambda a: None if a is None else a[live])
+        sub = (lambda a: a) if np.all(live) else (lambda a: a if a is None or isinstance(a, float) else a[live])
         new = np.full(batch + (n,), np.nan)
+        dt = _member_dt(dt, batch + (n,))
         with np.errstate(all="ignore"):
-            new_l, conv_l = forced_sigma_and_state(self._code, system, sub(mu), dt, sub(eta), sub(dx), sub(dxx),
+            new_l, conv_l = forced_sigma_and_state(self._code, system, sub(mu), sub(dt), sub(eta), sub(dx), sub(dxx),
                                                    self._sigma)
         ok_l = np.all(np.isfinite(new_l), axis=-1)
         conv = None
@@ -212,10 +230,11 @@ class CoadjointSolver(Solver):
         return None
 
     def step(self, fields, y, t, dt, dX, dXX):
-        """One step (contract item 7); a failed member comes back NaN."""
+        """One step (contract item 7; ``dt`` a scalar, or ``(..., 1)`` per member, item 10); a failed member comes
+        back NaN."""
         if fields.has_forces:
-            return self._advance_forced(fields, y, float(dt), self._eta(fields, dX, dXX), dX, dXX)[0]
-        return self._advance(fields, y, float(dt), self._eta(fields, dX, dXX))[0]
+            return self._advance_forced(fields, y, dt, self._eta(fields, dX, dXX), dX, dXX)[0]
+        return self._advance(fields, y, dt, self._eta(fields, dX, dXX))[0]
 
     def integrate(self, fields, y, times, dX, dXX, save, stop_on_failure=True):
         """Advance a block of steps (contract item 8); compiled kernels where they apply (module docstring).
@@ -226,11 +245,15 @@ class CoadjointSolver(Solver):
         system = fields
         n = system.dim
         batch = y.shape[:-1]
-        dts = np.diff(np.asarray(times, dtype=np.float64))
-        nk = dts.size
+        times = np.asarray(times, dtype=np.float64)
+        own = times.ndim > 1                    # each member on its own times (contract item 10): the numpy path
+        if own:
+            times = np.broadcast_to(times, batch + times.shape[-1:])
+        dts = np.diff(times)
+        nk = dts.shape[-1]
         nsave = int(np.count_nonzero(save))
-        plain = system.hamiltonian.is_quadratic and not system.has_forces      # forces: the numpy path
-        matrix = isinstance(system.algebra, MatrixLieAlgebra) and not system.has_forces
+        plain = system.hamiltonian.is_quadratic and not system.has_forces and not own     # forces: the numpy path
+        matrix = isinstance(system.algebra, MatrixLieAlgebra) and not system.has_forces and not own
         if plain and not isinstance(system.algebra, (SO3Algebra, SE3Algebra)):
             system, matrix = choose(system, dts)     # constants or matrices, by a cost model (._dispatch)
         if matrix:                      # the state held as a matrix, updated by conjugation (._isospectral)
@@ -273,11 +296,12 @@ class CoadjointSolver(Solver):
             y2 = y
             eta = self._eta(system, dX, dXX)                                    # (B_X..., K, n)
             for k in range(nk):
+                dt = dts[..., k, None] if own else float(dts[k])
                 if system.has_forces:
-                    y2, ok, conv = self._advance_forced(system, y2, float(dts[k]), eta[..., k, :], dX[..., k, :],
+                    y2, ok, conv = self._advance_forced(system, y2, dt, eta[..., k, :], dX[..., k, :],
                                                         None if dXX is None else dXX[..., k, :, :])
                 else:
-                    y2, ok, conv = self._advance(system, y2, float(dts[k]), eta[..., k, :])
+                    y2, ok, conv = self._advance(system, y2, dt, eta[..., k, :])
                 new = ~ok & (first_bad < 0)
                 if new.any():
                     first_bad[new] = k
@@ -294,6 +318,9 @@ class CoadjointSolver(Solver):
 
     def _chord_error(self, members, first_bad, times, dts):
         k = int(min(first_bad[tuple(m)] for m in members))
+        if times.ndim > 1:                     # times per member: those of the first member that failed at step k
+            first = next(tuple(m) for m in members if first_bad[tuple(m)] == k)
+            times, dts = times[first], dts[first]
         who = ", ".join(str(tuple(int(i) for i in m)) for m in members[:8])
         return ChordConvergenceError(
             f"implicit midpoint: the chord iteration did not converge at step {k} of the block from "

@@ -122,10 +122,10 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
         ``Solution.times`` has the batch's axes, shorter rows repeating their last time and state); ``True``
         makes the batch take the same steps (the error ratio is the maximum over its members). ``None``
         (default): steps per member where the solver steps members on their own times in one call
-        (``Solver.member_times``: ``Davie``, ``LogODE``, ``Heun``, ``Euler``, on autonomous fields or fields
-        declared ``batched_time``), shared steps otherwise (e.g. the coadjoint solvers of :mod:`mechanics`,
-        whose compiled kernels take one time grid), where per-member steps cost one call per member per
-        attempt. ``Solution.stats["shared_steps"]`` says which ran.
+        (``Solver.member_times``: ``Davie``, ``LogODE``, ``Heun``, ``Euler`` on autonomous fields or fields
+        declared ``batched_time``, and the coadjoint solvers of :mod:`mechanics`), shared steps otherwise, where
+        per-member steps cost one call per member per attempt. ``Solution.stats["shared_steps"]`` says which
+        ran.
     progress : None, bool or callable
         Report progress and the time left (:mod:`roughpaths.progress`): ``None``/``False`` silent (default),
         ``True`` a bar on standard error (``tqdm`` if importable, else a plain line), a callable is called
