@@ -5,7 +5,8 @@ Claims:
 * adaptive steps per member are the default for the coadjoint solvers (``Solution.stats["shared_steps"]`` is
   ``False``), and a member's states, times and counts are bitwise the same solved alone or in any batch, for
   LieEuler, LieHeun and ImplicitMidpoint on so(3), for the heavy top on se(3), for a forced system (the numpy
-  path with ``force`` and ``noise_forces``) and for su(3) as a matrix algebra;
+  path with ``force`` and ``noise_forces``), for su(3) as a matrix algebra and for su(3) from its matrix basis (a
+  structure-constant algebra, whose members are stepped on its matrix twin);
 * ``integrate`` with times of shape ``(members, K + 1)`` takes each member along its own grid: it agrees to
   round-off with solving each member alone on its grid by the fixed-step route (for so(3) and se(3) that is the
   compiled block kernels, another implementation of the same steps), and so does ``step`` with ``dt`` of
@@ -16,7 +17,8 @@ import numpy as np
 import pytest
 
 import roughpaths as rp
-from mechanics import (ImplicitMidpoint, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body, so3, su)
+from mechanics import (ImplicitMidpoint, LieAlgebra, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body, so3,
+                       su)
 
 S = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.5], [0.0, -0.5, 0.0]])
 
@@ -27,8 +29,8 @@ def _forced():
                             noise_forces=lambda mu: 0.1 * np.stack([np.sin(mu), np.cos(mu) - 1.0, mu ** 2], axis=-1))
 
 
-def _su3():
-    g = su(3)
+def _su3(basis=False):
+    g = LieAlgebra.from_matrix_basis(su(3).basis) if basis else su(3)
     xi = 0.4 * np.random.default_rng(2).standard_normal((3, g.dim))
     return LiePoissonSystem(g, np.diag(1.0 + np.arange(g.dim) / g.dim), xi)
 
@@ -46,6 +48,7 @@ CASES = {
                              ImplicitMidpoint(), np.array([0.1, 0.2, 1.0, 0.0, 0.3, 0.9])),
     "forced LieHeun": (_forced, LieHeun(), np.array([0.6, 0.0, 0.8])),
     "su3 LieHeun": (_su3, LieHeun(), None),
+    "su3 basis LieHeun": (lambda: _su3(basis=True), LieHeun(), None),       # stepped on its matrix twin
 }
 
 
