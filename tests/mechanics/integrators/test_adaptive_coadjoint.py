@@ -5,7 +5,7 @@ round-off whatever steps the controller takes, and its strong error against a fi
 on the same tree falls in proportion to ``rtol`` (fitted slope near 1, not the 2/3 of an error-per-step rule), with
 steps per member (the default: the coadjoint solvers take each member on its own times) and with steps shared by
 the batch. Per member, rtol = 1e-2 is pre-asymptotic (about 10 steps a path), so the fit starts at 3e-3: 200 paths
-gave slopes 0.93 per member and 1.03 shared over 1e-2 .. 3e-4.
+gave slopes 0.92 per member and 0.98 shared over 1e-2 .. 3e-4; here, 16 paths, 1.09 and 1.12.
 """
 
 import numpy as np
@@ -30,4 +30,4 @@ def test_adaptive_lie_heun_keeps_the_casimir_and_converges_in_rtol():
             assert np.abs(np.linalg.norm(sol.states, axis=-1) - 1.0).max() < 1e-12
             errs.append(float(np.sqrt(np.mean(np.sum((sol.final - ref) ** 2, axis=-1)))))
         slope = np.polyfit(np.log(rtols), np.log(errs), 1)[0]
-        assert 0.8 <= slope <= 1.3, (shared, slope, errs)
+        assert 0.8 <= slope <= 1.25, (shared, slope, errs)
