@@ -260,6 +260,9 @@ class LieAlgebra:
         r""":math:`\mathrm{ad}^*_\xi\mu` with :math:`\langle\mathrm{ad}^*_\xi\mu,\eta\rangle = \langle\mu,[\xi,\eta]\rangle`:
         ``(ad_star(xi, mu))[j] = xi[i] mu[k] c[i, j, k]``, shapes ``(..., n)`` broadcast."""
         xi, mu = self._vec(xi, "xi"), self._vec(mu, "mu")
+        return self._ad_star_unchecked(xi, mu)
+
+    def _ad_star_unchecked(self, xi, mu):
         return np.einsum("...i,...k,ijk->...j", xi, mu, self._c)
 
     def ad_star_matrix(self, xi) -> np.ndarray:
@@ -347,6 +350,11 @@ class SO3Algebra(LieAlgebra):
 
     def __reduce__(self):
         return (SO3Algebra, ())
+
+    def _ad_star_unchecked(self, xi, mu):
+        """``ad*_ξ μ = μ × ξ``: the two non-zero terms of the structure-constant sum per component, in one product
+        and one difference each (the sum's bits; a third of its time on the batches of a numpy step)."""
+        return _cross(mu, xi)
 
 
 class SE3Algebra(LieAlgebra):

@@ -357,8 +357,7 @@ class LiePoissonSystem(ForcesMixin, MatrixStatesMixin):
     def _ad_star(self, x, mu):
         if self._matrix:
             x, mu = np.broadcast_arrays(x, mu)
-            return self.algebra._ad_star_unchecked(x, mu)
-        return np.einsum("...i,...k,ijk->...j", x, mu, self.algebra._c)
+        return self.algebra._ad_star_unchecked(x, mu)
 
     def _ad_star_op(self, x):
         """``[..., j, k] = ∂(ad*_x μ)_j / ∂μ_k``, shape ``(..., n, n)``."""
