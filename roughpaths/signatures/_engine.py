@@ -9,6 +9,7 @@ reversed-layout signature is the row-major one of the path (:func:`_signature_fl
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 
 import numpy as np
@@ -65,6 +66,9 @@ def _units(nb: int, n: int, nchunks: int) -> tuple:
     return ub, lo, np.minimum(lo + seg, n - 1)
 
 
+_F64 = np.dtype(np.float64)
+
+
 def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
     """``a`` reshaped to ``shape``, float64, C-contiguous and writeable (copied only if needed).
 
@@ -72,7 +76,24 @@ def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
     another type: every array a kernel receives goes through here, so the kernels compiled at install
     time (``tools/warm_kernels.py``) are the ones every call finds.
     """
+    if a.dtype is _F64 and a.flags.carray:          # already so (np.require's argument handling: ~1 us)
+        return a.reshape(shape)
     return np.require(a.reshape(shape), dtype=np.float64, requirements=["C", "W"])
+
+
+#: Arrays of at most this many floats are scanned for NaN/inf by a dot product with zeros (one BLAS call,
+#: no temporary; ``0 * inf`` and ``0 * nan`` are NaN, which no sum forgets), larger ones by ``np.isfinite``.
+_DOT_SCAN = 4096
+_ZEROS = np.zeros(_DOT_SCAN)
+_ZEROS.flags.writeable = False
+
+
+def _all_finite(a: np.ndarray) -> bool:
+    """``True`` if the float64 array ``a`` holds no NaN or inf."""
+    if a.size <= _DOT_SCAN:
+        v = a.reshape(-1)
+        return math.isfinite(v.dot(_ZEROS[:v.shape[0]]))
+    return bool(np.isfinite(a).all())
 
 
 @lru_cache(maxsize=512)
@@ -88,6 +109,8 @@ def _logsigdim(d: int, depth: int) -> int:
 
 
 def _check_depth(depth) -> int:
+    if type(depth) is int and depth >= 1:          # the usual case, without the numbers.Integral check
+        return depth
     return check_positive_int(depth, "depth")
 
 
@@ -116,16 +139,19 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
 
 def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
     """Validated float64 paths; ``finite=False`` leaves NaN/inf to :func:`_finite_or_raise` where it can."""
-    x = as_float_array(paths, "paths", min_ndim=2, allow_nonfinite=True)
+    if type(paths) is np.ndarray and paths.dtype is _F64 and paths.ndim >= 2:
+        x = paths                                   # what as_float_array returns for it, without its checks
+    else:
+        x = as_float_array(paths, "paths", min_ndim=2, allow_nonfinite=True)
     if x.shape[-2] < 1:
         raise ValueError(f"paths needs at least one point along axis -2 (shape (..., n, d)), got shape "
                          f"{x.shape}.")
     if x.shape[-1] < 1:
         raise ValueError(f"paths needs at least one coordinate along the last axis (shape (..., n, d)), "
                          f"got shape {x.shape}.")
-    if finite or x.shape[-2] == 1 or x.shape[-1] == 1:
+    if (finite or x.shape[-2] == 1 or x.shape[-1] == 1) and not _all_finite(x):
         # a lone point does not enter the output, nor (d = 1, level 2 = ½ X²) an interior point
-        as_float_array(x, "paths")
+        as_float_array(x, "paths")                  # raises, naming the first non-finite point
     return x
 
 
@@ -139,7 +165,7 @@ def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
     as before. When the input is the smaller array (short paths at high depth) it is scanned
     instead: the same outcome.
     """
-    if not np.isfinite(x if x.size < out.size else out).all():
+    if not _all_finite(x if x.size < out.size else out):
         as_float_array(x, "paths")
     return out
 
@@ -174,26 +200,42 @@ def _split_units(nunits: int, d: int, depth: int) -> tuple:
     return groups, min(nunits, groups * _lanes.LANES)
 
 
-def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
-    """Signature (reversed layout) of every work unit of a ``(B, n, d)`` batch, shape ``(units, sigdim)``."""
-    nb, n, d = x.shape
-    units = _units(nb, n, nchunks)
-    off = level_offsets(d, depth)
+@lru_cache(maxsize=64)
+def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
+    """What :func:`_reversed_parts` runs for a ``(nb, n, d)`` batch: a function of the shape only, made once.
+
+    ``(units, offsets, (units, sigdim), lane kernel or None, its ranges, first unit alone, one-unit
+    kernel or None, its ranges)``; the ranges are :func:`roughpaths._threads.ranges`' (lists, not to be changed).
+    """
     dim = _sigdim(d, depth)
     nunits = nb * nchunks
-    part = np.empty((nunits, dim))
     per_unit = (n / nchunks) * 1.5 * d ** depth
     ngroups, first_alone = _split_units(nunits, d, depth)
-    if ngroups:
-        lanes = _lanes.lane_groups(d, depth)
-        # ``1.5 d^m`` underestimates d = 2 at depth 5 by 2-3x (loop control), so 64 x 256 such paths (~290 us)
-        # stay on one thread; counted (12 a level), they ran on two 0-24 % slower at load 1.3-2.1
-        _threads.run(lambda lo, hi: lanes(x, *units, depth, off, lo, hi, part),
-                     _threads.ranges(ngroups, per_unit * _lanes.LANES), merge=True)
-    if first_alone < nunits:
-        alone = _blocked.block_units(d, depth)
-        _threads.run(lambda lo, hi: alone(x, *units, depth, off, first_alone + lo, first_alone + hi, part),
-                     _threads.ranges(nunits - first_alone, per_unit), merge=True)
+    # ``1.5 d^m`` underestimates d = 2 at depth 5 by 2-3x (loop control), so 64 x 256 such paths (~290 us)
+    # stay on one thread; counted (12 a level), they ran on two 0-24 % slower at load 1.3-2.1
+    lanes = _lanes.lane_groups(d, depth) if ngroups else None
+    alone = _blocked.block_units(d, depth) if first_alone < nunits else None
+    return (_units(nb, n, nchunks), level_offsets(d, depth), (nunits, dim),
+            lanes, _threads.ranges(ngroups, per_unit * _lanes.LANES),
+            first_alone, alone, _threads.ranges(nunits - first_alone, per_unit))
+
+
+def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
+    """Signature (reversed layout) of every work unit of a ``(B, n, d)`` batch, shape ``(units, sigdim)``."""
+    (ub, ulo, uhi), off, shape, lanes, lane_ranges, first_alone, alone, alone_ranges = _parts_plan(
+        *x.shape, depth, nchunks)
+    part = np.empty(shape)
+    if lanes is not None:
+        if len(lane_ranges) == 1:                   # one range: called here (no closure, no thread query)
+            lanes(x, ub, ulo, uhi, depth, off, 0, lane_ranges[0][1], part)
+        else:
+            _threads.run(lambda lo, hi: lanes(x, ub, ulo, uhi, depth, off, lo, hi, part), lane_ranges, merge=True)
+    if alone is not None:
+        if len(alone_ranges) == 1:
+            alone(x, ub, ulo, uhi, depth, off, first_alone, first_alone + alone_ranges[0][1], part)
+        else:
+            _threads.run(lambda lo, hi: alone(x, ub, ulo, uhi, depth, off, first_alone + lo, first_alone + hi, part),
+                         alone_ranges, merge=True)
     return part
 
 
@@ -240,7 +282,7 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
         return out
     perm = _reversed_to_rowmajor(d, depth)
     if out.size <= _SMALL_PERMUTE:
-        return out[:, perm]
+        return out.take(perm, axis=1)               # out[:, perm], in C order and ~1 us sooner
     res = np.empty_like(out)
     _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
                  _threads.ranges(nb, 4 * perm.shape[0]), merge=True)
