@@ -9,7 +9,6 @@ reversed-layout signature is the row-major one of the path (:func:`_signature_fl
 
 from __future__ import annotations
 
-import math
 from functools import lru_cache
 
 import numpy as np
@@ -81,18 +80,9 @@ def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
     return np.require(a.reshape(shape), dtype=np.float64, requirements=["C", "W"])
 
 
-#: Arrays of at most this many floats are scanned for NaN/inf by a dot product with zeros (one BLAS call,
-#: no temporary; ``0 * inf`` and ``0 * nan`` are NaN, which no sum forgets), larger ones by ``np.isfinite``.
-_DOT_SCAN = 4096
-_ZEROS = np.zeros(_DOT_SCAN)
-_ZEROS.flags.writeable = False
-
-
 def _all_finite(a: np.ndarray) -> bool:
-    """``True`` if the float64 array ``a`` holds no NaN or inf."""
-    if a.size <= _DOT_SCAN:
-        v = a.reshape(-1)
-        return math.isfinite(v.dot(_ZEROS[:v.shape[0]]))
+    """``True`` if the float64 array ``a`` holds no NaN or inf (a dot product with zeros would be cheaper on small
+    arrays, but numpy warns of the ``0 * inf`` it meets, before the check's own error)."""
     return bool(np.isfinite(a).all())
 
 
