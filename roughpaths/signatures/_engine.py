@@ -75,7 +75,7 @@ def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
     another type: every array a kernel receives goes through here, so the kernels compiled at install
     time (``tools/warm_kernels.py``) are the ones every call finds.
     """
-    if a.dtype is _F64 and a.flags.carray:          # already so (np.require's argument handling: ~1 us)
+    if a.dtype == _F64 and a.flags.carray:          # already so (np.require's argument handling: ~1 us)
         return a.reshape(shape)
     return np.require(a.reshape(shape), dtype=np.float64, requirements=["C", "W"])
 
@@ -83,7 +83,7 @@ def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
 def _all_finite(a: np.ndarray) -> bool:
     """``True`` if the float64 array ``a`` holds no NaN or inf (a dot product with zeros would be cheaper on small
     arrays, but numpy warns of the ``0 * inf`` it meets, before the check's own error)."""
-    return bool(np.isfinite(a).all())
+    return bool(np.logical_and.reduce(np.isfinite(a), axis=None))      # ndarray.all without its Python wrapper
 
 
 @lru_cache(maxsize=512)
@@ -129,7 +129,7 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
 
 def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
     """Validated float64 paths; ``finite=False`` leaves NaN/inf to :func:`_finite_or_raise` where it can."""
-    if type(paths) is np.ndarray and paths.dtype is _F64 and paths.ndim >= 2:
+    if type(paths) is np.ndarray and paths.dtype == _F64 and paths.ndim >= 2:
         x = paths                                   # what as_float_array returns for it, without its checks
     else:
         x = as_float_array(paths, "paths", min_ndim=2, allow_nonfinite=True)

@@ -29,7 +29,7 @@ __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]
 
 
 def _check_grad(grad_output, batch: tuple, width: int, what: str) -> np.ndarray:
-    if (type(grad_output) is np.ndarray and grad_output.dtype is _F64 and grad_output.ndim >= 1
+    if (type(grad_output) is np.ndarray and grad_output.dtype == _F64 and grad_output.ndim >= 1
             and _all_finite(grad_output)):
         g = grad_output                             # what as_float_array returns for it, without its checks
     else:
