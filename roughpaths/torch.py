@@ -146,7 +146,7 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
 
     def _forward(ctx, params, *tensors):
         # checked by apply() below: CPU tensors of one float dtype
-        arrays = batch_broadcast([_numpy64(t) for t in tensors], core)
+        arrays = [_numpy64(tensors[0])] if len(tensors) == 1 else batch_broadcast([_numpy64(t) for t in tensors], core)
         out = forward(*arrays, **params)
         ctx.params, ctx.arrays = params, arrays
         ctx.save_for_backward(*tensors)           # torch's check that no input was modified in place
@@ -158,7 +158,11 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         if grad_readonly:
             g.flags.writeable = False             # torch's memory: the VJP takes its own copy if it must
         grads = vjp(*ctx.arrays, g if g.dtype == np.float64 else g.astype(np.float64), **ctx.params)
-        grads = (grads,) if len(tensors) == 1 else tuple(grads)
+        if len(tensors) == 1:                     # (one input: no generator, no zip)
+            t = tensors[0]
+            return None, (_tensor(sum_to(np.asarray(grads), tuple(t.shape)), t.dtype) if ctx.needs_input_grad[1]
+                          else None)
+        grads = tuple(grads)
         return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype) if need else None
                                for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
 
