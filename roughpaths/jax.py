@@ -146,15 +146,22 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
 
     def build(params: dict, dtype, register: bool = True):
         def forward_host(*arrs):
-            arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
+            if len(arrs) == 1:                      # one input: nothing to broadcast
+                arrays = (np.asarray(arrs[0], dtype=np.float64),)
+            else:
+                arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             return (np.asarray(forward(*arrays, **params), dtype=dtype),)
 
         def backward_host(*arrs):
             *arrs, g = arrs
+            g = np.asarray(g, dtype=np.float64)
+            if len(arrs) == 1:
+                a, = arrs
+                grad = vjp(np.asarray(a, dtype=np.float64), g, **params)
+                return (np.asarray(sum_to(np.asarray(grad), a.shape), dtype=dtype),)
             shapes = [a.shape for a in arrs]        # as received: with vmap's axes in front
             arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
-            grads = vjp(*arrays, np.asarray(g, dtype=np.float64), **params)
-            grads = (grads,) if len(arrs) == 1 else tuple(grads)
+            grads = tuple(vjp(*arrays, g, **params))
             return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
 
         forward_call, backward_call = _host_call(forward_host, register), _host_call(backward_host, register)
