@@ -9,6 +9,7 @@ reversed-layout signature is the row-major one of the path (:func:`_signature_fl
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 
 import numpy as np
@@ -80,9 +81,16 @@ def _kernel_array(a: np.ndarray, shape: tuple) -> np.ndarray:
     return np.require(a.reshape(shape), dtype=np.float64, requirements=["C", "W"])
 
 
+#: Arrays of at most this many floats are scanned for NaN/inf by summing them as Python floats (a NaN or inf
+#: entry makes the sum NaN or inf, and Python's float sum neither warns nor raises), ~1 us sooner than
+#: ``np.isfinite`` on a lone short path; a finite sum that overflowed is scanned again by ``np.isfinite``.
+_SUM_SCAN = 48
+
+
 def _all_finite(a: np.ndarray) -> bool:
-    """``True`` if the float64 array ``a`` holds no NaN or inf (a dot product with zeros would be cheaper on small
-    arrays, but numpy warns of the ``0 * inf`` it meets, before the check's own error)."""
+    """``True`` if the float64 array ``a`` holds no NaN or inf."""
+    if a.size <= _SUM_SCAN and math.isfinite(sum(a.ravel().tolist())):
+        return True
     return bool(np.logical_and.reduce(np.isfinite(a), axis=None))      # ndarray.all without its Python wrapper
 
 
@@ -115,16 +123,24 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
     layout permutation); the log-signature 2 more (log, scratch) plus the sparse Lyndon map, whose
     top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built).
     """
-    dim = _sigdim(d, depth)
-    need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
-    if log and depth > 1 and d > 1:
-        need += 12 * min(_logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+    need = _need_bytes(batch, d, depth, log)
     if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
         return
+    dim = _sigdim(d, depth)
     what = "logsignature" if log else "signature"
     check_memory(need, f"depth={depth} with d={d} and {batch} path(s): the {what} (sigdim({d}, {depth}) = "
                  f"{float(dim):.3g} floats per path)", "lower depth, process the batch in smaller pieces, or use "
                  "fewer dimensions")
+
+
+@lru_cache(maxsize=256)
+def _need_bytes(batch: int, d: int, depth: int, log: bool) -> int:
+    """The estimate of :func:`_check_fits` (cached: it costs about a microsecond, a small signature's tenth)."""
+    dim = _sigdim(d, depth)
+    need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
+    if log and depth > 1 and d > 1:
+        need += 12 * min(_logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
+    return need
 
 
 def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
