@@ -31,14 +31,16 @@ Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`
   which runs as one call of the compiled kernels.
 * **Cost.** The forward converts the tensors to numpy once, without a copy (float64) or with one
   cast (float32, whose float64 copy is kept for the backward), and the result back without a copy;
-  the backward reuses those arrays. The fixed cost of a step (forward plus ``backward``) above the
-  bare numpy calls, CPU time on a loaded 2-core machine (load 4.6-5), same runs: 0.088 ms on one path
-  of 8 points (0.119 ms before this wrapper was trimmed), 0.103 ms on 32 paths of 128 points in d = 3
-  at depth 2 (0.145 ms before). A bare ``torch.autograd.Function`` around the same two numpy calls,
-  with no checks or conversions at all, already costs 0.066 / 0.078 ms there (torch's node,
-  ``backward``'s argument checks, its engine), so what is left of the wrapper's own is about
-  0.02 ms. pysiglib's torch API pays an overhead of the same size (``benchmarks/bench_frameworks.py``
-  prints both, and their ratio, in one run).
+  the backward reuses those arrays, and the library's own VJPs get torch's cotangent without a copy
+  (they only read it). A step (forward plus ``backward``) of one path of 8 points in d = 3, CPU time on
+  a loaded 2-core machine (load 3.4-3.6, medians of 6 alternating process pairs against the code
+  before this trim): 0.083 ms at depth 2 (0.121 before), 0.101 ms at depth 3 (0.160), of which the
+  bare numpy calls are 0.019 / 0.033 ms (0.040 / 0.068: their own fixed cost was cut too). What is
+  left above them, 0.064 / 0.068 ms, is mostly torch's: an identity ``torch.autograd.Function`` step
+  costs 0.040 ms there, and a bare ``Function`` around the same two numpy calls with no checks or
+  conversions 0.050 / 0.055 ms above the calls; the wrapper's own share is 0.013-0.014 ms (0.019-0.027
+  before; 32 paths of 128 points at depth 2: 0.014, 0.027 before). pysiglib's torch API pays an
+  overhead of the same size (``benchmarks/bench_frameworks.py`` prints both, and their ratio, in one run).
 
 Examples
 --------

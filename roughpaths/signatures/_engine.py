@@ -5,6 +5,11 @@ kernels store words with the first letter fastest (the *reversed* layout); resul
 row-major order: by a permutation of the output (:func:`_reversed_to_rowmajor`), or, where the path is
 smaller than its signature, by running the kernels on the path negated and reversed in time, whose
 reversed-layout signature is the row-major one of the path (:func:`_signature_flat`).
+
+A small input's cost is this module's Python, not the kernels': what depends on the shape only (the work
+units, the kernels, the thread ranges: :func:`_parts_plan`) is decided once per shape, a float64 array is
+taken as it is, and a single range calls its kernel directly (one path of 8 points in d = 3 at depth 3:
+9 us for the signature, 18 us for its gradient, against 16 and 39 before these trims).
 """
 
 from __future__ import annotations

@@ -15,7 +15,6 @@ import numpy as np
 
 from .. import _threads
 from ..algebra.flat import level_offsets, lyndon_flat_vjp
-from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
 from . import _level2 as _l2

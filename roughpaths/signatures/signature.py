@@ -30,7 +30,6 @@ import numpy as np
 
 from .. import _threads
 from ..algebra.flat import level_offsets, log_flat, lyndon_flat
-from ..algebra.tensor import logsigdim, sigdim
 from . import _kernels as _k
 from ._engine import (_check_depth, _check_fits, _check_paths, _finite_or_raise, _kernel_array, _level2_flat,
                       _logsigdim, _reversed_to_rowmajor, _sigdim, _signature_flat)
