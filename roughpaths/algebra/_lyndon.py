@@ -307,8 +307,9 @@ _SMALL_LEVELS = 4096
 
 
 def lyndon_levels(dim: int, depth: int) -> tuple:
-    """``(projections, starts)``: :func:`lyndon_projection` of levels ``1..depth`` and where each level's
-    coordinates start in the concatenated Lyndon coordinates (``starts[depth]``: their number).
+    """``(projections, starts, work)``: :func:`lyndon_projection` of levels ``1..depth``, where each level's
+    coordinates start in the concatenated Lyndon coordinates (``starts[depth]``: their number), and the
+    work of one row (coordinates plus map entries).
 
     For small ``dim**depth`` kept together (one look-up instead of one per level, which costs more than the
     coordinates of a small batch); otherwise assembled from the byte-bounded cache on each call.
@@ -323,7 +324,7 @@ def _levels(dim: int, depth: int) -> tuple:
     starts = [0]
     for p in projections:
         starts.append(starts[-1] + p[0].shape[0])
-    return projections, tuple(starts)
+    return projections, tuple(starts), float(sum(p[0].shape[0] + p[2].shape[0] for p in projections))
 
 
 @lru_cache(maxsize=32)
