@@ -20,7 +20,9 @@ after an untimed call of the same function. "ratio" is ours / peer (below 1: our
    printed as "autograd floor": the same step through an identity ``Function``.
 3. JAX: a jitted ``value_and_grad`` of ``sum(roughpaths.jax.signature(x, 3) * G)`` (two XLA FFI custom
    calls of the numpy API) against the bare numpy calls and against pysiglib's JAX API (its own XLA
-   FFI custom calls into compiled C++) where it loads, at a tiny and a moderate size.
+   FFI custom calls into compiled C++) where it loads, at a tiny and a moderate size. "host floor" is
+   the same program through ``roughpaths.jax.differentiable`` with host functions that only allocate
+   their (zero) results: the XLA program, the two host calls and their frames, without the numpy API.
 
 Usage: ``python benchmarks/bench_frameworks.py [--repeats 7] [--batch 32] [--length 128] [--sections 123]``
 (with ``PYTHONPATH`` putting this checkout first; needs torch, jax and pysiglib: the ``bench`` extra).
@@ -149,7 +151,7 @@ def main() -> None:
         psj = None
         print(f"(pysiglib's JAX API did not load: {type(exc).__name__}: {str(exc)[:100]})")
     print("3. JAX, jitted forward + backward (value_and_grad of sum(sig * G)), depth 3, ms; ratio = ours / pysiglib")
-    print(f"{'case':<22}{'ours':>10}{'numpy':>10}{'overhead':>10}{'pysiglib':>10}{'ratio':>8}")
+    print(f"{'case':<22}{'ours':>10}{'numpy':>10}{'overhead':>10}{'host floor':>12}{'pysiglib':>10}{'ratio':>8}")
     for B3, n3, d in ((1, 8, 3), (B, n, 3), (B, n, 8)) if "3" in args.sections else ():
         xn = np.cumsum(rng.standard_normal((B3, n3, d)), axis=1) / np.sqrt(n3)
         gn = rng.standard_normal((B3, rp.sigdim(d, 3)))
@@ -157,14 +159,19 @@ def main() -> None:
         ours = jax.jit(jax.value_and_grad(lambda p: jnp.sum(rpj.signature(p, 3) * gj)))
         f_o = lambda: jax.block_until_ready(ours(xj))
         f_n = lambda: (rp.signature(xn, 3), rp.signature_vjp(xn, 3, gn))
-        fns = [f_o, f_n]
+        dim = rp.sigdim(d, 3)
+        noop = rpj.differentiable(lambda p: np.zeros(p.shape[:-2] + (dim,)), lambda p, g: np.zeros(p.shape),
+                                  lambda batch, cores: batch + (dim,), names=("paths",), core=(2,))
+        floor = jax.jit(jax.value_and_grad(lambda p: jnp.sum(noop(p) * gj)))
+        fns = [f_o, f_n, lambda: jax.block_until_ready(floor(xj))]
         if psj is not None:
             peer = jax.jit(jax.value_and_grad(lambda p: jnp.sum(psj.sig(p, 3, n_jobs=-1) * gj)))
             fns.append(lambda: jax.block_until_ready(peer(xj)))
         t = cpu_medians(fns, args.repeats)
         name = f"{B3} x {n3}, d={d}"
-        ffi = f"{1e3 * t[2]:>10.3f}{t[0] / t[2]:>8.2f}" if psj is not None else f"{'-':>10}{'-':>8}"
-        print(f"{name:<22}{1e3 * t[0]:>10.3f}{1e3 * t[1]:>10.3f}{1e3 * (t[0] - t[1]):>10.3f}{ffi}", flush=True)
+        ffi = f"{1e3 * t[3]:>10.3f}{t[0] / t[3]:>8.2f}" if psj is not None else f"{'-':>10}{'-':>8}"
+        print(f"{name:<22}{1e3 * t[0]:>10.3f}{1e3 * t[1]:>10.3f}{1e3 * (t[0] - t[1]):>10.3f}{1e3 * t[2]:>12.3f}{ffi}",
+              flush=True)
 
 
 if __name__ == "__main__":

@@ -42,9 +42,13 @@ skipped and listed. ``--sweep-d 2,6-9``, ``--sweep-depths 3,4``, ``--sweep-batch
 ``--sweep-kinds sig,logsig,sig vjp`` select a subset; ``--sweep-modes 1`` runs the one-thread mode only.
 A timed sample of a small cell is a loop of calls lasting about 2 ms (divided back to one call).
 
+``--fixed-cost`` prints only the cost of a call on tiny inputs (one path of 8 points in d = 2, 3 at
+depths 2-3, and 32 x 128 in d = 3), where the Python around the kernels is most of the time: ours,
+iisignature and pysiglib on one thread, CPU time, medians of interleaved calls, and the ratios.
+
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
 [--depths 3,4] [--only-streams] [--sweep [--sweep-d 2-20] [--sweep-depths 2-6] [--sweep-batches 16,64]
-[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6]]`` (the cells, kinds and depths
+[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6]] [--fixed-cost]`` (the cells, kinds and depths
 select peer-table cells and skip the rest).
 """
 
@@ -168,6 +172,47 @@ def paired(fns, repeats: int, clock) -> list:
             fn()
             times[i].append(clock() - t0)
     return [float(np.median(t)) for t in times]
+
+
+def fixed_cost_section(args) -> None:
+    """The fixed cost of a call: tiny inputs, where the Python around the kernels is most of the time.
+
+    One thread for everybody (``numba.set_num_threads(1)``, ``n_jobs=1``), CPU time, medians of
+    ``100 * --repeats`` interleaved calls (ours, iisignature, pysiglib, ...), in microseconds.
+    """
+    import iisignature
+    import numba
+    import pysiglib
+
+    import roughpaths as rp
+
+    numba.set_num_threads(1)
+    rng = np.random.default_rng(7)
+    reps = 100 * args.repeats
+    print(f"Fixed cost per call, one thread, CPU-time medians of {reps} interleaved calls, us; load average "
+          f"{os.getloadavg()[0]:.1f}")
+    print(f"{'case':<24}{'kind':<18}{'ours':>8}{'iisig':>8}{'pysiglib':>10}{'/iisig':>8}{'/pysiglib':>10}")
+    for b, n, d, m in ((1, 8, 2, 3), (1, 8, 3, 3), (1, 8, 3, 2), (32, 128, 3, 3)):
+        x = np.cumsum(rng.standard_normal((b, n, d)), axis=1) / np.sqrt(n)
+        g = rng.standard_normal((b, rp.sigdim(d, m)))
+        gl = rng.standard_normal((b, rp.logsigdim(d, m)))
+        prep = iisignature.prepare(d, m)
+        pysiglib.prepare_log_sig(d, m, method=2)
+        rows = [("signature", lambda: rp.signature(x, m), lambda: iisignature.sig(x, m),
+                 lambda: pysiglib.sig(x, m, n_jobs=1)),
+                ("signature_vjp", lambda: rp.signature_vjp(x, m, g), lambda: iisignature.sigbackprop(g, x, m),
+                 lambda: pysiglib.sig_backprop(x, pysiglib.sig(x, m, n_jobs=1), g, m, n_jobs=1)),
+                ("logsignature", lambda: rp.logsignature(x, m), lambda: iisignature.logsig(x, prep),
+                 lambda: pysiglib.log_sig(x, m, method=2, n_jobs=1)),
+                ("logsignature_vjp", lambda: rp.logsignature_vjp(x, m, gl),
+                 lambda: iisignature.logsigbackprop(gl, x, prep), None)]
+        for kind, ours, iis, peer in rows:
+            fns = [ours, iis] + ([peer] if peer is not None else [])
+            t = [1e6 * v for v in paired(fns, reps, time.process_time)]
+            tp = f"{t[2]:>10.1f}" if peer is not None else f"{'-':>10}"
+            rp_ = f"{t[0] / t[2]:>10.2f}" if peer is not None else f"{'-':>10}"
+            print(f"{f'{b} x {n}, d={d}, m={m}':<24}{kind:<18}{t[0]:>8.1f}{t[1]:>8.1f}{tp}{t[0] / t[1]:>8.2f}{rp_}",
+                  flush=True)
 
 
 def peer_table(cases: dict, args, rng) -> None:
@@ -355,7 +400,12 @@ def main() -> None:
     parser.add_argument("--sweep-modes", default="1,n", help="sweep modes: 1 (one thread), n (all threads)")
     parser.add_argument("--sweep-max-sigdim", type=float, default=2e6,
                         help="skip sweep cells with more signature floats per path")
+    parser.add_argument("--fixed-cost", action="store_true",
+                        help="print the per-call cost on small inputs only (against iisignature and pysiglib)")
     args = parser.parse_args()
+    if args.fixed_cost:
+        fixed_cost_section(args)
+        return
     if args.sweep:
         width_sweep(args)
         return

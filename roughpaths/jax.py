@@ -23,16 +23,18 @@ be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.v
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
 * **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls), CPU time on a loaded
-  2-core machine (load 5.7), same run, against pysiglib's XLA FFI calls into compiled C++
+  2-core machine, against pysiglib's XLA FFI calls into compiled C++ timed in the same process
   (``benchmarks/bench_frameworks.py`` prints the same comparison): one path of 8 points in d = 3 at
-  depth 3, 0.147 ms against 0.019 ms (7.8x; through ``pure_callback`` it was 0.461 ms, 24.5x); 32
-  paths of 128 points, 0.79 against 0.63 ms (1.24x; 1.75x before); the same in d = 8, 5.0 against
-  6.4 ms (0.79x; 0.88x before). On the tiny input the time splits into the XLA program itself
-  (0.017 ms with handlers that do nothing: pysiglib's whole call), reading the call frames and
-  copying the results (0.018 ms), the wrappers (0.005 ms) and the two numpy calls (0.074 ms; 0.059
-  ms called directly): the numpy API's own fixed cost, not the call, is the floor. Batch many paths
-  into one call (``vmap`` does) to amortise it. First ``jax.grad`` step in a new process: about 0.2 s
-  CPU of XLA compiles (and ``import jax`` about 1.1 s); the handler adds no numba compile.
+  depth 3, 0.106 against 0.023 ms (4.6x; 7.3x before the numpy API's fixed cost and the handler were
+  trimmed, medians of 6 alternating process pairs at load 2-3.7; through ``pure_callback`` it was
+  24.5x). On that tiny input the time splits into the XLA program with its two host calls (0.038-0.050
+  ms with host functions that only allocate zero results: 2.2x pysiglib's whole call by itself, the
+  frames read and wrapped in Python) and the two numpy calls (about 0.027 ms alone on a quiet
+  machine): the numpy API's own fixed cost and the Python handler, not the XLA call, are the floor, so
+  the target of 2x pysiglib is out of reach without compiled code. 32 paths of 128 points: 1.03x
+  (1.19x before); in d = 8, about 0.75x. Batch many paths into one call (``vmap`` does) to amortise
+  the fixed cost. First ``jax.grad`` step in a new process: about 0.2 s CPU of XLA compiles (and
+  ``import jax`` about 1.1 s); the handler adds no numba compile.
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
 :func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``
@@ -146,15 +148,22 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
 
     def build(params: dict, dtype, register: bool = True):
         def forward_host(*arrs):
-            arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
+            if len(arrs) == 1:                      # one input: nothing to broadcast
+                arrays = (np.asarray(arrs[0], dtype=np.float64),)
+            else:
+                arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             return (np.asarray(forward(*arrays, **params), dtype=dtype),)
 
         def backward_host(*arrs):
             *arrs, g = arrs
+            g = np.asarray(g, dtype=np.float64)
+            if len(arrs) == 1:
+                a, = arrs
+                grad = vjp(np.asarray(a, dtype=np.float64), g, **params)
+                return (np.asarray(sum_to(np.asarray(grad), a.shape), dtype=dtype),)
             shapes = [a.shape for a in arrs]        # as received: with vmap's axes in front
             arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
-            grads = vjp(*arrays, np.asarray(g, dtype=np.float64), **params)
-            grads = (grads,) if len(arrs) == 1 else tuple(grads)
+            grads = tuple(vjp(*arrays, g, **params))
             return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
 
         forward_call, backward_call = _host_call(forward_host, register), _host_call(backward_host, register)

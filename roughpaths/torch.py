@@ -31,14 +31,16 @@ Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`
   which runs as one call of the compiled kernels.
 * **Cost.** The forward converts the tensors to numpy once, without a copy (float64) or with one
   cast (float32, whose float64 copy is kept for the backward), and the result back without a copy;
-  the backward reuses those arrays. The fixed cost of a step (forward plus ``backward``) above the
-  bare numpy calls, CPU time on a loaded 2-core machine (load 4.6-5), same runs: 0.088 ms on one path
-  of 8 points (0.119 ms before this wrapper was trimmed), 0.103 ms on 32 paths of 128 points in d = 3
-  at depth 2 (0.145 ms before). A bare ``torch.autograd.Function`` around the same two numpy calls,
-  with no checks or conversions at all, already costs 0.066 / 0.078 ms there (torch's node,
-  ``backward``'s argument checks, its engine), so what is left of the wrapper's own is about
-  0.02 ms. pysiglib's torch API pays an overhead of the same size (``benchmarks/bench_frameworks.py``
-  prints both, and their ratio, in one run).
+  the backward reuses those arrays, and the library's own VJPs get torch's cotangent without a copy
+  (they only read it). A step (forward plus ``backward``) of one path of 8 points in d = 3, CPU time on
+  a loaded 2-core machine (load 3.4-3.6, medians of 6 alternating process pairs against the code
+  before this trim): 0.083 ms at depth 2 (0.121 before), 0.101 ms at depth 3 (0.160), of which the
+  bare numpy calls are 0.019 / 0.033 ms (0.040 / 0.068: their own fixed cost was cut too). What is
+  left above them, 0.064 / 0.068 ms, is mostly torch's: an identity ``torch.autograd.Function`` step
+  costs 0.040 ms there, and a bare ``Function`` around the same two numpy calls with no checks or
+  conversions 0.050 / 0.055 ms above the calls; the wrapper's own share is 0.013-0.014 ms (0.019-0.027
+  before; 32 paths of 128 points at depth 2: 0.014, 0.027 before). pysiglib's torch API pays an
+  overhead of the same size (``benchmarks/bench_frameworks.py`` prints both, and their ratio, in one run).
 
 Examples
 --------
@@ -137,10 +139,16 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     >>> a.grad
     tensor([6.])
     """
+    return _function(forward, vjp, names=names, core=core, label=label, grad_readonly=True)
+
+
+def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_readonly: bool):
+    """:func:`differentiable`; ``grad_readonly=False`` for a ``vjp`` known not to write to its ``grad_output``
+    (the library's own: a read-only cotangent would be copied by the numpy API's input check, ~1-2 us)."""
 
     def _forward(ctx, params, *tensors):
         # checked by apply() below: CPU tensors of one float dtype
-        arrays = batch_broadcast([_numpy64(t) for t in tensors], core)
+        arrays = [_numpy64(tensors[0])] if len(tensors) == 1 else batch_broadcast([_numpy64(t) for t in tensors], core)
         out = forward(*arrays, **params)
         ctx.params, ctx.arrays = params, arrays
         ctx.save_for_backward(*tensors)           # torch's check that no input was modified in place
@@ -149,9 +157,14 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     def _compute_backward(ctx, grad):
         tensors = ctx.saved_tensors               # (raises if an input was modified in place since)
         g = grad.detach().numpy()
-        g.flags.writeable = False                 # torch's memory: the VJP takes its own copy if it must
+        if grad_readonly:
+            g.flags.writeable = False             # torch's memory: the VJP takes its own copy if it must
         grads = vjp(*ctx.arrays, g if g.dtype == np.float64 else g.astype(np.float64), **ctx.params)
-        grads = (grads,) if len(tensors) == 1 else tuple(grads)
+        if len(tensors) == 1:                     # (one input: no generator, no zip)
+            t = tensors[0]
+            return None, (_tensor(sum_to(np.asarray(grads), tuple(t.shape)), t.dtype) if ctx.needs_input_grad[1]
+                          else None)
+        grads = tuple(grads)
         return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype) if need else None
                                for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
 
@@ -177,12 +190,13 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     return apply
 
 
-_signature = differentiable(lambda x, depth: _rp.signature(x, depth),
-                            lambda x, g, depth: _rp.signature_vjp(x, depth, g),
-                            names=("paths",), core=(2,), label="_Signature")
-_logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
-                               lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
-                               names=("paths",), core=(2,), label="_LogSignature")
+# signature_vjp and logsignature_vjp only read their cotangent (gathers, and kernels that read it)
+_signature = _function(lambda x, depth: _rp.signature(x, depth),
+                       lambda x, g, depth: _rp.signature_vjp(x, depth, g),
+                       names=("paths",), core=(2,), label="_Signature", grad_readonly=False)
+_logsignature = _function(lambda x, depth: _rp.logsignature(x, depth),
+                          lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
+                          names=("paths",), core=(2,), label="_LogSignature", grad_readonly=False)
 _kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
                          lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
                          names=("x", "y"), core=(2, 2), label="_SignatureKernel")

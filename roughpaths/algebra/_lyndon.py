@@ -31,7 +31,7 @@ import numpy as np
 
 __all__ = ["lyndon_words", "standard_factorisation", "bracket_string", "level_expansion",
            "expansion_matrix",
-           "lyndon_projection", "lyndon_indices", "count_lyndon_words", "CACHE_BYTES", "cache_clear"]
+           "lyndon_projection", "lyndon_levels", "count_lyndon_words", "lyndon_indices", "CACHE_BYTES", "cache_clear"]
 
 #: Byte budget of the cache of expansions and projection matrices (least recently used evicted).
 CACHE_BYTES = 256 * 2 ** 20
@@ -92,6 +92,7 @@ def cache_clear() -> None:
     """Drop every cached expansion / projection (and the word lists)."""
     _CACHE.clear()
     lyndon_words.cache_clear()
+    _small_levels.cache_clear()
 
 
 def _mobius(n: int) -> int:
@@ -298,3 +299,34 @@ def lyndon_projection(dim: int, k: int) -> tuple:
         return (lidx, m.indptr.astype(np.int64), m.indices.astype(np.int64),
                 np.ascontiguousarray(m.data, dtype=np.float64))
     return _CACHE.get(("proj", dim, k), build)
+
+
+#: Alphabets and depths with ``dim**depth`` at most this keep their per-level projections together
+#: (:func:`lyndon_levels`): a few hundred kB at most, 32 of them at most.
+_SMALL_LEVELS = 4096
+
+
+def lyndon_levels(dim: int, depth: int) -> tuple:
+    """``(projections, starts, work)``: :func:`lyndon_projection` of levels ``1..depth``, where each level's
+    coordinates start in the concatenated Lyndon coordinates (``starts[depth]``: their number), and the
+    work of one row (coordinates plus map entries).
+
+    For small ``dim**depth`` kept together (one look-up instead of one per level, which costs more than the
+    coordinates of a small batch); otherwise assembled from the byte-bounded cache on each call.
+    """
+    if dim ** depth <= _SMALL_LEVELS:
+        return _small_levels(dim, depth)
+    return _levels(dim, depth)
+
+
+def _levels(dim: int, depth: int) -> tuple:
+    projections = tuple(lyndon_projection(dim, k) for k in range(1, depth + 1))
+    starts = [0]
+    for p in projections:
+        starts.append(starts[-1] + p[0].shape[0])
+    return projections, tuple(starts), float(sum(p[0].shape[0] + p[2].shape[0] for p in projections))
+
+
+@lru_cache(maxsize=32)
+def _small_levels(dim: int, depth: int) -> tuple:
+    return _levels(dim, depth)

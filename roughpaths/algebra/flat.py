@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import _threads
 from . import _kernels as _k
-from ._lyndon import lyndon_projection
+from ._lyndon import lyndon_levels
 
 __all__ = ["level_offsets", "log_flat", "lyndon_flat", "lyndon_flat_vjp"]
 
@@ -61,14 +61,14 @@ def log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
 def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Lyndon coordinates ``(B, logsigdim)`` of a C-contiguous ``(B, sigdim)`` batch of Lie elements."""
     off = level_offsets(dim, depth)
-    projections = [lyndon_projection(dim, k) for k in range(1, depth + 1)]
-    sizes = [p[0].shape[0] for p in projections]
-    out = np.empty((z.shape[0], sum(sizes)))
-    parts = _threads.ranges(z.shape[0], float(sum(p[0].shape[0] + p[2].shape[0] for p in projections)))
-    starts = [sum(sizes[:k]) for k in range(depth)]
+    projections, starts, work = lyndon_levels(dim, depth)
+    out = np.empty((z.shape[0], starts[-1]))
+    parts = _threads.ranges(z.shape[0], work)
 
     def rows(lo, hi):                       # every level of rows lo .. hi-1, one hand-off in all
-        for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
+        out[lo:hi, :dim] = z[lo:hi, :dim]   # level 1: every letter is a Lyndon word, its own coordinate
+        for k in range(2, depth + 1):
+            lidx, indptr, indices, data = projections[k - 1]
             _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, starts[k - 1], lo, hi)
     _run(rows, parts)
     return out
@@ -78,9 +78,7 @@ def lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Cotangent ``(B, sigdim)`` (row-major) of the Lie element, given that of its Lyndon coordinates."""
     off = level_offsets(dim, depth)
     gz = np.zeros((gc.shape[0], int(off[depth + 1])))
-    start = 0
-    for k in range(1, depth + 1):
-        lidx, indptr, indices, data = lyndon_projection(dim, k)
-        _k.lyndon_vjp(gc, start, lidx, indptr, indices, data, gz, off[k])
-        start += lidx.shape[0]
+    projections, starts, _ = lyndon_levels(dim, depth)
+    for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
+        _k.lyndon_vjp(gc, starts[k - 1], lidx, indptr, indices, data, gz, off[k])
     return gz

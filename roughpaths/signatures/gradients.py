@@ -9,25 +9,30 @@ The backward pass runs on the same work units as the forward kernels
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from .. import _threads
 from ..algebra.flat import level_offsets, lyndon_flat_vjp
-from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array
 from . import _lanes
 from . import _level2 as _l2
 from . import _rough_vjp, _vjp, _vjp_wide
-from ._engine import (_WIDE, _check_depth, _check_fits, _check_paths, _horner_chunks, _kernel_array,
-                      _reversed_parts, _reversed_signature, _reversed_to_rowmajor, _sigdim, _signature_flat,
-                      _split_units, _units)
+from ._engine import (_F64, _WIDE, _all_finite, _check_depth, _check_fits, _check_paths, _horner_chunks,
+                      _kernel_array, _logsigdim, _reversed_parts, _reversed_signature, _reversed_to_rowmajor, _sigdim,
+                      _signature_flat, _split_units, _units)
 from .signature import rough_path_signature
 
 __all__ = ["signature_vjp", "logsignature_vjp", "rough_path_signature_vjp"]
 
 
 def _check_grad(grad_output, batch: tuple, width: int, what: str) -> np.ndarray:
-    g = as_float_array(grad_output, "grad_output", min_ndim=1)
+    if (type(grad_output) is np.ndarray and grad_output.dtype == _F64 and grad_output.ndim >= 1
+            and _all_finite(grad_output)):
+        g = grad_output                             # what as_float_array returns for it, without its checks
+    else:
+        g = as_float_array(grad_output, "grad_output", min_ndim=1)
     if g.shape != batch + (width,):
         raise ValueError(f"grad_output has shape {g.shape}, expected {batch + (width,)}: the shape of "
                          f"{what}(paths, depth) (batch axes of paths, then {width}).")
@@ -57,37 +62,59 @@ def _signature_vjp_flat(x: np.ndarray, depth: int, g_row: np.ndarray) -> np.ndar
         g2 = _kernel_array(g_row, g_row.shape)
         _threads.run(lambda lo, hi: _l2.sig2_vjp_rows(x, g2, lo, hi, gx), _threads.ranges(nb, n * d * d))
         return gx
-    g_rev = np.empty_like(g_row)
-    g_rev[:, _reversed_to_rowmajor(d, depth)] = g_row
-    return _signature_vjp_rev(x, depth, g_rev)
+    return _signature_vjp_rev(x, depth, g_row.take(_rowmajor_to_reversed(d, depth), axis=1))
+
+
+@lru_cache(maxsize=None)
+def _rowmajor_to_reversed(dim: int, depth: int) -> np.ndarray:
+    """Gather index: ``reversed = rowmajor[..., inv]``, the inverse of :func:`_reversed_to_rowmajor` (a gather by
+    ``take`` costs half the scatter ``reversed[..., perm] = rowmajor`` on small batches; the same values)."""
+    perm = _reversed_to_rowmajor(dim, depth)
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(perm.shape[0])
+    return inv
+
+
+@lru_cache(maxsize=64)
+def _vjp_plan(nb: int, n: int, d: int, depth: int) -> tuple:
+    """What :func:`_signature_vjp_rev` runs for a ``(nb, n, d)`` batch (a function of the shape, made once):
+    ``(nchunks, units, offsets, (lane kernel, ranges) or None, (one-unit kernel, first unit, ranges) or None)``."""
+    off = level_offsets(d, depth)
+    nchunks = _horner_chunks(n, d, depth)
+    nunits = nb * nchunks
+    per_unit = (n / nchunks) * 5 * d ** depth
+    ngroups, first_alone = _split_units(nunits, d, depth)         # the same bits either way
+    lanes = (_vjp.sig_vjp_groups(d), _threads.ranges(ngroups, per_unit * _lanes.LANES)) if ngroups else None
+    if d >= _WIDE:                                          # every unit alone, the top level in blocks
+        alone = (_vjp_wide.sig_vjp_wide(d), 0, _threads.ranges(nunits, per_unit))
+    elif first_alone < nunits:
+        alone = (_vjp.sig_vjp_units(d), first_alone, _threads.ranges(nunits - first_alone, per_unit))
+    else:
+        alone = None
+    return nchunks, _units(nb, n, nchunks), off, lanes, alone
 
 
 def _signature_vjp_rev(x: np.ndarray, depth: int, g_rev: np.ndarray, part: np.ndarray | None = None) -> np.ndarray:
     """:func:`_signature_vjp_flat` (``n >= 2``, ``depth >= 3``) for a cotangent ``g_rev`` in the kernels' reversed
     layout; ``part``, the forward signatures of the work units (:func:`_reversed_parts`), if already computed."""
     nb, n, d = x.shape
-    off = level_offsets(d, depth)
-    nchunks = _horner_chunks(n, d, depth)
-    units = _units(nb, n, nchunks)
+    nchunks, (ub, ulo, uhi), off, lanes, alone = _vjp_plan(nb, n, d, depth)
     if part is None:
         part = _reversed_parts(x, depth, nchunks)
     gd = np.zeros((nb, n - 1, d))
-    nunits = nb * nchunks
-    per_unit = (n / nchunks) * 5 * d ** depth
-    ngroups, first_alone = _split_units(nunits, d, depth)         # the same bits either way
-    if ngroups:
-        groups = _vjp.sig_vjp_groups(d)
-        _threads.run(lambda lo, hi: groups(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
-                     _threads.ranges(ngroups, per_unit * _lanes.LANES))
-    if d >= _WIDE:                                          # every unit alone, the top level in blocks
-        wide = _vjp_wide.sig_vjp_wide(d)
-        _threads.run(lambda lo, hi: wide(x, *units, nchunks, depth, off, part, g_rev, lo, hi, gd),
-                     _threads.ranges(nunits, per_unit))
-    elif first_alone < nunits:
-        alone = _vjp.sig_vjp_units(d)
-        _threads.run(lambda lo, hi: alone(x, *units, nchunks, depth, off, part, g_rev, first_alone + lo,
-                                          first_alone + hi, gd),
-                     _threads.ranges(nunits - first_alone, per_unit))
+    if lanes is not None:
+        kernel, parts = lanes
+        if len(parts) == 1:                         # one range: called here (no closure, no thread query)
+            kernel(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, 0, parts[0][1], gd)
+        else:
+            _threads.run(lambda lo, hi: kernel(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, lo, hi, gd), parts)
+    if alone is not None:
+        one, first, parts = alone
+        if len(parts) == 1:
+            one(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, first, first + parts[0][1], gd)
+        else:
+            _threads.run(lambda lo, hi: one(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, first + lo, first + hi,
+                                            gd), parts)
     return _increments_to_points(gd, n)
 
 
@@ -172,7 +199,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     depth = _check_depth(depth)
     x = _check_paths(paths)
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
-    g = _check_grad(grad_output, batch, logsigdim(d, depth), "logsignature")
+    g = _check_grad(grad_output, batch, _logsigdim(d, depth), "logsignature")
     flat = _kernel_array(x, (-1, n, d))
     if depth == 1 or d == 1:
         g_sig = np.zeros((flat.shape[0], _sigdim(d, depth)))
@@ -181,23 +208,22 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     _check_fits(flat.shape[0], d, depth, log=True)
     off = level_offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
-    g_log_row = lyndon_flat_vjp(g, d, depth)
-    g_log_rev = np.empty_like(g_log_row)
-    g_log_rev[:, perm] = g_log_row
+    g_log_rev = lyndon_flat_vjp(g, d, depth).take(_rowmajor_to_reversed(d, depth), axis=1)
     small = depth == 2 or n == 1 or flat.shape[0] == 0      # the general route's special cases
     if small:
-        sig = _signature_flat(flat, depth)
-        sig_rev = np.empty_like(sig)
-        sig_rev[:, perm] = sig
+        sig_rev = _signature_flat(flat, depth).take(_rowmajor_to_reversed(d, depth), axis=1)
     else:
         # the forward signatures of the work units, computed once: glued for the log's backward pass, and
         # handed to the signature's backward pass (which would otherwise recompute them)
         part, sig_rev = _reversed_signature(flat, depth, _horner_chunks(n, d, depth))
     g_sig_rev = np.empty_like(sig_rev)
-    _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
-                 _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
+    parts = _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1])
+    if len(parts) == 1:                             # one range: called here (no closure, no thread query)
+        _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, 0, parts[0][1], g_sig_rev)
+    else:
+        _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev), parts)
     if small:
-        return _signature_vjp_flat(flat, depth, np.ascontiguousarray(g_sig_rev[:, perm])).reshape(x.shape)
+        return _signature_vjp_flat(flat, depth, g_sig_rev.take(perm, axis=1)).reshape(x.shape)
     return _signature_vjp_rev(flat, depth, g_sig_rev, part).reshape(x.shape)
 
 

@@ -30,10 +30,9 @@ import numpy as np
 
 from .. import _threads
 from ..algebra.flat import level_offsets, log_flat, lyndon_flat
-from ..algebra.tensor import logsigdim, sigdim
 from . import _kernels as _k
 from ._engine import (_check_depth, _check_fits, _check_paths, _finite_or_raise, _kernel_array, _level2_flat,
-                      _reversed_to_rowmajor, _sigdim, _signature_flat)
+                      _logsigdim, _reversed_to_rowmajor, _sigdim, _signature_flat)
 
 __all__ = ["signature", "logsignature", "rough_path_signature"]
 
@@ -97,7 +96,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     d = x.shape[-1]
     if depth == 1 or d == 1:
         # d = 1: the free Lie algebra is R (a path's log-signature is its increment).
-        return signature(x, 1)[..., :logsigdim(d, depth)]
+        return signature(x, 1)[..., :_logsigdim(d, depth)]
     batch, n = x.shape[:-2], x.shape[-2]
     flat = _kernel_array(x, (-1, n, d))
     _check_fits(flat.shape[0], d, depth, log=True)
@@ -105,10 +104,10 @@ def logsignature(paths, depth: int) -> np.ndarray:
         # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas,
         # which the level-2 kernel accumulates directly
         if flat.shape[0] == 0 or n == 1:
-            return np.zeros(batch + (logsigdim(d, 2),))
+            return np.zeros(batch + (_logsigdim(d, 2),))
         return _finite_or_raise(_level2_flat(flat, log=True), x).reshape(batch + (-1,))
     sig = np.ascontiguousarray(_finite_or_raise(_signature_flat(flat, depth), x))
-    return lyndon_flat(log_flat(sig, d, depth), d, depth).reshape(batch + (-1,))
+    return lyndon_flat(log_flat(sig, d, depth), d, depth).reshape(batch + (_logsigdim(d, depth),))
 
 
 def rough_path_signature(X, depth: int) -> np.ndarray:

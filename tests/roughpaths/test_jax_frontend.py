@@ -210,3 +210,19 @@ def test_kernel_gradient_steps_lower_a_loss():
         x = x - 0.01 * jax.grad(loss)(x)
         losses.append(float(loss(x)))
     assert np.all(np.diff(losses) < 0) and losses[-1] < 0.7 * losses[0], losses
+
+
+def test_host_functions_get_fresh_views_of_the_buffers(x64):
+    # the FFI handler reuses its views of XLA's buffers: what a host function does to its argument's
+    # shape must not reach the next call
+    def forward(a):
+        out = a.sum(axis=-1)
+        a.shape = (-1,)                      # a rude host function
+        return out
+
+    f = rpj.differentiable(forward, lambda a, g: np.broadcast_to(g[..., None], a.shape).copy(),
+                           lambda batch, cores: batch + cores[0][:1], names=("a",), core=(2,))
+    x = jnp.asarray(_paths((2, 4, 3)))            # float64: the host function gets the view itself, not a copy
+    g = jax.jit(lambda a: f(a))
+    for _ in range(3):
+        np.testing.assert_allclose(np.asarray(g(x)), np.asarray(x).sum(axis=-1), rtol=1e-12)

@@ -137,3 +137,14 @@ def test_kernel_adam_steps_lower_a_loss():
         opt.step()
         losses.append(loss.item())
     assert losses[-1] < losses[0], losses
+
+
+@pytest.mark.parametrize("name, depth", [("signature", 2), ("signature", 3), ("logsignature", 3)])
+def test_backward_leaves_the_cotangent_unchanged(name, depth):
+    # the library's VJPs receive torch's cotangent without a protective copy: they must only read it
+    x = torch.from_numpy(_paths((3, 7, 2))).requires_grad_()
+    out = getattr(rpt, name)(x, depth)
+    g = torch.from_numpy(np.random.default_rng(1).standard_normal(tuple(out.shape)))
+    before = g.clone()
+    out.backward(g)
+    assert torch.equal(g, before)

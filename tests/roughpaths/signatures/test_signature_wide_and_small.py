@@ -104,3 +104,26 @@ def test_wide_level2_lane_groups_with_chunks_and_a_tail(rng):
     for b in (0, 7, 8):
         np.testing.assert_array_equal(signature(x[b:b + 1], 2)[0], s[b])
         np.testing.assert_array_equal(logsignature(x[b:b + 1], 2)[0], ls[b])
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 4])
+def test_empty_batch_has_the_shapes_of_the_layouts(m):
+    # an empty batch (0 paths) gives empty results of the documented widths (depth >= 3 used to fail on a reshape)
+    x = np.zeros((0, 5, 3))
+    assert signature(x, m).shape == (0, sigdim(3, m))
+    assert logsignature(x, m).shape == (0, logsigdim(3, m))
+    assert signature_vjp(x, m, np.zeros((0, sigdim(3, m)))).shape == (0, 5, 3)
+    assert logsignature_vjp(x, m, np.zeros((0, logsigdim(3, m)))).shape == (0, 5, 3)
+
+
+def test_results_do_not_depend_on_the_input_layout(rng):
+    # float64 C arrays are taken as they are, other layouts and dtypes converted: the same values either way
+    # (iisignature's sigbackprop answers in float32: compared to 1e-5)
+    x = _paths(rng, 4, 9, 3)
+    g = rng.standard_normal((4, sigdim(3, 3)))
+    for xi in (x, np.asfortranarray(x), x.astype(np.float32), x[::-1][::-1], x.tolist()):
+        xr = np.asarray(xi, dtype=np.float64)
+        np.testing.assert_allclose(signature(xi, 3), iisignature.sig(xr, 3), rtol=0, atol=TOL)
+        ref = iisignature.sigbackprop(g, xr, 3)
+        np.testing.assert_allclose(signature_vjp(xi, 3, g), ref, rtol=0, atol=1e-5 * (1 + np.abs(ref).max()))
+        assert np.array_equal(signature_vjp(xi, 3, g), signature_vjp(np.ascontiguousarray(xr), 3, g))
