@@ -151,7 +151,7 @@ class _TreeSteps:
     def propose(self):
         """The attempts of every lane not yet at ``t1``, lanes on the same interval together (``[]``: done)."""
         live = self.live = self.i < self.end
-        act = self.act = live.nonzero()[0]
+        act = live.nonzero()[0]
         if act.size == 0:
             return []
         self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
