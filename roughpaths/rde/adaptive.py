@@ -80,7 +80,7 @@ def _step_doubling(solver, fields, y, a):
     second half another: two calls instead of three, the same numbers. They call ``solver.step`` (the
     contract's ``integrate`` returns what stepping returns) with the arguments ``integrate`` passes it."""
     if a.times.ndim == 2 and isinstance(a.dXX, np.ndarray):
-        n, (t0, tm, t1) = y.shape[0], np.split(a.times, 3, axis=1)              # (members, 1) each
+        n, t0, tm, t1 = y.shape[0], a.times[:, :1], a.times[:, 1:2], a.times[:, 2:]   # (members, 1) each
         dX, dXX = np.concatenate([a.dX[:, 0], a.whole[0][:, 0]]), np.concatenate([a.dXX[:, 0], a.whole[1][:, 0]])
         both = solver.step(fields, np.concatenate([y, y]), np.concatenate([t0, t0]),
                            np.concatenate([tm - t0, t1 - t0]), dX, dXX)                # first half; whole step
@@ -150,7 +150,8 @@ class _TreeSteps:
 
     def propose(self):
         """The attempts of every lane not yet at ``t1``, lanes on the same interval together (``[]``: done)."""
-        act = self.act = (self.i < self.end).nonzero()[0]
+        live = self.live = self.i < self.end
+        act = live.nonzero()[0]
         if act.size == 0:
             return []
         self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
@@ -160,20 +161,23 @@ class _TreeSteps:
                              f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
-        L, cell, i, h, mc = self.L, self.cell, self.i[act], self.state["h"][act], self.min_cells
+        every = act.size == self.lanes                    # no lane done: whole arrays, no gathers
+        L, cell, mc, paths = self.L, self.cell, self.min_cells, self.paths if every else self.paths[act]
+        i, h = (self.i, self.state["h"]) if every else (self.i[act], self.state["h"][act])
         target = self.end if self.targets.size == 1 else self.targets[np.searchsorted(self.targets, i, side="right")]
         depth = np.minimum(np.maximum(np.ceil(np.log2(self.span / h)).astype(np.int64) + self.fine, 0), L)
         unit = np.left_shift(np.int64(1), L - depth)
         j = np.rint((i + h / cell) / unit).astype(np.int64) * unit
         j = np.maximum(np.maximum(j, i + mc), (i // unit + 1) * unit)
-        j = np.where((j >= target) | (target - j < mc), target, j)
-        self.j[act], hc = j, (j - i) * cell
+        j = np.where(j > target - mc, target, j)              # at or near the target: the target
+        self.j[act], dj = j, j - i
+        hc = dj * cell
         self.floor = np.zeros(self.lanes, dtype=bool)
-        self.floor[act] = ((j - i) <= mc) | (hc <= self.dt_min * (1 + 1e-12))
+        self.floor[act] = (dj <= mc) | (hc <= self.dt_min * (1 + 1e-12))
         self.bad, self.tried = np.zeros(self.run.members, dtype=bool), np.zeros(self.run.members, dtype=bool)
         cols = np.empty((act.size, 3 if self.control.adaptive else 2), dtype=np.int64)      # the ends, in place
         cols[:, 0], cols[:, -1], cols[:, 1:-1] = i, j, ((i + j) // 2)[:, None]
-        ts = self.t0 + cell * cols.astype(np.float64)          # (lanes, 3) or (lanes, 2)
+        ts = cols * cell + self.t0                              # (lanes, 3) or (lanes, 2)
         if self.shared:
             members, ts, h = self.lane_members[0], ts[0], float(hc[0])
             if members.size == 1:               # one member: walked as a path of its own, as per member
@@ -183,7 +187,7 @@ class _TreeSteps:
             W, XX = W.reshape((members.size,) + W.shape[-2:]), XX.reshape((members.size,) + XX.shape[-3:])
         else:
             members, h = act, hc
-            W, XX = self.tree.increments_and_areas(ts, self.paths[act])
+            W, XX = self.tree.increments_and_areas(ts, paths)
         if self.shared or self.vector:            # one call: the batch on shared steps, or each member on its own
             return [self._attempt(members, ts, W, XX, h)]
         pairs, inverse = np.unique(np.stack([i, j]), axis=1, return_inverse=True)
@@ -202,19 +206,9 @@ class _TreeSteps:
         if err is not None:
             self.err[a.members] = err
 
-    def _lane_ratios(self, ok, bad):
-        if self.shared:
-            r = np.zeros(1)
-            if ok.any():
-                r[0] = np.max(self.err[ok])                             # NaN propagates: never accepted
-        else:
-            r = np.where(ok, self.err, 0.0)
-        r[self.lane_of[bad]] = math.inf
-        return r
-
     def adapt(self, attempts):
         """Fail the members that miss the tolerance at ``dt_min``, let the controller decide, advance the lanes."""
-        run, act, cell = self.run, self.act, self.cell
+        run, cell = self.run, self.cell
         bad = self.bad & run.healthy
         ok = self.tried & run.healthy & ~bad
         r = None
@@ -226,18 +220,21 @@ class _TreeSteps:
                 run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t0 + self.i[
                     self.lane_of[m[0]]] * cell, (self.j - self.i)[self.lane_of[m[0]]] * cell, self.control))
                 ok &= ~unmet
-            r = self._lane_ratios(ok, bad)
+            r = np.where(ok, self.err, 0.0) if not self.shared else \
+                np.array([np.max(self.err[ok]) if ok.any() else 0.0])      # the batch's: NaN propagates, never accepted
+            r[bad if not self.shared else self.lane_of[bad]] = math.inf
         t, h = self.t0 + self.i * cell, (self.j - self.i) * cell
-        accept = (np.asarray(self.control.adapt(self.state, t, h, r), dtype=bool) | self.floor) & (self.i < self.end)
-        self.rejected[act] += ~accept[act]
+        accept = (np.asarray(self.control.adapt(self.state, t, h, r), dtype=bool) | self.floor) & self.live
+        self.rejected += self.live > accept                 # the live lanes not accepted
         lanes = accept.nonzero()[0]
         if lanes.size == 0:
             return
-        members = (accept[self.lane_of] & self.tried).nonzero()[0]
-        if bad[members].any():
+        members = ((accept if not self.shared else accept[self.lane_of]) & self.tried).nonzero()[0]
+        if bad.any() and bad[members].any():
             m = members[bad[members]]
             run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
-        run.y[members] = np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
+        run.y[members] = self.y_new[members] if run.healthy.all() else \
+            np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
         self.accepted += accept                            # the lanes that advance
         np.copyto(self.i, self.j, where=accept)
         at = self.i[lanes]
