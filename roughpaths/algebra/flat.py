@@ -40,21 +40,12 @@ def level_offsets(dim: int, depth: int) -> np.ndarray:
     return off
 
 
-def _run(fn, parts: list) -> None:
-    """:func:`roughpaths._threads.run`, but a single range runs here at once (a small batch's call
-    then costs no thread-pool query)."""
-    if len(parts) == 1:
-        fn(*parts[0])
-    else:
-        _threads.run(fn, parts)
-
-
 def log_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Row-major ``log(1 + a)`` of a C-contiguous ``(B, sigdim)`` float64 batch (numba, Horner)."""
     off = level_offsets(dim, depth)
     out = np.empty_like(a)
-    _run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
-         _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
+    _threads.run(lambda lo, hi: _k.log_rows(a, dim, depth, off, lo, hi, out),
+                 _threads.ranges(a.shape[0], 1.5 * a.shape[1]))
     return out
 
 
@@ -70,7 +61,7 @@ def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
         for k in range(2, depth + 1):
             lidx, indptr, indices, data = projections[k - 1]
             _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, starts[k - 1], lo, hi)
-    _run(rows, parts)
+    _threads.run(rows, parts)
     return out
 
 

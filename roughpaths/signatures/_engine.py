@@ -237,16 +237,10 @@ def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
         *x.shape, depth, nchunks)
     part = np.empty(shape)
     if lanes is not None:
-        if len(lane_ranges) == 1:                   # one range: called here (no closure, no thread query)
-            lanes(x, ub, ulo, uhi, depth, off, 0, lane_ranges[0][1], part)
-        else:
-            _threads.run(lambda lo, hi: lanes(x, ub, ulo, uhi, depth, off, lo, hi, part), lane_ranges, merge=True)
+        _threads.run(lambda lo, hi: lanes(x, ub, ulo, uhi, depth, off, lo, hi, part), lane_ranges, merge=True)
     if alone is not None:
-        if len(alone_ranges) == 1:
-            alone(x, ub, ulo, uhi, depth, off, first_alone, first_alone + alone_ranges[0][1], part)
-        else:
-            _threads.run(lambda lo, hi: alone(x, ub, ulo, uhi, depth, off, first_alone + lo, first_alone + hi, part),
-                         alone_ranges, merge=True)
+        _threads.run(lambda lo, hi: alone(x, ub, ulo, uhi, depth, off, first_alone + lo, first_alone + hi, part),
+                     alone_ranges, merge=True)
     return part
 
 

@@ -104,17 +104,11 @@ def _signature_vjp_rev(x: np.ndarray, depth: int, g_rev: np.ndarray, part: np.nd
     gd = np.zeros((nb, n - 1, d))
     if lanes is not None:
         kernel, parts = lanes
-        if len(parts) == 1:                         # one range: called here (no closure, no thread query)
-            kernel(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, 0, parts[0][1], gd)
-        else:
-            _threads.run(lambda lo, hi: kernel(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, lo, hi, gd), parts)
+        _threads.run(lambda lo, hi: kernel(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, lo, hi, gd), parts)
     if alone is not None:
         one, first, parts = alone
-        if len(parts) == 1:
-            one(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, first, first + parts[0][1], gd)
-        else:
-            _threads.run(lambda lo, hi: one(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, first + lo, first + hi,
-                                            gd), parts)
+        _threads.run(lambda lo, hi: one(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, first + lo, first + hi, gd),
+                     parts)
     return _increments_to_points(gd, n)
 
 
@@ -217,11 +211,8 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
         # handed to the signature's backward pass (which would otherwise recompute them)
         part, sig_rev = _reversed_signature(flat, depth, _horner_chunks(n, d, depth))
     g_sig_rev = np.empty_like(sig_rev)
-    parts = _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1])
-    if len(parts) == 1:                             # one range: called here (no closure, no thread query)
-        _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, 0, parts[0][1], g_sig_rev)
-    else:
-        _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev), parts)
+    _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
+                 _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
     if small:
         return _signature_vjp_flat(flat, depth, g_sig_rev.take(perm, axis=1)).reshape(x.shape)
     return _signature_vjp_rev(flat, depth, g_sig_rev, part).reshape(x.shape)
