@@ -246,10 +246,13 @@ def _on_stop_signal(signum, frame):
 
 
 def _quiet_unraisable(previous):
-    """A ``sys.unraisablehook`` that drops the interruptions of our stop signals (the run stops at the next
-    piece boundary instead, with its usual one-line message) and passes everything else on."""
+    """A ``sys.unraisablehook`` that, once a stop signal has come, drops what finalizers and callbacks from C
+    cannot raise: the interruption itself (the run stops at the next piece boundary instead, with its usual
+    one-line message) and the errors of objects the interruption left half-built (llvmlite's ``__del__``
+    of an object whose constructor the signal cut short raises ``AttributeError``). Before any signal,
+    everything is passed on."""
     def hook(unraisable):
-        if _SIGNALLED and isinstance(unraisable.exc_value, KeyboardInterrupt):
+        if _SIGNALLED:
             return
         previous(unraisable)
     return hook

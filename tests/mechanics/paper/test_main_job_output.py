@@ -303,6 +303,45 @@ def test_a_stop_signal_swallowed_by_a_callback_from_c_still_stops_the_run(tmp_pa
     assert {sig: signal.getsignal(sig) for sig in before} == before and sys.unraisablehook is hook   # restored
 
 
+def test_a_stop_signal_that_leaves_an_object_half_built_prints_no_traceback(tmp_path, monkeypatch, capsys):
+    """A signal that cuts a constructor short leaves an object whose ``__del__`` fails (llvmlite's
+    ``ObjectRef`` while numba compiles: ``AttributeError: ... '_as_parameter_'``, seen in CI): the run stops
+    with its usual message and no traceback. Before any signal, such errors are still passed on."""
+    from mechanics.paper.checks import CHECKS
+    from mechanics.paper.tasks import Task
+
+    chen = CHECKS["chen"]
+
+    class HalfBuilt:
+        def __init__(self, signalled):
+            if not signalled:
+                return                            # failed some other way, before the attribute exists
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.5)                       # the handler raises here, before the attribute exists
+            self.handle = 1
+
+        def __del__(self):
+            del self.handle                       # AttributeError when the constructor was cut short
+
+    def cut_short(ctx):
+        HalfBuilt(signalled=False)                # a failing __del__ before the signal: passed on
+        try:
+            HalfBuilt(signalled=True)
+        except BaseException as exc:              # the frames go (as in numba's unwinding): __del__ runs now
+            stop = exc.with_traceback(None)
+        raise stop
+
+    passed_on = []
+    monkeypatch.setattr(sys, "unraisablehook", passed_on.append)
+    monkeypatch.setitem(CHECKS, "chen", Task(name="chen", title=chen.title, func=cut_short))
+    out = tmp_path / "run"
+    assert main(["--tiny", "--only", "chen", "--output", str(out)]) == 128 + signal.SIGTERM
+    err = capsys.readouterr().err
+    assert "terminated" in err and "--resume" in err and "Traceback" not in err, err
+    assert [type(u.exc_value) for u in passed_on] == [AttributeError]     # the one before the signal only
+    assert (Path(str(out) + ".incomplete") / "INCOMPLETE.txt").is_file()
+
+
 def test_a_previous_run_hidden_by_an_interrupted_overwrite_is_restored_or_cleaned(tmp_path, capsys):
     """A kill between the two renames of --overwrite left '.run.replaced-PID': reported and cleaned up."""
     out = tmp_path / "run"
