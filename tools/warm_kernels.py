@@ -16,7 +16,8 @@ variant on a user's first call, a few seconds each (``benchmarks/bench_first_cal
 
 ``--more`` adds what the test suite reaches besides (lone, wide and long chunked paths, the rough-path
 signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule, the coadjoint schemes on rough
-paths built from arrays, the midpoint rule in six dimensions): ``tools/setup_env.sh`` passes it when it
+paths built from arrays, the midpoint rule in six dimensions, the compile-time variants the oracle and bit-equality
+tests reach, the matrix algebras of Proposition 2.1's tests, a corrected ensemble on worker processes): ``tools/setup_env.sh`` passes it when it
 installs the test extra, so those compiles happen at set-up on both cores, not inside the tests (where both
 xdist workers may compile the same kernel). ``SUITE_PROFILE`` (``tests/conftest.py``) and
 ``tools/suite_profile.py`` list what the suite still compiles.
@@ -87,6 +88,38 @@ def warm_more_signatures() -> None:
     rp.p_variation(lone, 2.5)
 
 
+def warm_more_variants() -> None:
+    """For the test suite (``--more``): the compile-time variants its oracle and bit-equality tests reach and a
+    user's first tries do not (measured with ``SUITE_PROFILE`` on a cold cache after the rest of the warm-up:
+    86 s of compilation inside the tests, 42 s of it the one-unit reference kernel). The lane kernels of
+    d = 2 at depth 5, d = 4 at depth 3 and (5, 3); the one-unit kernels (6, 4), (8, 4) and d = 4 at depth 8;
+    the level-2 kernels of d = 4, 5; and :func:`~roughpaths.signatures._lanes.scalar_units`, the per-segment
+    kernel the tests hold the others to (private: the tests call it directly), for d = 2, 3, 5, 6."""
+    import roughpaths as rp
+    from roughpaths.algebra.flat import level_offsets
+    from roughpaths.signatures import _lanes
+    from roughpaths.signatures._engine import _units
+
+    rng = np.random.default_rng(0)
+
+    def path(*shape):
+        return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
+
+    for d, m in ((2, 5), (4, 3), (5, 3)):                 # lanes (16 paths: two full lane groups)
+        rp.signature(path(16, 20, d), m)
+    rp.signature_vjp(path(16, 20, 4), 3, np.ones((16, rp.sigdim(4, 3))))
+    for d, m in ((6, 4), (8, 4)):                          # one unit at a time, compile-time width and depth
+        rp.signature(path(2, 20, d), m)
+    rp.logsignature(path(2, 6, 4), 8)
+    for d in (4, 5):
+        rp.signature(path(3, 20, d), 2)
+    for d in (2, 3, 5, 6):
+        x = path(3, 10, d)
+        units = _units(3, 10, 2)
+        off = level_offsets(d, 3)
+        _lanes.scalar_units(x, *units, 3, off, 0, 6, np.empty((6, off[4])))
+
+
 def warm_more_drivers() -> None:
     """For the test suite (``--more``): the Brownian driver with every Lévy-area method at d = 2 and 3 (the
     tests sample with each; the default's kernels are the main job's), a few seconds of CPU each."""
@@ -153,6 +186,36 @@ def warm_more_coadjoint() -> None:
     solve(su3, BrownianDriver(3, seed=0, dt=0.01, n_steps=2, batch_shape=(2,)), np.ones((2, 8)), ImplicitMidpoint())
 
 
+def warm_more_matrix_algebras() -> None:
+    """For the test suite (``--more``): the generic coadjoint kernel on su(3) and so(5) with Lie–Euler at
+    θ = 0, and the midpoint rule's variant with a bounded chord iteration, on rough paths built from arrays
+    (Proposition 2.1's and the isospectral tests; 11 s of compilation inside them), and a streamed rigid-body
+    ensemble with a Lévy-area correction (compiled by the worker processes of a test of the executors, 7 s)."""
+    from mechanics import ChordConvergenceError, ImplicitMidpoint, LieEuler, LiePoissonSystem, so, su
+    from roughpaths import RoughPath, brownian_rough_path, solve
+
+    rng = np.random.default_rng(0)
+    for g in (su(3), so(5)):
+        vals = np.cumsum(rng.standard_normal((3, 241, 4)) * 0.06, axis=1)
+        fine = RoughPath.from_path(vals, times=np.linspace(0.0, 1.0, 241))
+        s = rng.standard_normal((4, 4))
+        system = LiePoissonSystem(g, np.linspace(0.7, 1.8, g.dim), 0.3 * rng.standard_normal((4, g.dim)), theta=0.0)
+        solve(system, fine.restrict(fine.times[::4]).perturb(s - s.T), np.ones(g.dim), LieEuler())
+    from mechanics import rigid_body, run_ensemble     # a streamed ensemble with a Lévy-area correction
+    corrected = rigid_body([1.0, 2.0, 3.0], sigma=0.4, s=np.array([[0, 0, 1.0], [0, 0, 0], [-1.0, 0, 0]]), theta=0.5)
+    from concurrent.futures import ProcessPoolExecutor
+    with ProcessPoolExecutor(max_workers=1) as ex:     # its arrays reach the workers unpickled: other specialisations
+        for executor in (None, ex):
+            run_ensemble(corrected, [0.0, 0.0, 1.0], dt=0.01, n_steps=60, n_paths=70, seed=0, burn_in=20,
+                         record_every=15, keep_final=True, executor=executor)
+    system = LiePoissonSystem(su(3), 0.05 + rng.random(8), 0.3 * rng.standard_normal((2, 8)), theta=2.0)
+    X = brownian_rough_path(np.linspace(0.0, 1.0, 3), dim=2, rng=np.random.default_rng(3))
+    try:
+        solve(system, X, 20.0 * rng.standard_normal(8), ImplicitMidpoint(max_iter=3))
+    except ChordConvergenceError:
+        pass
+
+
 def warm_signature_kernels() -> None:
     import roughpaths as rp
 
@@ -193,8 +256,10 @@ PARTS = {
     "mechanics": (("coadjoint kernels", warm_coadjoint),),
 }
 #: with ``--more`` (``tools/setup_env.sh`` when it installs the test extra): what the test suite reaches besides
-MORE = {"roughpaths": (("more signatures", warm_more_signatures), ("more drivers", warm_more_drivers)),
-        "mechanics": (("more coadjoint schemes", warm_more_coadjoint), ("more signature gradients", warm_more_gradients))}
+MORE = {"roughpaths": (("more signatures", warm_more_signatures), ("more drivers", warm_more_drivers),
+                       ("signature variants of the tests", warm_more_variants)),
+        "mechanics": (("more coadjoint schemes", warm_more_coadjoint), ("more signature gradients", warm_more_gradients),
+                      ("matrix algebras of the tests", warm_more_matrix_algebras))}
 
 
 def main() -> None:
