@@ -61,7 +61,11 @@ warm_up() {
         echo $! > "$PID_FILE"
         return
     fi
-    echo "Compiling the numba kernels once (about a minute) ..." >&2
+    if [ -n "$more" ]; then   # measured on 2 cores: 190-220 s with the suite's kernels
+        echo "Compiling the numba kernels once, the test suite's too (about 3-4 minutes) ..." >&2
+    else
+        echo "Compiling the numba kernels once (about a minute) ..." >&2
+    fi
     local start=$SECONDS warm
     warm="$(mktemp -d)"
     # Two processes, one per core: the main job's kernels (a --tiny run) then the other coadjoint kernels, and
