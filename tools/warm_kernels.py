@@ -16,10 +16,10 @@ variant on a user's first call, a few seconds each (``benchmarks/bench_first_cal
 
 ``--more`` adds what the test suite reaches besides (lone, wide and long chunked paths, the rough-path
 signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule, the coadjoint schemes on rough
-paths built from arrays, the midpoint rule in six dimensions, the compile-time variants the oracle and bit-equality
-tests reach, the matrix algebras of Proposition 2.1's tests, a corrected ensemble on worker processes): ``tools/setup_env.sh`` passes it when it
-installs the test extra, so those compiles happen at set-up on both cores, not inside the tests (where both
-xdist workers may compile the same kernel). ``SUITE_PROFILE`` (``tests/conftest.py``) and
+paths built from arrays, the midpoint rule in six dimensions, the compile-time variants the oracle and
+bit-equality tests reach, the matrix algebras of Proposition 2.1's tests, a corrected ensemble on worker
+processes): ``tools/setup_env.sh`` passes it when it installs the test extra, so those compiles happen at
+set-up on both cores, not inside the tests (where both xdist workers may compile the same kernel). ``SUITE_PROFILE`` (``tests/conftest.py``) and
 ``tools/suite_profile.py`` list what the suite still compiles.
 
 Usage: ``python tools/warm_kernels.py [--part roughpaths|mechanics] [--more]`` (prints the time each family
@@ -37,6 +37,11 @@ import time
 import numpy as np
 
 
+def _walk(rng, *shape):
+    """Random-walk paths of ``shape`` (points along axis -2), steps of size about 0.1."""
+    return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
+
+
 def warm() -> None:
     """The signature kernels of a first try: batches of d = 2 and d = 3 paths at depths 2-4, the
     log-signature, and both gradients.
@@ -49,7 +54,7 @@ def warm() -> None:
 
     rng = np.random.default_rng(0)
     for d in (3, 2):
-        x = np.cumsum(rng.standard_normal((16, 100, d)), axis=-2) * 0.1
+        x = _walk(rng, 16, 100, d)
         for m in (2, 3, 4):
             rp.signature(x, m)
             rp.logsignature(x, m)
@@ -64,21 +69,18 @@ def warm_more_signatures() -> None:
     import roughpaths as rp
 
     rng = np.random.default_rng(0)
-
-    def path(*shape):
-        return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
-
-    lone, wide, wide_batch, long_path = path(9, 3), path(2, 7, 6), path(9, 7, 6), path(2 * 1024 + 8, 2)
+    lone, wide, wide_batch = _walk(rng, 9, 3), _walk(rng, 2, 7, 6), _walk(rng, 9, 7, 6)
+    long_path = _walk(rng, 2 * 1024 + 8, 2)
     for x in (lone, wide, wide_batch, long_path):
         for m in (2, 3):
             rp.signature(x, m)
             rp.logsignature(x, m)
             rp.signature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.sigdim(np.shape(x)[-1], m),)))
             rp.logsignature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.logsigdim(np.shape(x)[-1], m),)))
-    rp.signature(path(2 * 8192 + 8, 3), 2)                 # level 2, chunked
-    rp.signature(path(9, 700, 7), 3)                        # the lanes' (7, 3) variant
-    rp.signature(path(9, 700, 1), 3)                        # the lanes' run-time variant (d = 1 reaches it)
-    X = rp.RoughPath.from_path(path(10, 9, 3))
+    rp.signature(_walk(rng, 2 * 8192 + 8, 3), 2)           # level 2, chunked
+    rp.signature(_walk(rng, 9, 700, 7), 3)                 # the lanes' (7, 3) variant
+    rp.signature(_walk(rng, 9, 700, 1), 3)                 # the lanes' run-time variant (d = 1 reaches it)
+    X = rp.RoughPath.from_path(_walk(rng, 10, 9, 3))
     for m in (2, 3):
         s = rp.rough_path_signature(X, m)
         rp.rough_path_signature_vjp(X, m, np.ones_like(s))
@@ -101,20 +103,16 @@ def warm_more_variants() -> None:
     from roughpaths.signatures._engine import _units
 
     rng = np.random.default_rng(0)
-
-    def path(*shape):
-        return np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
-
     for d, m in ((2, 5), (4, 3), (5, 3)):                 # lanes (16 paths: two full lane groups)
-        rp.signature(path(16, 20, d), m)
-    rp.signature_vjp(path(16, 20, 4), 3, np.ones((16, rp.sigdim(4, 3))))
+        rp.signature(_walk(rng, 16, 20, d), m)
+    rp.signature_vjp(_walk(rng, 16, 20, 4), 3, np.ones((16, rp.sigdim(4, 3))))
     for d, m in ((6, 4), (8, 4)):                          # one unit at a time, compile-time width and depth
-        rp.signature(path(2, 20, d), m)
-    rp.logsignature(path(2, 6, 4), 8)
+        rp.signature(_walk(rng, 2, 20, d), m)
+    rp.logsignature(_walk(rng, 2, 6, 4), 8)
     for d in (4, 5):
-        rp.signature(path(3, 20, d), 2)
+        rp.signature(_walk(rng, 3, 20, d), 2)
     for d in (2, 3, 5, 6):
-        x = path(3, 10, d)
+        x = _walk(rng, 3, 10, d)
         units = _units(3, 10, 2)
         off = level_offsets(d, 3)
         _lanes.scalar_units(x, *units, 3, off, 0, 6, np.empty((6, off[4])))
@@ -141,7 +139,7 @@ def warm_more_gradients() -> None:
 
     rng = np.random.default_rng(0)
     for shape in ((9, 4), (6, 1), (2, 37, 20), (2, 37, 8)):
-        x = np.cumsum(rng.standard_normal(shape), axis=-2) * 0.1
+        x = _walk(rng, *shape)
         rp.signature_vjp(x, 3, np.ones(shape[:-2] + (rp.sigdim(shape[-1], 3),)))
 
 
@@ -189,8 +187,7 @@ def warm_more_coadjoint() -> None:
 def warm_more_matrix_algebras() -> None:
     """For the test suite (``--more``): the generic coadjoint kernel on su(3) and so(5) with Lie–Euler at
     θ = 0, and the midpoint rule's variant with a bounded chord iteration, on rough paths built from arrays
-    (Proposition 2.1's and the isospectral tests; 11 s of compilation inside them), and a streamed rigid-body
-    ensemble with a Lévy-area correction (compiled by the worker processes of a test of the executors, 7 s)."""
+    (Proposition 2.1's and the isospectral tests; 11 s of compilation inside them)."""
     from mechanics import ChordConvergenceError, ImplicitMidpoint, LieEuler, LiePoissonSystem, so, su
     from roughpaths import RoughPath, brownian_rough_path, solve
 
@@ -201,19 +198,27 @@ def warm_more_matrix_algebras() -> None:
         s = rng.standard_normal((4, 4))
         system = LiePoissonSystem(g, np.linspace(0.7, 1.8, g.dim), 0.3 * rng.standard_normal((4, g.dim)), theta=0.0)
         solve(system, fine.restrict(fine.times[::4]).perturb(s - s.T), np.ones(g.dim), LieEuler())
-    from mechanics import rigid_body, run_ensemble     # a streamed ensemble with a Lévy-area correction
-    corrected = rigid_body([1.0, 2.0, 3.0], sigma=0.4, s=np.array([[0, 0, 1.0], [0, 0, 0], [-1.0, 0, 0]]), theta=0.5)
-    from concurrent.futures import ProcessPoolExecutor
-    with ProcessPoolExecutor(max_workers=1) as ex:     # its arrays reach the workers unpickled: other specialisations
-        for executor in (None, ex):
-            run_ensemble(corrected, [0.0, 0.0, 1.0], dt=0.01, n_steps=60, n_paths=70, seed=0, burn_in=20,
-                         record_every=15, keep_final=True, executor=executor)
     system = LiePoissonSystem(su(3), 0.05 + rng.random(8), 0.3 * rng.standard_normal((2, 8)), theta=2.0)
     X = brownian_rough_path(np.linspace(0.0, 1.0, 3), dim=2, rng=np.random.default_rng(3))
     try:
         solve(system, X, 20.0 * rng.standard_normal(8), ImplicitMidpoint(max_iter=3))
     except ChordConvergenceError:
         pass
+
+
+def warm_more_ensembles() -> None:
+    """For the test suite (``--more``): a streamed rigid-body ensemble with a Lévy-area correction, here and on a
+    worker process, whose arrays arrive unpickled (other specialisations: compiled inside the workers of a test
+    of the executors, 7 s)."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from mechanics import rigid_body, run_ensemble
+
+    corrected = rigid_body([1.0, 2.0, 3.0], sigma=0.4, s=np.array([[0, 0, 1.0], [0, 0, 0], [-1.0, 0, 0]]), theta=0.5)
+    with ProcessPoolExecutor(max_workers=1) as ex:
+        for executor in (None, ex):
+            run_ensemble(corrected, [0.0, 0.0, 1.0], dt=0.01, n_steps=60, n_paths=70, seed=0, burn_in=20,
+                         record_every=15, keep_final=True, executor=executor)
 
 
 def warm_signature_kernels() -> None:
@@ -258,8 +263,10 @@ PARTS = {
 #: with ``--more`` (``tools/setup_env.sh`` when it installs the test extra): what the test suite reaches besides
 MORE = {"roughpaths": (("more signatures", warm_more_signatures), ("more drivers", warm_more_drivers),
                        ("signature variants of the tests", warm_more_variants)),
-        "mechanics": (("more coadjoint schemes", warm_more_coadjoint), ("more signature gradients", warm_more_gradients),
-                      ("matrix algebras of the tests", warm_more_matrix_algebras))}
+        "mechanics": (("more coadjoint schemes", warm_more_coadjoint),
+                      ("more signature gradients", warm_more_gradients),
+                      ("matrix algebras of the tests", warm_more_matrix_algebras),
+                      ("corrected ensembles of the tests", warm_more_ensembles))}
 
 
 def main() -> None:

@@ -102,8 +102,7 @@ def member_system(system):
     structure-constant algebra with a matrix basis (a conjugation of ``N × N`` matrices instead of the exponential
     of ``n × n``, ``n ~ N²``: su(6) from its matrix basis, ``LieAlgebra.from_matrix_basis``, LieHeun adaptive per
     member, 16 paths at rtol 1e-3, 11.3 s -> 2.3 s of CPU), for a quadratic Hamiltonian without forces; otherwise
-    ``system``. It depends on the system only, never on the steps
-    or the batch."""
+    ``system``. It depends on the system only, never on the steps or the batch."""
     alg = system.algebra
     if (not system.hamiltonian.is_quadratic or system.has_forces or getattr(alg, "basis", None) is None
             or type(alg) is not LieAlgebra):
