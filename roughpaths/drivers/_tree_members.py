@@ -42,7 +42,7 @@ _WALK_CACHE_BYTES = 64 * 2 ** 20
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
-def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A, cidx, cw, cG):
+def _walk_nb(prefix, root_w, root_G, rows, keys, times, t0, idx, L, span, tag, width, W, A, cidx, cw, cG):
     """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children of
     the last ``S`` (2, or 1 for a tree too large for two) nodes split at each depth of each tree row are kept in
     ``cidx, cw, cG``: slots ``S depth .. S depth + S - 1`` of a row (``DS = S (L + 1)`` slots) hold a pair each,
@@ -52,8 +52,23 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
     its parent's slot of children): the walk is depth first, so no node of a depth is split between a split (or a
     hit) of its parent and the reading of both children it holds; a split replaces the pair of its depth used less
     recently. A node inside a cell is reduced here (the arithmetic of ``reduce_node``, one compiled kernel less to
-    link). No array assignments: numba compiles a shape check with a formatted error message for them (about 3 s)."""
+    link). No array assignments: numba compiles a shape check with a formatted error message for them (about 3 s).
+
+    The cells' ends ``idx (Q, n + 1)`` are the grid indices of ``times`` (rounded to the nearest, at most ``2^L``),
+    computed here. Returns 0, or ``q + 1`` for the first row ``q`` whose times are not strictly increasing on the
+    grid within ``[t0, t0 + span]`` (nothing walked then). ``A`` receives the Stratonovich areas, the Lévy area plus
+    ``½ W ⊗ W``."""
     Q, n = idx.shape[0], idx.shape[1] - 1
+    top_index = np.int64(1) << L
+    scale = 2.0 ** L
+    for q in range(Q):
+        for k in range(n + 1):
+            v = times[q, k]
+            if not (v >= t0 and v <= t0 + span):
+                return q + 1
+            idx[q, k] = min(np.int64(np.rint((v - t0) / span * scale)), top_index)
+            if k > 0 and idx[q, k] <= idx[q, k - 1]:
+                return q + 1
     nseg, d = root_w.shape[1], root_w.shape[2]
     m = prefix.size
     caching = cidx.shape[0] > 0
@@ -149,18 +164,22 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, idx, L, span, tag, width, W, A,
             sd[top], si[top] = depth + 1, 2 * index + 1          # the right child, then the left (popped first)
             sd[top + 1], si[top + 1] = depth + 1, 2 * index
             top += 2
+        for c in range(n):
+            for a in range(d):
+                for b in range(d):
+                    A[q, c, a, b] += 0.5 * W[q, c, a] * W[q, c, b]
+    return 0
 
 
-def member_cells(tree, rows, idx, tag):
-    """``(W (Q, n, d), A (Q, n, d, d))``: row ``q`` of ``tree`` (flat index ``rows[q]``) on the grid cells
-    ``[idx[q, k], idx[q, k + 1])`` (``idx (Q, n + 1)`` strictly increasing grid indices per row; ``tag`` the
-    tree's split stream tag). Needs the tree's seeded fast path (``tree._prefix``)."""
+def member_cells(tree, rows, times, tag):
+    """``(W (Q, n, d), XX (Q, n, d, d))``, increments and Stratonovich areas: row ``q`` of ``tree`` (flat index
+    ``rows[q]``) between its ``times[q]`` (``(Q, n + 1)``, strictly increasing on the tree's grid in ``[t0, t1]``,
+    else a ``ValueError``; ``tag`` the tree's split stream tag). Needs the tree's seeded fast path (``tree._prefix``)."""
     if tree._root_node is None:
         tree._root_node = tree._root()
-    w, G = tree._root_node
-    Q, n, d = idx.shape[0], idx.shape[1] - 1, tree.dim
-    W, A = np.empty((Q, n, d)), np.empty((Q, n, d, d))
-    rows = np.ascontiguousarray(rows, dtype=np.int64)
+    w, G = (np.ascontiguousarray(v) for v in tree._root_node)
+    Q, n, d = times.shape[0], times.shape[1] - 1, tree.dim
+    W, A, idx = np.empty((Q, n, d)), np.empty((Q, n, d, d)), np.empty((Q, n + 1), dtype=np.int64)
     cache = tree.__dict__.get("_walk_cache")
     if cache is None:            # the children of two nodes per depth and row (or one) if 64 MiB hold them
         P, D, nseg = tree.n_paths, tree.resolution + 1, w.shape[1]
@@ -169,7 +188,10 @@ def member_cells(tree, rows, idx, tag):
         slots = np.concatenate([np.full(S * D, -1), np.zeros(D)]).astype(np.int64)
         cache = tree._walk_cache = (np.repeat(slots[None], R, axis=0), np.empty((R, S * D, 2, nseg, d)),
                                     np.empty((R, S * D, 2, d, d)))
-    _walk_nb(tree._prefix, np.ascontiguousarray(w), np.ascontiguousarray(G), rows, tree._paths[rows],
-             np.ascontiguousarray(idx, dtype=np.int64), tree.resolution, float(tree.t1 - tree.t0), tag,
-             split_width(w.shape[1], d), W, A, *cache)
+    t0, span, L = float(tree.t0), float(tree.t1 - tree.t0), tree.resolution
+    q = _walk_nb(tree._prefix, w, G, rows, tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64), t0, idx, L,
+                 span, tag, split_width(w.shape[1], d), W, A, *cache)
+    if q:
+        raise ValueError(f"times must increase strictly in [t0, t1] = [{tree.t0}, {tree.t1}] on the tree's grid "
+                         f"(t1 - t0)·2^-{L}, row by row; row {q - 1} is {np.asarray(times)[q - 1]!r}.")
     return W, A

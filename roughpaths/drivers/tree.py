@@ -308,12 +308,7 @@ class BrownianTree(Driver):
                 W, A = self.increments_and_levy_areas(t[0])
                 W, A = W.reshape((self.n_paths,) + W.shape[-2:])[paths], A.reshape((self.n_paths,) + A.shape[-3:])[paths]
             elif self._prefix is not None:          # one vectorised walk for every path on its own times
-                T, L = self.t1 - self.t0, self.resolution
-                idx = np.minimum(np.rint((t - self.t0) / T * 2.0 ** L).astype(np.int64), 2 ** L)
-                if t.size and not (t.min() >= self.t0 and t.max() <= self.t1 and (idx[:, 1:] > idx[:, :-1]).all()):
-                    raise ValueError(f"times must increase strictly in [t0, t1] = [{self.t0}, {self.t1}] on the "
-                                     f"tree's grid (t1 - t0)·2^-{L}, row by row.")
-                W, A = member_cells(self, paths, idx, _SPLIT)
+                return member_cells(self, paths, t, _SPLIT)
             else:
                 W, A = (np.concatenate(x) for x in zip(*[self.select([p]).increments_and_levy_areas(tk)
                                                          for p, tk in zip(paths.tolist(), t)]))

@@ -54,22 +54,9 @@ import math
 
 import numpy as np
 
-from ..validation import check_memory
+from ._attempts import _advance_nb, _doubling_nb, _judge_nb, _ratios_nb, _snap_nb
 
 __all__ = []
-
-
-def _areas(W, A):
-    """Stratonovich areas ``A + ½ W ⊗ W`` from increments ``W (..., d)`` and Lévy areas ``A (..., d, d)``."""
-    return A + 0.5 * W[..., :, None] * W[..., None, :]
-
-
-def _whole_step(W, XX):
-    """Increment and area of a step from those of its halves ``W (..., 2, d)``, ``XX (..., 2, d, d)``, by Chen:
-    ``X = X_1 + X_2``, ``XX = XX_1 + XX_2 + X_1 ⊗ X_2``; shapes ``(..., 1, d)`` and ``(..., 1, d, d)``."""
-    W1, W2 = W[..., 0, :], W[..., 1, :]
-    XXw = XX[..., 0, :, :] + XX[..., 1, :, :] + W1[..., :, None] * W2[..., None, :]
-    return (W1 + W2)[..., None, :], XXw[..., None, :, :]
 
 
 def _step_doubling(solver, fields, y, a):
@@ -78,23 +65,26 @@ def _step_doubling(solver, fields, y, a):
     With each member on its own times (``a.times (members, 3)``) the first half and the whole step are one
     step of the solver on the members stacked twice (a member's arithmetic is its own in any batch), the
     second half another: two calls instead of three, the same numbers. They call ``solver.step`` (the
-    contract's ``integrate`` returns what stepping returns) with the arguments ``integrate`` passes it."""
+    contract's ``integrate`` returns what stepping returns) with the arguments ``integrate`` passes it.
+    The whole step's increment and area are the Chen product of the halves' (:func:`_doubling_nb`)."""
+    n, e, d = y.shape[0], y.shape[-1], a.dX.shape[-1]
+    Y2, T2, DT2, DX2, DXX2 = np.empty((2 * n, e)), np.empty((2 * n, 1)), np.empty((2 * n, 1)), \
+        np.empty((2 * n, d)), np.empty((2 * n, d, d))
+    ts = a.times if a.times.ndim == 2 else np.broadcast_to(a.times, (n, 3))
+    _doubling_nb(y, ts, a.dX, a.dXX, Y2, T2, DT2, DX2, DXX2)
     if a.times.ndim == 2 and isinstance(a.dXX, np.ndarray):
-        n, t0, tm, t1 = y.shape[0], a.times[:, :1], a.times[:, 1:2], a.times[:, 2:]   # (members, 1) each
-        dX, dXX = np.concatenate([a.dX[:, 0], a.whole[0][:, 0]]), np.concatenate([a.dXX[:, 0], a.whole[1][:, 0]])
-        both = solver.step(fields, np.concatenate([y, y]), np.concatenate([t0, t0]),
-                           np.concatenate([tm - t0, t1 - t0]), dX, dXX)                # first half; whole step
-        return solver.step(fields, both[:n], tm, t1 - tm, a.dX[:, 1], a.dXX[:, 1]), both[n:]
+        both = solver.step(fields, Y2, T2, DT2, DX2, DXX2)                # first half; whole step
+        return solver.step(fields, both[:n], ts[:, 1:2], ts[:, 2:] - ts[:, 1:2], a.dX[:, 1], a.dXX[:, 1]), both[n:]
     y2 = solver.integrate(fields, y, a.times, a.dX, a.dXX, a.save, stop_on_failure=a.stop)[0]
-    return y2, solver.integrate(fields, y, a.times[..., [0, -1]], *a.whole, a.save[:1], stop_on_failure=False)[0]
+    return y2, solver.integrate(fields, y, a.times[..., [0, -1]], DX2[n:, None], DXX2[n:, None], a.save[:1],
+                                stop_on_failure=False)[0]
 
 
 class _Attempt:
-    """One call of the solver: flat ``members``, ``times``, ``dX``, ``dXX``, ``save`` mask, the ``whole`` step (or None)."""
+    """One call of the solver: flat ``members``, ``times``, ``dX``, ``dXX``, ``save`` mask, the step ``h`` if adaptive."""
 
-    def __init__(self, members, times, dX, dXX, save, whole=None, h=None):
-        self.members, self.times, self.dX, self.dXX, self.save, self.whole, self.h = \
-            members, times, dX, dXX, save, whole, h
+    def __init__(self, members, times, dX, dXX, save, h=None):
+        self.members, self.times, self.dX, self.dXX, self.save, self.h = members, times, dX, dXX, save, h
         self.stop = False
 
 
@@ -146,13 +136,17 @@ class _TreeSteps:
         self.saved = [(np.arange(n), np.full(n, t0), run.y[self.lane_members])] if keep0 else []
         self.n_saved = n if keep0 else 0                   # states saved so far, over all lanes
         self.y_new, self.err = np.empty_like(run.y), np.zeros(P)
+        self.bad, self.tried, self.unmet = (np.zeros(P, dtype=bool) for _ in range(3))
+        self.floor, self.act, self.done = np.zeros(n, dtype=bool), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+        self.cols, self.r = np.empty((n, 3 if control.adaptive else 2), dtype=np.int64), np.zeros(n)
+        self.t_at, self.h_at = np.zeros(n), np.zeros(n)              # every lane's attempt [t, t + h]
+        self.failing, self.held = np.zeros(P, dtype=bool), np.zeros(n, dtype=bool)
         self.progress_total, self.reached = (T, "solve (adaptive)", "time"), 0.0
 
     def propose(self):
         """The attempts of every lane not yet at ``t1``, lanes on the same interval together (``[]``: done)."""
         live = self.live = self.i < self.end
-        act = live.nonzero()[0]
-        if act.size == 0:
+        if not live.any():
             return []
         self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
         if self.iterations > self.control.max_steps and (self.accepted + self.rejected >= self.control.max_steps).any():
@@ -161,23 +155,12 @@ class _TreeSteps:
                              f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
-        every = act.size == self.lanes                    # no lane done: whole arrays, no gathers
-        L, cell, mc, paths = self.L, self.cell, self.min_cells, self.paths if every else self.paths[act]
-        i, h = (self.i, self.state["h"]) if every else (self.i[act], self.state["h"][act])
-        target = self.end if self.targets.size == 1 else self.targets[np.searchsorted(self.targets, i, side="right")]
-        depth = np.minimum(np.maximum(np.ceil(np.log2(self.span / h)).astype(np.int64) + self.fine, 0), L)
-        unit = np.left_shift(np.int64(1), L - depth)
-        j = np.rint((i + h / cell) / unit).astype(np.int64) * unit
-        j = np.maximum(np.maximum(j, i + mc), (i // unit + 1) * unit)
-        j = np.where(j > target - mc, target, j)              # at or near the target: the target
-        self.j[act], dj = j, j - i
-        hc = dj * cell
-        self.floor = np.zeros(self.lanes, dtype=bool)
-        self.floor[act] = (dj <= mc) | (hc <= self.dt_min * (1 + 1e-12))
-        self.bad, self.tried = np.zeros(self.run.members, dtype=bool), np.zeros(self.run.members, dtype=bool)
-        cols = np.empty((act.size, 3 if self.control.adaptive else 2), dtype=np.int64)      # the ends, in place
-        cols[:, 0], cols[:, -1], cols[:, 1:-1] = i, j, ((i + j) // 2)[:, None]
-        ts = cols * cell + self.t0                              # (lanes, 3) or (lanes, 2)
+        n = _snap_nb(self.i, self.state["h"], self.targets, self.end, self.L, self.fine, self.min_cells, self.t0,
+                     self.span, self.cell, self.dt_min, self.j, self.floor, self.act, self.cols, self.t_at, self.h_at)
+        act, i, j = self.act[:n], self.cols[:n, 0], self.cols[:n, -1]
+        paths, hc = self.paths[act], self.h_at[act]
+        self.bad[:], self.tried[:] = False, False
+        ts = self.cols[:n] * self.cell + self.t0                # (lanes, 3) or (lanes, 2)
         if self.shared:
             members, ts, h = self.lane_members[0], ts[0], float(hc[0])
             if members.size == 1:               # one member: walked as a path of its own, as per member
@@ -195,48 +178,34 @@ class _TreeSteps:
         return [self._attempt(members[k], ts[k[0]], W[k], XX[k], h[k[0]]) for k in groups]
 
     def _attempt(self, members, ts, W, XX, h):
-        whole = _whole_step(W, XX) if self.control.adaptive else None
-        return _Attempt(members, ts, W, XX, np.zeros(ts.shape[-1] - 1, dtype=bool), whole, h)
+        return _Attempt(members, ts, W, XX, np.zeros(ts.shape[-1] - 1, dtype=bool), h if self.control.adaptive else None)
 
     def judge(self, a, y_new, saved, first_bad, err):
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
-        self.y_new[a.members] = y_new
-        self.tried[a.members] = True
-        self.bad[a.members] = ~np.isfinite(y_new).all(axis=-1)
-        if err is not None:
-            self.err[a.members] = err
+        _judge_nb(a.members, y_new, self.err if err is None else err, err is not None, self.y_new, self.tried, self.bad,
+                  self.err)
 
     def adapt(self, attempts):
         """Fail the members that miss the tolerance at ``dt_min``, let the controller decide, advance the lanes."""
-        run, cell = self.run, self.cell
-        bad = self.bad & run.healthy
-        ok = self.tried & run.healthy & ~bad
-        r = None
-        if self.control.adaptive:
-            unmet = ok & ~(self.err <= 1.0) & self.floor[self.lane_of] if self.floor.any() else ok[:0]
-            if unmet.any():                         # the tolerance cannot be met at dt_min: fail, never crawl
-                np.add.at(self.at_min, self.lane_of[unmet], 1)
-                m = np.flatnonzero(unmet)
-                run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t0 + self.i[
-                    self.lane_of[m[0]]] * cell, (self.j - self.i)[self.lane_of[m[0]]] * cell, self.control))
-                ok &= ~unmet
-            r = np.where(ok, self.err, 0.0) if not self.shared else \
-                np.array([np.max(self.err[ok]) if ok.any() else 0.0])      # the batch's: NaN propagates, never accepted
-            r[bad if not self.shared else self.lane_of[bad]] = math.inf
-        t, h = self.t0 + self.i * cell, (self.j - self.i) * cell
-        accept = (np.asarray(self.control.adapt(self.state, t, h, r), dtype=bool) | self.floor) & self.live
-        self.rejected += self.live > accept                 # the live lanes not accepted
-        lanes = accept.nonzero()[0]
-        if lanes.size == 0:
-            return
-        members = ((accept if not self.shared else accept[self.lane_of]) & self.tried).nonzero()[0]
-        if bad.any() and bad[members].any():
-            m = members[bad[members]]
+        run, cell, r, adaptive = self.run, self.cell, self.r, self.control.adaptive
+        if _ratios_nb(self.err, self.tried, self.bad, run.healthy, self.lane_of, self.floor, adaptive, r, self.unmet):
+            m = np.flatnonzero(self.unmet)          # the tolerance cannot be met at dt_min: fail, never crawl
+            np.add.at(self.at_min, self.lane_of[m], 1)
+            run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t0 + self.i[
+                self.lane_of[m[0]]] * cell, (self.j - self.i)[self.lane_of[m[0]]] * cell, self.control))
+        accept = np.array(self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive else None),
+                          dtype=bool)
+        n, nbad = _advance_nb(accept, self.floor, self.live, self.tried, self.bad, run.healthy, self.lane_of,
+                              self.accepted, self.rejected, self.i, self.j, run.y, self.y_new, self.done, self.failing,
+                              self.held)
+        if nbad:                                  # non-finite on an accepted step: report it, then move its lanes
+            m = np.flatnonzero(self.failing)
             run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
-        run.y[members] = self.y_new[members] if run.healthy.all() else \
-            np.where(run.healthy[members][:, None], self.y_new[members], np.nan)
-        self.accepted += accept                            # the lanes that advance
-        np.copyto(self.i, self.j, where=accept)
+            self.accepted += self.held
+            np.copyto(self.i, self.j, where=self.held)
+        if n == 0:
+            return
+        lanes = self.done[:n].copy()             # kept in self.saved: not a view of the reused buffer
         at = self.i[lanes]
         if not self.save_all:
             keep = at == self.end if self.save_list.size == 1 and self.save_list[0] == self.end else \

@@ -224,7 +224,7 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
             while attempts := steps.propose():
                 for a in attempts:
                     y_start = run.y[a.members]
-                    if a.whole is None:
+                    if a.h is None:
                         y_new, saved, first_bad = solver.integrate(fields, y_start, a.times, a.dX, a.dXX, a.save,
                                                                    stop_on_failure=a.stop)
                         err = None

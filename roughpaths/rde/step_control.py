@@ -33,7 +33,10 @@ the failure policy, the saved states and the statistics.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from ..validation import check_positive_int, check_positive_real
 
@@ -211,15 +214,31 @@ class PIController(StepController):
         return np.sqrt(ms) * np.sqrt(span / h)
 
     def adapt(self, state, t, h, r):
-        accept = r <= 1.0
-        q = state["q"]
-        rr = np.maximum(np.where(np.isnan(r), np.inf, r), 1e-10)
-        f = self.safety * rr ** (-(self.icoeff + self.pcoeff) / q) * state["r_prev"] ** (self.pcoeff / q)
-        hi = np.where(accept & ~state["rejected"], self.factor_max, 1.0)
-        f = np.minimum(hi, np.maximum(self.factor_min, np.where(np.isfinite(rr), f, self.factor_min)))
-        state["r_prev"] = np.where(accept, rr, state["r_prev"])
-        state["rejected"] = ~accept
+        r, h = (np.ascontiguousarray(v, dtype=np.float64).reshape(-1) for v in (r, h))
+        accept = np.empty(r.size, dtype=bool)
         span = state["span"]
-        state["h"] = np.minimum(self.dt_max(span), np.maximum(self.dt_min(span), h * f))
+        _pi_adapt_nb(r, h, state["h"], state["r_prev"], state["rejected"], accept, state["q"], self.safety,
+                     self.icoeff, self.pcoeff, self.factor_min, self.factor_max, self.dt_min(span), self.dt_max(span))
         return accept
 
+
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
+def _pi_adapt_nb(r, h, h_next, r_prev, rejected, accept, q, safety, icoeff, pcoeff, factor_min, factor_max, dt_min,
+                 dt_max):
+    """:meth:`PIController.adapt` per lane: accept ``r <= 1``; the next step ``h · f`` (within ``[dt_min, dt_max]``)
+    with ``f = safety · r^(-(β_I + β_P)/q) · r_prev^(β_P/q)`` within ``[factor_min, factor_max]`` (``factor_max``
+    1 right after a rejection; ``factor_min`` for a NaN or infinite ratio); ``r`` is kept as ``r_prev`` if
+    accepted. Compiling: about 0.2 s (first adaptive solve, empty cache)."""
+    for k in range(r.size):
+        a = r[k] <= 1.0
+        rr = max(math.inf if r[k] != r[k] else r[k], 1e-10)
+        if rr == math.inf:
+            f = factor_min
+        else:
+            f = safety * rr ** (-(icoeff + pcoeff) / q) * r_prev[k] ** (pcoeff / q)
+            f = min(factor_max if a and not rejected[k] else 1.0, max(factor_min, f))
+        if a:
+            r_prev[k] = rr
+        rejected[k] = not a
+        h_next[k] = min(dt_max, max(dt_min, h[k] * f))
+        accept[k] = a

@@ -54,12 +54,16 @@ def test_the_whole_step_is_the_trees_answer_on_the_whole_interval():
     """The error estimate's one-step attempt sees the same path as its two halves: the Chen product of the
     halves' increments and areas equals the tree's own answer on the whole interval (a transposed or missing
     cross term X_1 ⊗ X_2, or a lost ½ in the areas, would not)."""
-    from roughpaths.rde.adaptive import _areas, _whole_step
+    from roughpaths.rde._attempts import _doubling_nb
 
     tree = rp.BrownianTree(3, seed=6, batch_shape=(4,))
     a, b = 0.15625, 0.40625
-    W, A = tree.increments_and_levy_areas([a, 0.5 * (a + b), b])
-    Ww, XXw = _whole_step(W, _areas(W, A))
+    ts = np.array([a, 0.5 * (a + b), b])
+    W, A = tree.increments_and_levy_areas(ts)
+    halves = (W, A + 0.5 * W[..., :, None] * W[..., None, :])        # Stratonovich areas of the halves
+    out = [np.empty(s) for s in ((8, 2), (8, 1), (8, 1), (8, 3), (8, 3, 3))]
+    _doubling_nb(np.zeros((4, 2)), np.tile(ts, (4, 1)), *halves, *out)
+    Ww, XXw = out[3][4:, None], out[4][4:, None]                      # rows n: are the whole steps
     W_ref, A_ref = tree.increments_and_levy_areas([a, b])
     XX_ref = A_ref + 0.5 * W_ref[..., :, None] * W_ref[..., None, :]          # Stratonovich: Lévy area + ½ W⊗W
     np.testing.assert_allclose(Ww, W_ref, rtol=0, atol=1e-14)
