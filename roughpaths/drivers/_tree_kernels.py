@@ -207,9 +207,14 @@ def _refine_segments_nb(w, G, delta, z, fine, GL, GR):
     NL = np.empty((d, d))
     NR = np.empty((d, d))
     N = np.empty((d, d))
-    L0 = np.zeros((d, d))
-    R0 = np.zeros((d, d))
-    Y = np.zeros((d, d))
+    L0 = np.empty((d, d))
+    R0 = np.empty((d, d))
+    Y = np.empty((d, d))
+    for a in range(d):            # zero diagonals (only the pairs a < b are written below); a loop, not np.zeros,
+        for b in range(d):        # whose 2-D overload numba compiles on its own (about 0.3 s)
+            L0[a, b] = 0.0
+            R0[a, b] = 0.0
+            Y[a, b] = 0.0
     C = np.empty((p, p))
     y = np.empty(p)
     o1, oa, ol = 2 * k, 2 * k + p, 4 * k + p

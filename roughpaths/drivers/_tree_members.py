@@ -189,6 +189,7 @@ def member_cells(tree, rows, times, tag):
         cache = tree._walk_cache = (np.repeat(slots[None], R, axis=0), np.empty((R, S * D, 2, nseg, d)),
                                     np.empty((R, S * D, 2, d, d)))
     t0, span, L = float(tree.t0), float(tree.t1 - tree.t0), tree.resolution
+    rows = np.ascontiguousarray(rows, dtype=np.int64)
     q = _walk_nb(tree._prefix, w, G, rows, tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64), t0, idx, L,
                  span, tag, split_width(w.shape[1], d), W, A, *cache)
     if q:
