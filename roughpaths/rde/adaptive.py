@@ -15,7 +15,9 @@ members and all take the same steps (``Solution.times`` then has one axis). The 
 the solver takes every member on its own times in one call (``Solver.member_times``, fields autonomous or
 ``batched_time``), shared otherwise. Per member, the tree answers all lanes in one compiled walk
 (:mod:`roughpaths.drivers._tree_members`); a solver without ``member_times`` is called once per group of
-lanes on the same interval.
+lanes on the same interval. The loop's own work per iteration (snapping the step ends, stacking step doubling's
+inputs, reducing error ratios over lanes, advancing the lanes) is compiled elementwise over lanes and members
+(:mod:`roughpaths.rde._attempts`), so it costs a few kernel calls, not some seventy numpy calls.
 
 The error estimate (step doubling)
 ----------------------------------

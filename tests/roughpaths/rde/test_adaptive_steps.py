@@ -144,6 +144,26 @@ def test_non_finite_members_are_reported_or_masked():
     assert np.all(np.isfinite(sol.final[[0, 2]])) and np.isnan(sol.final[1]).all()
 
 
+def test_a_member_non_finite_on_an_accepted_step_is_reported_at_that_step():
+    """Fixed steps on the tree accept every attempt, so a member that overflows is accepted non-finite: the error
+    names the member, its step and the step's times (those of the attempt, not of the next one); masked, its
+    states are NaN from that step on and the other members are what they are alone, bitwise."""
+    V = rp.VectorFields(lambda y: np.stack([y ** 3, 0.0 * y], axis=-1),
+                        lambda y: np.stack([3 * y ** 2, 0.0 * y], axis=-2)[..., None], dim_state=1, dim_noise=2)
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
+    y0 = np.array([[0.1], [40.0], [0.2]])
+    ctrl = rp.FixedSteps(1 / 64)
+    with pytest.raises(rp.NonFiniteStateError, match=r"step 3 \(t = 0\.0625, step from t = 0\.046875\) for batch "
+                                                     r"member \(1,\)"):
+        rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl)
+    sol = rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl, on_failure="mask")
+    assert sol.failed_step.tolist() == [-1, 3, -1] and sol.stats["accepted"].tolist() == [64, 64, 64]
+    assert np.isfinite(sol.states[1, :4]).all() and np.isnan(sol.states[1, 4:]).all()
+    for k in (0, 2):
+        alone = rp.solve(V, tree.select([k]), y0[k], rp.Davie(), step_control=ctrl)
+        np.testing.assert_array_equal(sol.states[k], alone.states[0])
+
+
 def test_bad_input_names_the_fix():
     V = rp.LinearVectorFields(M)
     tree = rp.BrownianTree(2, seed=0)
