@@ -177,23 +177,24 @@ def member_cells(tree, rows, times, tag):
     """``(W (Q, n, d), XX (Q, n, d, d))``, increments and Stratonovich areas: row ``q`` of ``tree`` (flat index
     ``rows[q]``) between its ``times[q]`` (``(Q, n + 1)``, strictly increasing on the tree's grid in ``[t0, t1]``,
     else a ``ValueError``; ``tag`` the tree's split stream tag). Needs the tree's seeded fast path (``tree._prefix``)."""
-    if tree._root_node is None:
-        tree._root_node = tree._root()
-    w, G = (np.ascontiguousarray(v) for v in tree._root_node)
-    Q, n, d = times.shape[0], times.shape[1] - 1, tree.dim
-    W, A, idx = np.empty((Q, n, d)), np.empty((Q, n, d, d)), np.empty((Q, n + 1), dtype=np.int64)
-    cache = tree.__dict__.get("_walk_cache")
-    if cache is None:            # the children of two nodes per depth and row (or one) if 64 MiB hold them
-        P, D, nseg = tree.n_paths, tree.resolution + 1, w.shape[1]
+    fixed = tree.__dict__.get("_walk_cache")
+    if fixed is None:            # the walk's fixed arguments, and the children of two nodes per depth and row (or one)
+        if tree._root_node is None:                                     # if 64 MiB hold them
+            tree._root_node = tree._root()
+        w, G = (np.ascontiguousarray(v) for v in tree._root_node)
+        P, D, nseg, d = tree.n_paths, tree.resolution + 1, w.shape[1], tree.dim
         fits = [S for S in (2, 1) if P * D * (S * (2 * nseg * d + 2 * d * d + 1) + 1) * 8.0 <= _WALK_CACHE_BYTES]
         S, R = (fits[0], P) if fits else (1, 0)
         slots = np.concatenate([np.full(S * D, -1), np.zeros(D)]).astype(np.int64)
-        cache = tree._walk_cache = (np.repeat(slots[None], R, axis=0), np.empty((R, S * D, 2, nseg, d)),
-                                    np.empty((R, S * D, 2, d, d)))
-    t0, span, L = float(tree.t0), float(tree.t1 - tree.t0), tree.resolution
+        fixed = tree._walk_cache = (w, G, float(tree.t0), tree.resolution, float(tree.t1 - tree.t0),
+                                    split_width(nseg, d), (np.repeat(slots[None], R, axis=0),
+                                                           np.empty((R, S * D, 2, nseg, d)), np.empty((R, S * D, 2, d, d))))
+    w, G, t0, L, span, width, cache = fixed
+    Q, n, d = times.shape[0], times.shape[1] - 1, w.shape[2]
+    W, A, idx = np.empty((Q, n, d)), np.empty((Q, n, d, d)), np.empty((Q, n + 1), dtype=np.int64)
     rows = np.ascontiguousarray(rows, dtype=np.int64)
     q = _walk_nb(tree._prefix, w, G, rows, tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64), t0, idx, L,
-                 span, tag, split_width(w.shape[1], d), W, A, *cache)
+                 span, tag, width, W, A, *cache)
     if q:
         raise ValueError(f"times must increase strictly in [t0, t1] = [{tree.t0}, {tree.t1}] on the tree's grid "
                          f"(t1 - t0)·2^-{L}, row by row; row {q - 1} is {np.asarray(times)[q - 1]!r}.")
