@@ -239,6 +239,9 @@ def warm_tree() -> None:
         tree = rp.BrownianTree(d, seed=0, batch_shape=(2,))
         tree.area(0.1, 0.3)
         tree.increments_and_areas([[0.1, 0.3], [0.2, 0.4]], [0, 1])      # the per-member walk (adaptive steps)
+    # the adaptive loop's compiled bookkeeping and PIController's kernel (steps per member)
+    rp.solve(rp.LinearVectorFields(np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])),
+             rp.BrownianTree(2, seed=0, batch_shape=(2,)), np.ones(2), rp.Davie(), step_control=rp.PIController(0.1, 0.1))
 
 
 def warm_coadjoint() -> None:
