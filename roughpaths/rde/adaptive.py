@@ -72,7 +72,7 @@ def _step_doubling(solver, fields, y, a):
     n, e, d = y.shape[0], y.shape[-1], a.dX.shape[-1]
     Y2, T2, DT2, DX2, DXX2 = np.empty((2 * n, e)), np.empty((2 * n, 1)), np.empty((2 * n, 1)), \
         np.empty((2 * n, d)), np.empty((2 * n, d, d))
-    ts = a.times if a.times.ndim == 2 else np.broadcast_to(a.times, (n, 3))
+    ts = a.times if a.times.ndim == 2 else np.tile(a.times, (n, 1))     # contiguous: one compiled layout
     _doubling_nb(y, ts, a.dX, a.dXX, Y2, T2, DT2, DX2, DXX2)
     if a.times.ndim == 2 and isinstance(a.dXX, np.ndarray):
         both = solver.step(fields, Y2, T2, DT2, DX2, DXX2)                # first half; whole step
@@ -184,6 +184,17 @@ class _TreeSteps:
 
     def judge(self, a, y_new, saved, first_bad, err):
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
+        y_new, m = np.ascontiguousarray(y_new, dtype=np.float64), a.members.size     # a user's solver or controller
+        if err is not None:                                                            # may return other types
+            err = np.ascontiguousarray(err, dtype=np.float64)
+            if err.shape != (m,):
+                if err.size != 1:
+                    raise ValueError(f"{type(self.control).__name__}.error_ratio returned {err.size} ratios for {m} "
+                                     f"member(s); it must return one per member, shape (members,).")
+                err = np.full(m, err.reshape(-1)[0])                             # one ratio for all, as numpy broadcasts
+        if y_new.shape != (m, self.run.e):
+            raise ValueError(f"the solver returned states of shape {y_new.shape} for {m} member(s) of dimension "
+                             f"{self.run.e}; a solver's step must return shape (members, e).")
         _judge_nb(a.members, y_new, self.err if err is None else err, err is not None, self.y_new, self.tried, self.bad,
                   self.err)
 

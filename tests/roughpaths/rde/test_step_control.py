@@ -103,3 +103,24 @@ def test_objects_outside_the_contract_are_refused_by_name():
         rp.FixedSteps(-1.0)
     with pytest.raises(ValueError, match="no grid"):
         next(tree.blocks())
+
+
+def test_a_controller_error_ratio_of_the_wrong_size_is_refused_by_name():
+    """The loop keeps one error ratio per member (compiled, no bounds checks): a user's ``error_ratio`` returning
+    another number of ratios is refused naming the controller; one ratio for all members is taken for each."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+
+    class TwoRatios(rp.PIController):
+        def error_ratio(self, y, y_new, y_err, h, span):
+            return np.zeros(2)
+
+    class OneRatio(rp.PIController):
+        def error_ratio(self, y, y_new, y_err, h, span):
+            return 0.5
+
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
+    with pytest.raises(ValueError, match=r"TwoRatios\.error_ratio returned 2 ratios for 3 member"):
+        rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=TwoRatios(1e-2, 1e-2))
+    sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=OneRatio(1e-2, 1e-2),
+                   save_at="end")
+    assert np.isfinite(sol.final).all() and (sol.stats["rejected"] == 0).all()
