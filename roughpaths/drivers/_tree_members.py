@@ -44,7 +44,7 @@ _WALK_CACHE_BYTES = 64 * 2 ** 20
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
-def _walk_nb(prefix, root_w, root_G, rows, keys, times, t0, idx, L, span, tag, width, W, A, cidx, cw, cG):
+def _walk_nb(prefix, root_w, root_G, rows, keys, times, t0, t1, idx, L, span, tag, width, W, A, cidx, cw, cG):
     """Row by row, the tree's depth-first walk for the cells ``idx[q]`` (see :func:`member_cells`). The children of
     the last ``S`` (2, or 1 for a tree too large for two) nodes split at each depth of each tree row are kept in
     ``cidx, cw, cG``: slots ``S depth .. S depth + S - 1`` of a row (``DS = S (L + 1)`` slots) hold a pair each,
@@ -58,7 +58,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, times, t0, idx, L, span, tag, w
 
     The cells' ends ``idx (Q, n + 1)`` are the grid indices of ``times`` (rounded to the nearest, at most ``2^L``),
     computed here. Returns 0, or ``q + 1`` for the first row ``q`` whose times are not strictly increasing on the
-    grid within ``[t0, t0 + span]`` (nothing walked then). ``A`` receives the Stratonovich areas, the Lévy area plus
+    grid within ``[t0, t1]`` (nothing walked then; ``t0 + span`` may round below ``t1``). ``A`` receives the Stratonovich areas, the Lévy area plus
     ``½ W ⊗ W``."""
     Q, n = idx.shape[0], idx.shape[1] - 1
     top_index = np.int64(1) << L
@@ -66,7 +66,7 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, times, t0, idx, L, span, tag, w
     for q in range(Q):
         for k in range(n + 1):
             v = times[q, k]
-            if not (v >= t0 and v <= t0 + span):
+            if not (v >= t0 and v <= t1):
                 return q + 1
             idx[q, k] = min(np.int64(np.rint((v - t0) / span * scale)), top_index)
             if k > 0 and idx[q, k] <= idx[q, k - 1]:
@@ -186,15 +186,15 @@ def member_cells(tree, rows, times, tag):
         fits = [S for S in (2, 1) if P * D * (S * (2 * nseg * d + 2 * d * d + 1) + 1) * 8.0 <= _WALK_CACHE_BYTES]
         S, R = (fits[0], P) if fits else (1, 0)
         slots = np.concatenate([np.full(S * D, -1), np.zeros(D)]).astype(np.int64)
-        fixed = tree._walk_cache = (w, G, float(tree.t0), tree.resolution, float(tree.t1 - tree.t0),
+        fixed = tree._walk_cache = (w, G, float(tree.t0), float(tree.t1), tree.resolution, float(tree.t1 - tree.t0),
                                     split_width(nseg, d), (np.repeat(slots[None], R, axis=0),
                                                            np.empty((R, S * D, 2, nseg, d)), np.empty((R, S * D, 2, d, d))))
-    w, G, t0, L, span, width, cache = fixed
+    w, G, t0, t1, L, span, width, cache = fixed
     Q, n, d = times.shape[0], times.shape[1] - 1, w.shape[2]
     W, A, idx = np.empty((Q, n, d)), np.empty((Q, n, d, d)), np.empty((Q, n + 1), dtype=np.int64)
     rows = np.ascontiguousarray(rows, dtype=np.int64)
-    q = _walk_nb(tree._prefix, w, G, rows, tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64), t0, idx, L,
-                 span, tag, width, W, A, *cache)
+    q = _walk_nb(tree._prefix, w, G, rows, tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64), t0, t1,
+                 idx, L, span, tag, width, W, A, *cache)
     if q:
         raise ValueError(f"times must increase strictly in [t0, t1] = [{tree.t0}, {tree.t1}] on the tree's grid "
                          f"(t1 - t0)·2^-{L}, row by row; row {q - 1} is {np.asarray(times)[q - 1]!r}.")

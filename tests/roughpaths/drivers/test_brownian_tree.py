@@ -208,3 +208,17 @@ def test_select_answers_bitwise_as_the_selected_members(dim):
         tree.select([6])
     with pytest.raises(TypeError, match="integer"):
         tree.select([0.5])
+
+
+def test_per_path_queries_reach_t1_where_t0_plus_the_span_rounds_below_it():
+    """On [1.35, 7.21], 1.35 + (7.21 - 1.35) rounds below 7.21: per-path times (the adaptive steps' walk) are
+    checked against [t0, t1] itself, so a query ending at t1 is answered (its increments add up to the whole
+    interval's) and one past t1 is still refused."""
+    t0, t1 = 1.35, 7.21
+    assert t0 + (t1 - t0) < t1
+    tree = rp.BrownianTree(2, seed=0, t0=t0, t1=t1, batch_shape=(2,))
+    W, _ = tree.increments_and_areas([[t0, 4.0, t1], [t0, 2.5, t1]], [0, 1])
+    whole, _ = tree.increments_and_levy_areas([t0, t1])
+    np.testing.assert_allclose(W.sum(axis=1), whole[:, 0], rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match=r"times must increase strictly in \[t0, t1\]"):
+        tree.increments_and_areas([[t0, 4.0, np.nextafter(t1, np.inf)], [t0, 2.5, t1]], [0, 1])
