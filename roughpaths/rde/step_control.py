@@ -215,6 +215,9 @@ class PIController(StepController):
 
     def adapt(self, state, t, h, r):
         r, h = (np.ascontiguousarray(v, dtype=np.float64).reshape(-1) for v in (r, h))
+        if not r.size == h.size == state["h"].size:          # the kernel writes the state in place, unchecked
+            raise ValueError(f"adapt needs one step h and one error ratio r per lane of the state ({state['h'].size}), "
+                             f"got {h.size} and {r.size}; pass arrays of shape (lanes,) as init(t0, t1, lanes, ...) made.")
         accept = np.empty(r.size, dtype=bool)
         span = state["span"]
         _pi_adapt_nb(r, h, state["h"], state["r_prev"], state["rejected"], accept, state["q"], self.safety,

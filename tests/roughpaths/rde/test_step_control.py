@@ -124,3 +124,15 @@ def test_a_controller_error_ratio_of_the_wrong_size_is_refused_by_name():
     sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=OneRatio(1e-2, 1e-2),
                    save_at="end")
     assert np.isfinite(sol.final).all() and (sol.stats["rejected"] == 0).all()
+
+
+def test_pi_adapt_refuses_arrays_that_do_not_match_its_state():
+    """``PIController.adapt`` updates the state's arrays in place (compiled): a step or ratio array of another
+    length than the state's lanes is refused, naming both sizes, instead of writing past the state."""
+    ctl = rp.PIController(1e-2, 1e-2)
+    state = ctl.init(0.0, 1.0, 3, 1.0)
+    with pytest.raises(ValueError, match=r"one error ratio r per lane of the state \(3\), got 3 and 5"):
+        ctl.adapt(state, np.zeros(3), np.full(3, 0.1), np.ones(5))
+    accept = ctl.adapt(state, np.zeros(3), np.full(3, 0.1), np.array([0.5, 2.0, np.nan]))
+    assert accept.tolist() == [True, False, False]
+    assert state["h"][0] > 0.1 and state["h"][1] < 0.1 and state["h"][2] == 0.1 * ctl.factor_min
