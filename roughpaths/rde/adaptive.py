@@ -82,6 +82,18 @@ def _step_doubling(solver, fields, y, a):
                                 stop_on_failure=False)[0]
 
 
+def _one_each(value, n, dtype, what):
+    """``value`` as a contiguous ``(n,)`` array of ``dtype`` for the compiled bookkeeping (no bounds checks there):
+    one entry for all is repeated, as numpy broadcast it; another count is refused, naming ``what``."""
+    v = np.asarray(value, dtype=dtype)
+    if v.shape == (n,) and v.flags.c_contiguous:
+        return v
+    if v.size != 1:
+        raise ValueError(f"{what} has {v.size} entries for {n} lane(s) or member(s); give one each, shape ({n},), "
+                         f"or one for all.")
+    return np.full(n, v.reshape(-1)[0], dtype=dtype)
+
+
 class _Attempt:
     """One call of the solver: flat ``members``, ``times``, ``dX``, ``dXX``, ``save`` mask, the step ``h`` if adaptive."""
 
@@ -157,7 +169,9 @@ class _TreeSteps:
                              f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
-        n = _snap_nb(self.i, self.state["h"], self.targets, self.end, self.L, self.fine, self.min_cells, self.t0,
+        h = self.state["h"] = _one_each(self.state["h"], self.lanes, np.float64,
+                                        f'the step control\'s state["h"] ({type(self.control).__name__})')
+        n = _snap_nb(self.i, h, self.targets, self.end, self.L, self.fine, self.min_cells, self.t0,
                      self.span, self.cell, self.dt_min, self.j, self.floor, self.act, self.cols, self.t_at, self.h_at)
         act, i, j = self.act[:n], self.cols[:n, 0], self.cols[:n, -1]
         paths, hc = self.paths[act], self.h_at[act]
@@ -186,12 +200,7 @@ class _TreeSteps:
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
         y_new, m = np.ascontiguousarray(y_new, dtype=np.float64), a.members.size     # a user's solver or controller
         if err is not None:                                                            # may return other types
-            err = np.ascontiguousarray(err, dtype=np.float64)
-            if err.shape != (m,):
-                if err.size != 1:
-                    raise ValueError(f"{type(self.control).__name__}.error_ratio returned {err.size} ratios for {m} "
-                                     f"member(s); it must return one per member, shape (members,).")
-                err = np.full(m, err.reshape(-1)[0])                             # one ratio for all, as numpy broadcasts
+            err = _one_each(err, m, np.float64, f"{type(self.control).__name__}.error_ratio's result")
         if y_new.shape != (m, self.run.e):
             raise ValueError(f"the solver returned states of shape {y_new.shape} for {m} member(s) of dimension "
                              f"{self.run.e}; a solver's step must return shape (members, e).")
@@ -204,10 +213,12 @@ class _TreeSteps:
         if _ratios_nb(self.err, self.tried, self.bad, run.healthy, self.lane_of, self.floor, adaptive, r, self.unmet):
             m = np.flatnonzero(self.unmet)          # the tolerance cannot be met at dt_min: fail, never crawl
             np.add.at(self.at_min, self.lane_of[m], 1)
-            run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t0 + self.i[
-                self.lane_of[m[0]]] * cell, (self.j - self.i)[self.lane_of[m[0]]] * cell, self.control))
-        accept = np.array(self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive else None),
-                          dtype=bool)
+            k = self.lane_of[m[0]]
+            run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t_at[k], self.h_at[k],
+                                                                self.control))
+        accept = _one_each(self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive
+                                              else None), self.lanes, bool, f"{type(self.control).__name__}.adapt's result")
+        accept = accept.copy()                      # written in place below; the controller may keep what it returned
         n, nbad = _advance_nb(accept, self.floor, self.live, self.tried, self.bad, run.healthy, self.lane_of,
                               self.accepted, self.rejected, self.i, self.j, run.y, self.y_new, self.done, self.failing,
                               self.held)

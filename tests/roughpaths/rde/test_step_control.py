@@ -119,7 +119,7 @@ def test_a_controller_error_ratio_of_the_wrong_size_is_refused_by_name():
             return 0.5
 
     tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
-    with pytest.raises(ValueError, match=r"TwoRatios\.error_ratio returned 2 ratios for 3 member"):
+    with pytest.raises(ValueError, match=r"TwoRatios\.error_ratio's result has 2 entries for 3 lane\(s\) or member"):
         rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=TwoRatios(1e-2, 1e-2))
     sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=OneRatio(1e-2, 1e-2),
                    save_at="end")
@@ -136,3 +136,29 @@ def test_pi_adapt_refuses_arrays_that_do_not_match_its_state():
     accept = ctl.adapt(state, np.zeros(3), np.full(3, 0.1), np.array([0.5, 2.0, np.nan]))
     assert accept.tolist() == [True, False, False]
     assert state["h"][0] > 0.1 and state["h"][1] < 0.1 and state["h"][2] == 0.1 * ctl.factor_min
+
+
+def test_a_user_controller_may_answer_with_one_step_and_one_verdict_for_all_lanes():
+    """A controller whose state holds one step (a float) and whose ``adapt`` returns one ``True`` for all lanes plugs in
+    as numpy broadcasting took it (the compiled bookkeeping gets them repeated per lane); a state step of another
+    count than the lanes is refused naming the controller."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+
+    class Eighths(rp.StepController):
+        def init(self, t0, t1, lanes, error_order):
+            return {"h": 0.125}
+
+        def adapt(self, state, t, h, r):
+            return True
+
+    class FiveSteps(Eighths):
+        def init(self, t0, t1, lanes, error_order):
+            return {"h": np.full(lanes + 2, 0.125)}
+
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
+    sol = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=Eighths())
+    assert sol.stats["accepted"].tolist() == [8, 8, 8] and (sol.times == np.arange(9) / 8).all()
+    fixed = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=rp.FixedSteps(0.125))
+    np.testing.assert_array_equal(sol.states, fixed.states)
+    with pytest.raises(ValueError, match=r'state\["h"\] \(FiveSteps\) has 5 entries for 3 lane'):
+        rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=FiveSteps())
