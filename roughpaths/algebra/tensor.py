@@ -149,7 +149,7 @@ def _mul(A: list, B: list, a0: float, b0: float, depth: int) -> list:
         if b0:
             c += b0 * A[k - 1]
         for i in range(1, k):
-            c += (A[i - 1][..., :, None] * B[k - i - 1][..., None, :]).reshape(batch + (-1,))
+            c += (A[i - 1][..., :, None] * B[k - i - 1][..., None, :]).reshape(c.shape)   # not -1: batch may be empty
         out.append(c)
     return out
 
@@ -334,7 +334,8 @@ def lyndon_coordinates(z, dim: int) -> np.ndarray:
     """
     z, dim, depth = _check_element(z, "z", dim)
     flat = np.ascontiguousarray(z.reshape(-1, z.shape[-1]))
-    return lyndon_flat(flat, dim, depth).reshape(z.shape[:-1] + (-1,))
+    out = lyndon_flat(flat, dim, depth)
+    return out.reshape(z.shape[:-1] + out.shape[-1:])          # not -1: an empty batch has no size to infer
 
 
 def from_lyndon_coordinates(c, dim: int, depth: int) -> np.ndarray:
@@ -359,4 +360,4 @@ def from_lyndon_coordinates(c, dim: int, depth: int) -> np.ndarray:
         e = expansion_matrix(dim, k)                       # sparse (n_k, dim**k)
         out.append(np.asarray((e.T @ flat[:, start:start + e.shape[0]].T).T))
         start += e.shape[0]
-    return np.concatenate(out, axis=-1).reshape(c.shape[:-1] + (-1,))
+    return np.concatenate(out, axis=-1).reshape(c.shape[:-1] + (sigdim(dim, depth),))   # not -1: batch may be empty

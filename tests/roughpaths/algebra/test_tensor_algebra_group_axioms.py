@@ -175,3 +175,15 @@ def test_level2_roundtrip_and_bad_input():
         tensor_log(np.full(6, np.nan), 2)
     with pytest.raises(TypeError, match="dim"):
         tensor_exp(np.zeros(6), 2.0)
+
+
+@pytest.mark.parametrize("batch", [(0,), (3, 0)])
+def test_group_operations_on_an_empty_batch_axis(batch):
+    """An empty batch axis gives an empty result of the same batch shape (reshapes to ``-1`` could not
+    infer the size of an empty array and raised)."""
+    d, m = 2, 3
+    z = np.zeros(batch + (sigdim(d, m),))
+    for got in (tensor_product(z, z, d), tensor_inverse(z, d), tensor_exp(z, d), tensor_log(z, d)):
+        assert got.shape == batch + (14,)
+    assert lyndon_coordinates(z, d).shape == batch + (5,)                # 2 + 1 + 2 Lyndon words
+    assert from_lyndon_coordinates(np.zeros(batch + (5,)), d, m).shape == batch + (14,)

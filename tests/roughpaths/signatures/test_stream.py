@@ -179,3 +179,19 @@ def test_stream_refuses_bad_queries(rng, call, exc, word):
 def test_constructors_refuse_bad_input(call, exc, word):
     with pytest.raises(exc, match=word):
         call()
+
+
+@pytest.mark.parametrize("batch", [(0,), (2, 0)])
+@pytest.mark.parametrize("length, expanding, log", [(3, False, False), (3, False, True), (3, True, False),
+                                                    (70, False, False), (70, True, True)])
+def test_an_empty_batch_axis_gives_empty_answers(batch, length, expanding, log):
+    """An empty batch axis is a batch of no paths: empty answers of the documented shape (the tensor
+    algebra's products reshaped to ``-1``, which numpy cannot infer on size 0, raised instead)."""
+    n, d, depth = 100, 2, 3
+    W = (n - 1 - length) + 1
+    width = (2 + 1 + 2) if log else (2 + 4 + 8)                 # logsigdim(2, 3), sigdim(2, 3)
+    got = rp.windowed_signature(np.zeros(batch + (n, d)), depth, length, expanding=expanding, log=log)
+    assert got.shape == batch + (W, width)
+    stream = rp.SignatureStream(np.zeros(batch + (n, d)), depth, block=8)
+    assert stream.signature([0, 5, 7], [99, 50, 7]).shape == batch + (3, 14)
+    assert stream.logsignature(3, 40).shape == batch + (5,)
