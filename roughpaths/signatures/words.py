@@ -138,9 +138,12 @@ def signature_coefficients(paths, words) -> np.ndarray:
     n_words = letters.shape[0]
     check_memory(n_paths * n_words * 8.0, f"the coefficients ({batch} paths x {n_words} words)",
                  "ask for fewer words or paths at a time")
-    check_work(n_paths * float(n) * float(lengths.sum()),
-               f"the coefficients of {n_words} words (total length {int(lengths.sum())}) along {n} points",
-               "ask for fewer or shorter words, or fewer points")
+    # a word of length k costs k (k + 1) / 2 multiply-adds a step (the Horner recursion), not k: counting
+    # the total length let one long word (k = 10^4 on 10^5 points) pass as 10^9 units and run for hours
+    steps_cost = float(np.sum(lengths * (lengths + 1) / 2.0))
+    check_work(n_paths * float(n) * steps_cost,
+               f"the coefficients of {n_words} words (total length {int(lengths.sum())}, {steps_cost:.3g} "
+               f"multiply-adds a step) along {n} points", "ask for fewer or shorter words, or fewer points")
     flat = np.ascontiguousarray(x.reshape(-1, n, d))
     out = np.zeros((flat.shape[0], n_words))
     rows = flat.shape[0] * n_words

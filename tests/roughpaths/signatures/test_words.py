@@ -76,3 +76,15 @@ def test_bad_paths_are_refused():
         rp.signature_coefficients(np.ones(3), [(0,)])
     with pytest.raises(ValueError, match="overflow"):
         rp.signature_coefficients(np.array([[0.0], [1e200]]), [(0, 0)])
+
+
+def test_the_work_estimate_counts_the_quadratic_cost_of_a_long_word(monkeypatch):
+    """A word of length k costs k (k + 1) / 2 multiply-adds a step (the module docstring's
+    O(n Σ|w|²)); the estimate counted k, so one long word passed the work budget by a factor k / 2."""
+    x = np.zeros((2, 1000, 2))
+    word = [(0, 1) * 100]                       # k = 200: 20100 multiply-adds a step
+    monkeypatch.setenv("ROUGHPATHS_MAX_WORK", str(2 * 1000 * 200 * 10))   # 10 times the old count
+    with pytest.raises(ValueError, match="work budget"):
+        rp.signature_coefficients(x, word)
+    monkeypatch.setenv("ROUGHPATHS_MAX_WORK", str(2 * 1000 * 20100))      # exactly the cost: allowed
+    assert np.array_equal(rp.signature_coefficients(x, word), np.zeros((2, 1)))
