@@ -321,7 +321,13 @@ def time_augment(paths, times=None):
     """
     x = _paths_array(paths)
     n = x.shape[-2]
-    t = jnp.arange(n, dtype=x.dtype) / max(n - 1, 1) if times is None else _as_jax(times, "times").astype(x.dtype)
+    if times is None:
+        # the grid is a constant: divided in numpy (float64, then rounded to the paths' dtype, which is the
+        # correctly rounded k / (n - 1) in float32 too), not in XLA, which turns the division by a constant
+        # into a product with its reciprocal and gave other times than numpy and torch (n = 7: t_2 differed)
+        t = jnp.asarray((np.arange(n) / max(n - 1, 1)).astype(x.dtype))
+    else:
+        t = _as_jax(times, "times").astype(x.dtype)
     if t.ndim < 1 or t.shape[-1] != n:
         raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {t.shape}.")
     return jnp.concatenate([jnp.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)

@@ -250,3 +250,28 @@ def test_torch_time_augment_times_and_a_signature_through_it(rng):
     dx = np.diff(x[0, :, 0])
     want = np.concatenate([[-dx[0]], dx[:-1] - dx[1:], [dx[-1]]])
     np.testing.assert_allclose(p.grad.numpy()[:, 0], want, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [7, 10, 49, 1001])
+def test_jax_default_times_are_the_correctly_rounded_quotients(n):
+    """The default time channel is ``k / (n - 1)`` rounded once, as the numpy and torch versions give it
+    (the docstring's promise): XLA rewrote the division by the constant ``n - 1`` as a product with its
+    reciprocal, which moved some times by one unit in the last place (n = 7: t_2)."""
+    jax = pytest.importorskip("jax")
+    import jax.numpy as jnp
+
+    import roughpaths.jax as rpj
+
+    want = np.array([k / (n - 1) for k in range(n)])          # Python's division is correctly rounded
+    got32 = np.asarray(rpj.time_augment(jnp.zeros((n, 1), dtype=jnp.float32)))[:, 0]
+    np.testing.assert_array_equal(got32, want.astype(np.float32))
+    np.testing.assert_array_equal(np.asarray(jax.jit(rpj.time_augment)(jnp.zeros((n, 1), dtype=jnp.float32)))[:, 0],
+                                  want.astype(np.float32))
+    old = jax.config.read("jax_enable_x64")
+    jax.config.update("jax_enable_x64", True)
+    try:
+        got64 = np.asarray(rpj.time_augment(jnp.zeros((n, 1), dtype=jnp.float64)))[:, 0]
+    finally:
+        jax.config.update("jax_enable_x64", old)
+    np.testing.assert_array_equal(got64, want)
+    np.testing.assert_array_equal(got64, rp.time_augment(np.zeros((n, 1)))[:, 0])
