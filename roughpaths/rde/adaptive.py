@@ -171,6 +171,13 @@ class _TreeSteps:
                              f"or raise the controller's max_steps.")
         h = self.state["h"] = _one_each(self.state["h"], self.lanes, np.float64,
                                         f'the step control\'s state["h"] ({type(self.control).__name__})')
+        bad = live & ~((h > 0) & (h < math.inf))    # the snapping kernel takes log2(span / h): NaN, 0 or < 0 there
+        if bad.any():                               # gave one step to t1 or a division by zero, never an error
+            k = int(np.argmax(bad))
+            raise ValueError(f'the step control\'s state["h"] ({type(self.control).__name__}) holds the step {h[k]!r} '
+                             f"for lane {k} at t = {self.t0 + int(self.i[k]) * self.cell:.6g}; a step must be a finite "
+                             f"number > 0 (t1 - t0 = {self.span!r} for one step to the end): fix the controller's init "
+                             f"or adapt.")
         n = _snap_nb(self.i, h, self.targets, self.end, self.L, self.fine, self.min_cells, self.t0,
                      self.span, self.cell, self.dt_min, self.j, self.floor, self.act, self.cols, self.t_at, self.h_at)
         act, i, j = self.act[:n], self.cols[:n, 0], self.cols[:n, -1]

@@ -162,3 +162,26 @@ def test_a_user_controller_may_answer_with_one_step_and_one_verdict_for_all_lane
     np.testing.assert_array_equal(sol.states, fixed.states)
     with pytest.raises(ValueError, match=r'state\["h"\] \(FiveSteps\) has 5 entries for 3 lane'):
         rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=FiveSteps())
+
+
+@pytest.mark.parametrize("step", [0.0, -0.125, np.nan, np.inf])
+@pytest.mark.parametrize("when", ["init", "adapt"])
+def test_a_step_that_is_not_a_positive_finite_number_is_refused_by_name(step, when):
+    """A controller's ``state["h"]`` must hold finite steps > 0 (contract item 2 and 4): a step of 0 divided by
+    zero, and a negative, NaN or infinite step passed through the snapping as one step straight to t1
+    (``accepted == 1``, a silent answer on a step the controller never proposed)."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+
+    class Broken(rp.StepController):
+        def init(self, t0, t1, lanes, error_order):
+            return {"h": np.full(lanes, step if when == "init" else 0.125)}
+
+        def adapt(self, state, t, h, r):
+            state["h"] = np.where(t + h >= 0.5, step, 0.125)      # goes wrong from t = 1/2 on
+            return np.ones(np.shape(h), dtype=bool)
+
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
+    for shared in (False, True):
+        with pytest.raises(ValueError, match=r'state\["h"\] \(Broken\) holds the step .* finite number > 0'):
+            rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=Broken(),
+                     shared_steps=shared, save_at="end")
