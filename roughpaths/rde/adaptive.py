@@ -53,6 +53,7 @@ tree itself (see :mod:`roughpaths.drivers.tree`); the error estimate (of the rig
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -139,7 +140,12 @@ class _TreeSteps:
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
         order = solver.error_order if solver.error_order is not None else solver.order
         self.state = control.init(t0, t1, n, order)
-        self.dt_min = control.dt_min(T)
+        self.dt_min = dt_min = control.dt_min(T)
+        if isinstance(dt_min, (bool, np.bool_)) or not isinstance(dt_min, (numbers.Real, np.floating, np.integer)) \
+                or not 0 <= dt_min < math.inf:         # the cell count below is ceil(dt_min / cell)
+            raise ValueError(f"{type(control).__name__}.dt_min({T!r}) returned {dt_min!r}; the smallest step must be a "
+                             f"finite number >= 0 (contract item 5; StepController's default is span * 2**-30).")
+        self.dt_min = float(dt_min)
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
         self.i, self.j, self.iterations = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), 0
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))

@@ -14,6 +14,7 @@ results are returned unchanged.
 
 from __future__ import annotations
 
+import numbers
 import time as _time
 
 import numpy as np
@@ -260,6 +261,11 @@ def _check_control(control, driver, solver):
         raise ValueError(f"step_control needs a driver that answers on any interval, a roughpaths.BrownianTree; "
                          f"got a {type(driver).__name__}, whose grid is fixed. Build BrownianTree(dim, seed=...) "
                          f"or drop step_control.")
+    name = type(control).__name__
+    if isinstance(control.max_steps, (bool, np.bool_)) or not isinstance(control.max_steps, numbers.Integral) \
+            or control.max_steps < 1:
+        raise ValueError(f"{name}.max_steps must be an integer >= 1 (the most attempts of a lane, contract item 5), "
+                         f"got {control.max_steps!r}; e.g. max_steps = 100_000 (StepController's default).")
     q = solver.error_order if solver.error_order is not None else solver.order
     if control.adaptive and (solver.error_estimate != "step_doubling" or not q > 0):
         raise ValueError(f"adaptive steps need the solver's declared error estimate (Solver.error_estimate, step "

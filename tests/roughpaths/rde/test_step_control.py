@@ -185,3 +185,31 @@ def test_a_step_that_is_not_a_positive_finite_number_is_refused_by_name(step, wh
         with pytest.raises(ValueError, match=r'state\["h"\] \(Broken\) holds the step .* finite number > 0'):
             rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=Broken(),
                      shared_steps=shared, save_at="end")
+
+
+@pytest.mark.parametrize("attr, value", [("dt_min", np.nan), ("dt_min", np.inf), ("dt_min", -1.0), ("dt_min", "0.1"),
+                                         ("max_steps", None), ("max_steps", 2.5), ("max_steps", 0), ("max_steps", -1)])
+def test_a_controllers_dt_min_and_max_steps_outside_the_contract_are_refused_by_name(attr, value):
+    """Contract item 5: ``dt_min(span)`` a finite step >= 0, ``max_steps`` an integer >= 1. A NaN or infinite
+    dt_min raised numpy's 'cannot convert float NaN to integer'; max_steps=None a bare TypeError, and 0, -1 or
+    2.5 stopped the solve with 'took 0 attempts' (or 2.5) instead of naming the bad value."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+
+    class Odd(rp.StepController):
+        max_steps = value if attr == "max_steps" else 100
+
+        def init(self, t0, t1, lanes, error_order):
+            return {"h": np.full(lanes, 0.125)}
+
+        def adapt(self, state, t, h, r):
+            return np.ones(np.shape(h), dtype=bool)
+
+        def dt_min(self, span):
+            return value if attr == "dt_min" else 0.0
+
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(3,))
+    with pytest.raises(ValueError, match=rf"Odd\.{attr}.*{attr}|Odd\.{attr}.*contract item 5"):
+        rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=Odd(), save_at="end")
+    ok = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=rp.FixedSteps(0.125),
+                  save_at="end")                           # the same schedule within the contract runs
+    assert ok.stats["accepted"].tolist() == [8, 8, 8]
