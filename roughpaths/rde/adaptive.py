@@ -155,6 +155,11 @@ class _TreeSteps:
         # the saved states, a row per iteration: (lanes, their times, their members' states (lanes, members, e))
         self.saved = [(np.arange(n), np.full(n, t0), run.y[self.lane_members])] if keep0 else []
         self.n_saved = n if keep0 else 0                   # states saved so far, over all lanes
+        if P == 0:         # no member to step (an empty batch axis): done at once, at the times asked (all: t0, t1)
+            self.i[:] = end
+            pts = np.array(sorted(self.save_idx | ({0, end} if self.save_all else set())), dtype=np.int64)
+            self.saved = [(np.zeros(pts.size, dtype=np.int64), np.where(pts < end, t0 + pts * cell, t1),
+                           np.empty((pts.size, 0, run.e)))]
         self.y_new, self.err = np.empty_like(run.y), np.zeros(P)
         self.bad, self.tried, self.unmet = (np.zeros(P, dtype=bool) for _ in range(3))
         self.floor, self.act, self.done = np.zeros(n, dtype=bool), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)

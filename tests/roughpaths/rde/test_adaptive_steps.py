@@ -222,3 +222,23 @@ def test_a_member_that_misses_the_tolerance_at_dt_min_is_masked_alone():
     sol = rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl, save_at="end", on_failure="mask")
     assert sol.failed.tolist() == [False, True, False] and sol.stats["at_dt_min"].tolist() == [0, 1, 0]
     assert np.all(np.isfinite(sol.final[[0, 2]])) and np.isnan(sol.final[1]).all()
+
+
+@pytest.mark.parametrize("batch", [(0,), (2, 0)])
+@pytest.mark.parametrize("shared", [None, True, False])
+@pytest.mark.parametrize("control", [rp.PIController(1e-2, 1e-2), rp.FixedSteps(0.125)])
+def test_an_empty_batch_axis_solves_to_empty_states(batch, shared, control):
+    """A tree (or y0) with an empty batch axis is a batch of no members: empty states at the times asked, as the
+    grid solve of the same tree gives them (the first attempt indexed the missing member: IndexError)."""
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=0, batch_shape=batch, t0=1.0, t1=3.0)
+    for save_at, times in (("end", [3.0]), ([1.5, 2.0, 3.0], [1.5, 2.0, 3.0]), ("all", [1.0, 3.0])):
+        sol = rp.solve(V, tree, np.ones(3), rp.Davie(), step_control=control, shared_steps=shared, save_at=save_at)
+        grid = rp.solve(V, tree.rough_path(np.array(times if len(times) > 1 else [1.0, 3.0])), np.ones(3), rp.Davie(),
+                        save_at=save_at if save_at != "all" else "all")
+        assert sol.times.tolist() == times and grid.states.shape[-2] == len(times)
+        assert sol.states.shape == grid.states.shape == batch + (len(times), 3)
+        assert sol.failed_step.shape == batch
+    sol = rp.solve(V, rp.BrownianTree(2, seed=0), np.ones(batch + (3,)), rp.Davie(), step_control=control,
+                   save_at="end")                                   # the empty axis from y0
+    assert sol.states.shape == batch + (1, 3) and sol.times.tolist() == [1.0]
