@@ -189,6 +189,15 @@ class _TreeSteps:
                              f"for lane {k} at t = {self.t0 + int(self.i[k]) * self.cell:.6g}; a step must be a finite "
                              f"number > 0 (t1 - t0 = {self.span!r} for one step to the end): fix the controller's init "
                              f"or adapt.")
+        if not self.control.adaptive and (live & (h < 8 * self.cell)).any():
+            # a schedule's step must survive the snapping to the tree's grid (spacing at most h/8, a change of at most
+            # 1/16): on a coarse tree (small resolution) a shorter step was silently rounded, up to 2 cells at least
+            k = int(np.argmax(live & (h < 8 * self.cell)))
+            need = min(62, self.L + max(1, math.ceil(math.log2(8 * self.cell / h[k]))))
+            raise ValueError(f"{type(self.control).__name__} proposes the step {h[k]!r} (lane {k}), shorter than 8 cells of "
+                             f"the tree's grid ((t1 - t0)·2^-{self.L} = {self.cell:.3g}), whose step ends it would move "
+                             f"by more than 1/16 of the step (to 2 cells at least); build the BrownianTree with "
+                             f"resolution={need} or more, or take steps of at least {8 * self.cell:.3g}.")
         n = _snap_nb(self.i, h, self.targets, self.end, self.L, self.fine, self.min_cells, self.t0,
                      self.span, self.cell, self.dt_min, self.j, self.floor, self.act, self.cols, self.t_at, self.h_at)
         act, i, j = self.act[:n], self.cols[:n, 0], self.cols[:n, -1]

@@ -213,3 +213,19 @@ def test_a_controllers_dt_min_and_max_steps_outside_the_contract_are_refused_by_
     ok = rp.solve(rp.LinearVectorFields(M), tree, np.ones(2), rp.Davie(), step_control=rp.FixedSteps(0.125),
                   save_at="end")                           # the same schedule within the contract runs
     assert ok.stats["accepted"].tolist() == [8, 8, 8]
+
+
+def test_fixed_steps_finer_than_a_coarse_trees_grid_are_refused_not_rounded():
+    """FixedSteps(dt) on a tree of resolution L steps ``dt`` (docs: step ends move by at most 1/16); on a coarse
+    tree (L = 4, cells of 1/16) dt = 0.1 came out as steps of 0.125 and dt = 0.05 as steps of 2 cells, silently.
+    Such steps are refused naming the resolution that resolves them; that resolution then gives steps of dt."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+    V = rp.LinearVectorFields(M)
+    for dt in (0.1, 0.05):
+        with pytest.raises(ValueError, match=r"shorter than 8 cells.*resolution=\d+"):
+            rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,), resolution=4), np.ones(2), rp.Davie(),
+                     step_control=rp.FixedSteps(dt))
+    sol = rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,), resolution=8), np.ones(2), rp.Davie(),
+                   step_control=rp.FixedSteps(0.1), shared_steps=True)
+    h = np.diff(sol.times)
+    assert sol.times[-1] == 1.0 and np.all(np.abs(h[:-1] - 0.1) <= 0.1 / 16) and h.size == 10
