@@ -242,7 +242,7 @@ class _TreeSteps:
             np.add.at(self.at_min, self.lane_of[m], 1)
             k = self.lane_of[m[0]]
             run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t_at[k], self.h_at[k],
-                                                                self.control))
+                                                                self.control, self.dt_min, self.L))
         accept = _one_each(self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive
                                               else None), self.lanes, bool, f"{type(self.control).__name__}.adapt's result")
         accept = accept.copy()                      # written in place below; the controller may keep what it returned

@@ -229,3 +229,19 @@ def test_fixed_steps_finer_than_a_coarse_trees_grid_are_refused_not_rounded():
                    step_control=rp.FixedSteps(0.1), shared_steps=True)
     h = np.diff(sol.times)
     assert sol.times[-1] == 1.0 and np.all(np.abs(h[:-1] - 0.1) <= 0.1 / 16) and h.size == 10
+
+
+def test_an_unmet_tolerance_on_a_coarse_tree_names_the_resolution_not_dt_min():
+    """On a coarse tree the shortest step is 2 cells of its grid, far above dt_min; the failure said 'at
+    dt_min = 0.0312' (the step, not dt_min) and advised lowering dt_min, which changes nothing. It now names the
+    tree's resolution; with the default resolution the message still points at dt_min."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+    V = rp.LinearVectorFields(M)
+    control = rp.PIController(1e-4, 1e-4)
+    with pytest.raises(ValueError, match=r"2 cells of \(t1 - t0\)·2\^-6.*higher resolution \(now 6") as info:
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,), resolution=6), np.ones(2), rp.Davie(),
+                 step_control=control)
+    assert "lower dt_min" not in str(info.value)
+    with pytest.raises(ValueError, match=r"at dt_min = .*lower dt_min"):
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), np.ones(2), rp.Davie(),
+                 step_control=rp.PIController(1e-14, 1e-14))
