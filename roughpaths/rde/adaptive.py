@@ -146,6 +146,11 @@ class _TreeSteps:
             raise ValueError(f"{type(control).__name__}.dt_min({T!r}) returned {dt_min!r}; the smallest step must be a "
                              f"finite number >= 0 (contract item 5; StepController's default is span * 2**-30).")
         self.dt_min = float(dt_min)
+        dt_max = control.dt_max(T)
+        if not self.dt_min <= dt_max:                  # the steps would be held at dt_min, above dt_max, silently
+            raise ValueError(f"{type(control).__name__}: dt_min({T!r}) = {self.dt_min!r} exceeds dt_max({T!r}) = "
+                             f"{dt_max!r} on the tree's [t0, t1] = [{t0}, {t1}] (dt_max is at most t1 - t0); pass "
+                             f"dt_min <= dt_max.")
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
         self.i, self.j, self.iterations = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), 0
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))

@@ -120,7 +120,7 @@ class PIController(StepController):
     dt0 : float, optional
         First step tried (default ``(t1 - t0) / 64``).
     dt_min : float, optional
-        Smallest step (default ``(t1 - t0) · 2^-30``). A step at ``dt_min`` whose error still exceeds the
+        Smallest step (default ``(t1 - t0) · 2^-30``, or ``dt_max`` if that is smaller). A step at ``dt_min`` whose error still exceeds the
         tolerance is a failure of the members concerned, counted in ``Solution.stats["at_dt_min"]``: by
         ``solve(..., on_failure=...)`` it raises a ``ValueError`` at once naming the fix (``"raise"``), or marks
         those members failed and finishes the others (``"mask"``). An unreachable tolerance thus fails after
@@ -197,7 +197,9 @@ class PIController(StepController):
                 f"pcoeff={self.pcoeff!r})")
 
     def dt_min(self, span) -> float:
-        return self._dt_min if self._dt_min is not None else span * 2.0 ** -30
+        # the default never exceeds a given dt_max: on a long interval (t1 - t0 = 1e5, dt_max=1e-5) span · 2^-30 did,
+        # and the steps were silently held at that dt_min, above dt_max
+        return self._dt_min if self._dt_min is not None else min(span * 2.0 ** -30, self.dt_max(span))
 
     def dt_max(self, span) -> float:
         return min(self._dt_max, span) if self._dt_max is not None else span

@@ -245,3 +245,22 @@ def test_an_unmet_tolerance_on_a_coarse_tree_names_the_resolution_not_dt_min():
     with pytest.raises(ValueError, match=r"at dt_min = .*lower dt_min"):
         rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), np.ones(2), rp.Davie(),
                  step_control=rp.PIController(1e-14, 1e-14))
+
+
+def test_dt_max_below_the_default_dt_min_is_honoured_and_dt_min_above_dt_max_refused():
+    """On a long interval the default dt_min, (t1 - t0)·2^-30, exceeds a small dt_max: the steps were held at
+    dt_min (9.3e-5 for t1 - t0 = 1e5), silently ten times the dt_max=1e-5 asked for. The default dt_min is now
+    at most dt_max; a dt_min above dt_max on the tree's interval (e.g. above t1 - t0) is refused by name."""
+    import re
+
+    M = 1e-3 * np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(2,), t1=1e5)
+    with pytest.raises(ValueError, match=r"took 20 attempts and reached t = (\S+) ") as info:
+        rp.solve(V, tree, np.ones(2), rp.Davie(), shared_steps=True,
+                 step_control=rp.PIController(1e-1, 1e-1, dt_max=1e-5, max_steps=20))
+    reached = float(re.search(r"reached t = (\S+) ", str(info.value)).group(1))
+    assert 0 < reached <= 20 * 1e-5 * (1 + 1 / 16)                     # 20 steps of at most dt_max
+    with pytest.raises(ValueError, match=r"dt_min\(1\.0\) = 2\.0 exceeds dt_max\(1\.0\) = 1\.0"):
+        rp.solve(V, rp.BrownianTree(2, seed=0), np.ones(2), rp.Davie(),
+                 step_control=rp.PIController(1e-2, 1e-2, dt_min=2.0))
