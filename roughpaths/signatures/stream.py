@@ -269,9 +269,12 @@ def windowed_signature(paths, depth: int, length: int, *, step: int = 1, expandi
         raise TypeError(f"expanding must be True or False, got {expanding!r}.")
     if not isinstance(log, (bool, np.bool_)):
         raise TypeError(f"log must be True or False, got {log!r}.")
+    if n < 2:                                 # no window of one step or more fits ("length <= 1" is no fix)
+        raise ValueError(f"paths have {n} point (shape {x.shape}): a window spans length >= 1 steps, so it needs "
+                         f"paths of at least 2 points; pass longer paths (the signature of one point is zero).")
     if length > n - 1:
         raise ValueError(f"length={length} is more than the {n - 1} steps of the paths (shape {x.shape}); pass "
-                         f"length <= {max(n - 1, 1)} or longer paths.")
+                         f"length <= {n - 1} or longer paths.")
     depth = check_positive_int(depth, "depth")
     k = np.arange((n - 1 - length) // step + 1)
     s = np.zeros_like(k) if expanding else k * step

@@ -195,3 +195,15 @@ def test_an_empty_batch_axis_gives_empty_answers(batch, length, expanding, log):
     stream = rp.SignatureStream(np.zeros(batch + (n, d)), depth, block=8)
     assert stream.signature([0, 5, 7], [99, 50, 7]).shape == batch + (3, 14)
     assert stream.logsignature(3, 40).shape == batch + (5,)
+
+
+def test_windows_of_one_point_paths_are_refused_with_a_fix_that_works():
+    """One point has no step, so no window fits. The refusal said 'pass length <= 1' although length=1 was the
+    value refused; it now asks for longer paths, and the length it names for two points does work."""
+    with pytest.raises(ValueError, match=r"1 point .* at least 2 points") as info:
+        rp.windowed_signature(np.ones((3, 1, 2)), 2, 1)
+    assert "length <= 1" not in str(info.value)
+    x = np.array([[0.0, 0.0], [1.0, 2.0]])
+    with pytest.raises(ValueError, match=r"pass length <= 1 "):
+        rp.windowed_signature(x, 2, 2)
+    np.testing.assert_allclose(rp.windowed_signature(x, 2, 1), [[1.0, 2.0, 0.5, 1.0, 1.0, 2.0]])   # exp(1, 2)
