@@ -133,20 +133,24 @@ class SignatureStream:
                                 f"{a.dtype}; pass point indices, e.g. np.searchsorted(times, t_query).")
             out.append(a.astype(np.int64))
         try:
-            s, t = np.broadcast_arrays(*out)
+            q = np.broadcast_shapes(out[0].shape, out[1].shape)
         except ValueError:
             raise ValueError(f"s of shape {out[0].shape} and t of shape {out[1].shape} do not broadcast.") from None
-        for a, name in ((s, "s"), (t, "t")):
+        # checked before any work on the broadcast queries: s > t below allocates one byte a query and the answer
+        # 16 more (s, t raveled), so an outer product of index arrays allocated gigabytes before this refusal
+        n_paths = float(np.prod(self.batch_shape, dtype=float))
+        size = float(np.prod(q, dtype=float))
+        check_memory(size * (n_paths * self._sigdim * 8.0 + 17.0), f"the answers ({self.batch_shape} paths x "
+                     f"{size:.0f} queries x {self._sigdim})", "ask fewer queries at a time")
+        for a, name in zip(out, ("s", "t")):
             if a.size and (a.min() < 0 or a.max() > self.n_points - 1):
                 bad = int(a[(a < 0) | (a > self.n_points - 1)].ravel()[0])
                 raise ValueError(f"{name} holds the index {bad}, outside the grid 0..{self.n_points - 1}.")
+        s, t = np.broadcast_arrays(*out)
         if np.any(s > t):
             k = tuple(int(i) for i in np.argwhere(s > t)[0])
             raise ValueError(f"s must be <= t, but s{list(k)} = {int(s[k])} > t{list(k)} = {int(t[k])}; the "
                              f"signature of the reversed piece is tensor_inverse(stream.signature(t, s), dim).")
-        n_paths = float(np.prod(self.batch_shape, dtype=float))
-        check_memory(n_paths * s.size * self._sigdim * 8.0, f"the answers ({self.batch_shape} paths x {s.size} "
-                     f"queries x {self._sigdim})", "ask fewer queries at a time")
         return s, t
 
     def _direct(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:

@@ -207,3 +207,26 @@ def test_windows_of_one_point_paths_are_refused_with_a_fix_that_works():
     with pytest.raises(ValueError, match=r"pass length <= 1 "):
         rp.windowed_signature(x, 2, 2)
     np.testing.assert_allclose(rp.windowed_signature(x, 2, 1), [[1.0, 2.0, 0.5, 1.0, 1.0, 2.0]])   # exp(1, 2)
+
+
+def test_broadcast_queries_are_refused_before_their_allocation(rng, monkeypatch):
+    """``s`` and ``t`` broadcast to the query shape; an outer product of index arrays (4000 x 4000 queries) was
+    compared (``s > t``, 16 MB) before the memory check refused the answers. The check now comes first: the
+    refusal allocates nothing of the queries' size (tracemalloc traces numpy's allocations)."""
+    import tracemalloc
+
+    x = _brownian(rng, (), 50, 2, 1.0)
+    stream = rp.SignatureStream(x, 2)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10 ** 6))
+    s, t = np.zeros((4000, 1), dtype=np.int64), (np.arange(4000) % 50)[None]
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError, match="memory budget"):
+            stream.signature(s, t)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 10 ** 6, peak
+    got = stream.signature(s[:3], t[:, :4])                     # a small outer product is answered
+    assert got.shape == (3, 4, 6)
+    np.testing.assert_allclose(got[1, 3], rp.signature(x[0:4], 2), rtol=1e-12)
