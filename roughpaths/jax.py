@@ -330,6 +330,13 @@ def time_augment(paths, times=None):
         t = _as_jax(times, "times").astype(x.dtype)
     if t.ndim < 1 or t.shape[-1] != n:
         raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {t.shape}.")
+    try:
+        ok = np.broadcast_shapes(x.shape[:-1], t.shape) == x.shape[:-1]
+    except ValueError:
+        ok = False
+    if not ok:                                    # as the numpy time_augment refuses them, naming times
+        raise ValueError(f"times of shape {t.shape} does not broadcast to the points of paths (shape {x.shape}, points "
+                         f"{x.shape[:-1]}); pass times of shape (n,) or (..., n) with the batch axes of paths.")
     return jnp.concatenate([jnp.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)
 
 

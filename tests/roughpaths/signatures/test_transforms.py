@@ -275,3 +275,29 @@ def test_jax_default_times_are_the_correctly_rounded_quotients(n):
         jax.config.update("jax_enable_x64", old)
     np.testing.assert_array_equal(got64, want)
     np.testing.assert_array_equal(got64, rp.time_augment(np.zeros((n, 1)))[:, 0])
+
+
+@pytest.mark.parametrize("t_shape", [(4, 3), (2, 3), (5, 1, 3)])
+def test_frontend_times_with_batch_axes_paths_lack_are_refused_naming_times(t_shape):
+    """times whose batch axes do not broadcast to those of paths (3 points, shape (3, 2) or (2, 3, 2) here):
+    the numpy function refuses them naming ``times``; torch raised its own RuntimeError from ``expand`` and
+    JAX a ValueError about broadcast_to that named neither argument."""
+    torch = pytest.importorskip("torch")
+    jax = pytest.importorskip("jax")
+    import jax.numpy as jnp
+
+    import roughpaths.jax as rpj
+    import roughpaths.torch as rpt
+
+    times = np.broadcast_to(np.arange(3.0), t_shape).copy()
+    paths = np.zeros((3, 2)) if t_shape != (2, 3) else np.zeros((4, 3, 2))
+    with pytest.raises(ValueError, match="times"):
+        rp.time_augment(paths, times)
+    with pytest.raises(ValueError, match=r"times of shape .* does not broadcast"):
+        rpt.time_augment(torch.from_numpy(paths), torch.from_numpy(times))
+    with pytest.raises(ValueError, match=r"times of shape .* does not broadcast"):
+        rpj.time_augment(jnp.asarray(paths, dtype=jnp.float32), jnp.asarray(times, dtype=jnp.float32))
+    ok = np.zeros((2, 3, 2))                                      # times (2, 3) against paths (2, 3, 2): accepted
+    t2 = np.broadcast_to(np.arange(3.0), (2, 3)).copy()
+    np.testing.assert_array_equal(rpt.time_augment(torch.from_numpy(ok), torch.from_numpy(t2)).numpy(),
+                                  rp.time_augment(ok, t2))
