@@ -28,8 +28,10 @@ What they add to the signature:
   tree-like cancellations), and levels carry time-weighted integrals (``S^{(0, i)} = ∫ t dx^i``...).
 * **basepoint**: the signature is invariant under translation; starting from the origin makes it
   see ``x_0`` (level 1 is then ``x_{n-1}``, the path's value, not its increment).
-* **invisibility reset**: the same information as the basepoint, through a visibility channel
-  (``S^{(0, i)}``-type terms carry ``x_0``), while the first ``d`` coordinates of level 1 are unchanged.
+* **invisibility reset**: the same information as the basepoint, through a visibility channel: level 1 is
+  ``(-1, -x_0)`` (the path is sent home at the end, so its coordinates there read the start, not the
+  increment), and ``S^{(0, 1+i)} = x^i_{n-1}``, ``S^{(1+i, 0)} = -(x_{n-1} - x_0)^i`` carry the end point
+  and the increment.
 
 The transforms are linear in the path (plus constants), so they are differentiable; the framework
 front ends have the same four functions written in torch and JAX operations
