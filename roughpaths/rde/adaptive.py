@@ -179,10 +179,13 @@ class _TreeSteps:
         if not live.any():
             return []
         self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
-        if self.iterations > self.control.max_steps and (self.accepted + self.rejected >= self.control.max_steps).any():
-            k = int(np.argmax(self.accepted + self.rejected))
+        over = live & (self.accepted + self.rejected >= self.control.max_steps)
+        if self.iterations > self.control.max_steps and over.any():
+            k = int(np.argmax(over))            # a lane still short of t1 (one done in max_steps attempts is fine)
+            who = ("the batch's shared steps" if self.shared else
+                   f"batch member {tuple(int(v) for v in np.unravel_index(k, self.run.batch))}")
             raise ValueError(f"adaptive solve took {self.control.max_steps} attempts and reached t = "
-                             f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] "
+                             f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] for {who} "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
         h = self.state["h"] = _one_each(self.state["h"], self.lanes, np.float64,

@@ -264,3 +264,23 @@ def test_dt_max_below_the_default_dt_min_is_honoured_and_dt_min_above_dt_max_ref
     with pytest.raises(ValueError, match=r"dt_min\(1\.0\) = 2\.0 exceeds dt_max\(1\.0\) = 1\.0"):
         rp.solve(V, rp.BrownianTree(2, seed=0), np.ones(2), rp.Davie(),
                  step_control=rp.PIController(1e-2, 1e-2, dt_min=2.0))
+
+
+def test_running_out_of_attempts_names_the_member_that_did_not_reach_t1():
+    """Per member, member 0 reaches t1 in exactly max_steps = 8 steps of 1/8 (allowed) and member 1, on steps
+    of 1/16, runs out at t = 1/2. The message named the lane with the most attempts, member 0: 'reached t = 1 of
+    [0.0, 1.0]'; it now names member 1 and t = 0.5."""
+    M = np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
+
+    class TwoPaces(rp.StepController):
+        max_steps = 8
+
+        def init(self, t0, t1, lanes, error_order):
+            return {"h": np.array([1 / 8, 1 / 16])}
+
+        def adapt(self, state, t, h, r):
+            return np.ones(np.shape(h), dtype=bool)
+
+    with pytest.raises(ValueError, match=r"took 8 attempts and reached t = 0\.5 of \[0\.0, 1\.0\] for batch member \(1,\)"):
+        rp.solve(rp.LinearVectorFields(M), rp.BrownianTree(2, seed=0, batch_shape=(2,)), np.ones(2), rp.Davie(),
+                 step_control=TwoPaces(), shared_steps=False)
