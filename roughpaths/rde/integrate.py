@@ -182,6 +182,9 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     if block_steps is not None:
         block_steps = check_positive_int(block_steps, "block_steps")
     control = _check_control(step_control, driver, solver)
+    if shared_steps is not None and not isinstance(shared_steps, (bool, np.bool_)):   # bool("no") is True
+        raise TypeError(f"shared_steps must be True, False or None (the solver's choice), got {shared_steps!r}; "
+                        f"pass shared_steps=True for one step size for the whole batch, False for steps per member.")
     if executor is not None:
         if control is not None:
             raise ValueError("executor= splits a batch solved on a fixed grid; with a step controller solve serially "

@@ -284,3 +284,17 @@ def test_running_out_of_attempts_names_the_member_that_did_not_reach_t1():
     with pytest.raises(ValueError, match=r"took 8 attempts and reached t = 0\.5 of \[0\.0, 1\.0\] for batch member \(1,\)"):
         rp.solve(rp.LinearVectorFields(M), rp.BrownianTree(2, seed=0, batch_shape=(2,)), np.ones(2), rp.Davie(),
                  step_control=TwoPaces(), shared_steps=False)
+
+
+@pytest.mark.parametrize("value", ["no", "False", 0, 2, [True]])
+def test_shared_steps_other_than_a_bool_or_none_is_refused(value):
+    """shared_steps was read as bool(shared_steps): "no" and "False" gave shared steps, 0 per-member steps,
+    silently. It must be True, False or None."""
+    V = rp.LinearVectorFields(M)
+    with pytest.raises(TypeError, match=r"shared_steps must be True, False or None .*, got"):
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(),
+                 step_control=rp.PIController(1e-2, 1e-2), shared_steps=value, save_at="end")
+    for ok in (True, False, np.bool_(True)):
+        sol = rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(),
+                       step_control=rp.PIController(1e-2, 1e-2), shared_steps=ok, save_at="end")
+        assert sol.stats["shared_steps"] is bool(ok)
