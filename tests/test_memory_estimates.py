@@ -103,6 +103,11 @@ CASES = [
     Case("sig_mmd_test", lambda: (_paths((30, 30, 2), 1), _paths((30, 30, 2), 2)),
          lambda X, Y: rp.sig_mmd_test(X, Y, seed=0, n_permutations=2000)),
     Case("brownian_expected_signature", lambda: (), lambda: rp.brownian_expected_signature(3, 8)),
+    # path transforms: lead–lag and invisibility reset build output-sized pieces before joining them
+    Case("lead_lag", lambda: (_paths((20000, 100, 3)),), lambda x: rp.lead_lag(x)),
+    Case("time_augment", lambda: (_paths((20000, 100, 3)),), lambda x: rp.time_augment(x)),
+    Case("basepoint", lambda: (_paths((20000, 100, 3)),), lambda x: rp.basepoint(x)),
+    Case("invisibility_reset", lambda: (_paths((20000, 100, 3)),), lambda x: rp.invisibility_reset(x)),
     # algebra
     Case("lyndon_basis", lambda: (), lambda: rp.lyndon_basis(4, 7)),
     # paths

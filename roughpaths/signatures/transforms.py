@@ -49,17 +49,22 @@ from ..validation import as_float_array, check_memory
 __all__ = ["lead_lag", "time_augment", "basepoint", "invisibility_reset"]
 
 
-def _check(paths, n_out: int, d_out: int) -> np.ndarray:
-    """``paths`` as a finite float64 ``(..., n, d)`` array with ``n, d >= 1``; the output size is checked."""
+def _check(paths, n_out: int, d_out: int, copies: int = 1) -> np.ndarray:
+    """``paths`` as a finite float64 ``(..., n, d)`` array with ``n, d >= 1``; the memory is checked: the output
+    and the ``copies - 1`` output-sized pieces a transform concatenates (lead–lag's lead and lag halves,
+    invisibility reset's visible points), plus one input-sized temporary (the finiteness check's mask, the
+    zeros and the time channel's broadcast)."""
     x = as_float_array(paths, "paths", min_ndim=2)
     n, d = x.shape[-2:]
     if n < 1 or d < 1:
         raise ValueError(f"paths must have shape (..., n, d) with n >= 1 points and d >= 1 channels, got shape "
                          f"{x.shape}; pass at least one point of at least one channel.")
     n_new, d_new = n_out(n), d_out(d)
-    size = float(np.prod(x.shape[:-2], dtype=float)) * n_new * d_new * 8.0
-    check_memory(size, f"the transformed paths ({x.shape[:-2]} x {n_new} points x {d_new} channels)",
-                 "transform fewer or shorter paths at a time")
+    batch = float(np.prod(x.shape[:-2], dtype=float))
+    size = batch * (copies * n_new * d_new + n * (d + 1)) * 8.0
+    check_memory(size, f"the transformed paths ({x.shape[:-2]} x {n_new} points x {d_new} channels, and "
+                 f"{copies - 1} output-sized temporaries)" if copies > 1 else f"the transformed paths "
+                 f"({x.shape[:-2]} x {n_new} points x {d_new} channels)", "transform fewer or shorter paths at a time")
     return x
 
 
@@ -91,7 +96,7 @@ def lead_lag(paths) -> np.ndarray:
     >>> float(logsignature(lead_lag(np.array([[0.0], [1.0], [3.0]])), 2)[2])   # ½ (1² + 2²)
     2.5
     """
-    x = _check(paths, lambda n: 2 * n - 1, lambda d: 2 * d)
+    x = _check(paths, lambda n: 2 * n - 1, lambda d: 2 * d, copies=2)      # the lead and lag halves, then joined
     k = np.arange(2 * x.shape[-2] - 1)
     return np.concatenate([x[..., (k + 1) // 2, :], x[..., k // 2, :]], axis=-1)
 
@@ -194,7 +199,7 @@ def invisibility_reset(paths) -> np.ndarray:
            [0., 3., 4.],
            [0., 0., 0.]])
     """
-    x = _check(paths, lambda n: n + 2, lambda d: d + 1)
+    x = _check(paths, lambda n: n + 2, lambda d: d + 1, copies=2)          # the visible points, then joined
     batch, d = x.shape[:-2], x.shape[-1]
     seen = np.concatenate([np.ones(x.shape[:-1] + (1,)), x], axis=-1)
     off = np.concatenate([np.zeros(batch + (1, 1)), x[..., -1:, :]], axis=-1)
