@@ -234,6 +234,9 @@ class _TreeSteps:
     def judge(self, a, y_new, saved, first_bad, err):
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
         y_new, m = np.ascontiguousarray(y_new, dtype=np.float64), a.members.size     # a user's solver or controller
+        if err is None and a.h is not None:       # read as 'no estimate': every step accepted at zero error, silently
+            raise TypeError(f"{type(self.control).__name__}.error_ratio returned None; an adaptive controller must "
+                            f"return the error ratio of each member (contract item 3), e.g. an array of shape ({m},).")
         if err is not None:                                                            # may return other types
             err = _one_each(err, m, np.float64, f"{type(self.control).__name__}.error_ratio's result")
         if y_new.shape != (m, self.run.e):

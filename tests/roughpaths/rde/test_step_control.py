@@ -298,3 +298,17 @@ def test_shared_steps_other_than_a_bool_or_none_is_refused(value):
         sol = rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(),
                        step_control=rp.PIController(1e-2, 1e-2), shared_steps=ok, save_at="end")
         assert sol.stats["shared_steps"] is bool(ok)
+
+
+def test_an_adaptive_controller_whose_error_ratio_returns_none_is_refused():
+    """An adaptive controller's error_ratio that returns None (a missing return) was taken for 'no estimate':
+    every attempt was accepted at zero error and the steps grew by factor_max to t1 (4 steps), silently."""
+    class Forgetful(rp.PIController):
+        def error_ratio(self, y, y_new, y_err, h, span):
+            super().error_ratio(y, y_new, y_err, h, span)          # computed, not returned
+
+    V = rp.LinearVectorFields(M)
+    for shared in (False, True):
+        with pytest.raises(TypeError, match=r"Forgetful\.error_ratio returned None"):
+            rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(),
+                     step_control=Forgetful(1e-2, 1e-2), shared_steps=shared)
