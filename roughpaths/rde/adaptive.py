@@ -254,8 +254,11 @@ class _TreeSteps:
             k = self.lane_of[m[0]]
             run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t_at[k], self.h_at[k],
                                                                 self.control, self.dt_min, self.L))
-        accept = _one_each(self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive
-                                              else None), self.lanes, bool, f"{type(self.control).__name__}.adapt's result")
+        verdict = self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive else None)
+        if verdict is None:                       # np.asarray(None, bool) is False: every attempt rejected until max_steps
+            raise TypeError(f"{type(self.control).__name__}.adapt returned None; it must return whether each lane's "
+                            f"attempt is accepted (contract item 4), e.g. np.ones(lanes, dtype=bool) for a schedule.")
+        accept = _one_each(verdict, self.lanes, bool, f"{type(self.control).__name__}.adapt's result")
         accept = accept.copy()                      # written in place below; the controller may keep what it returned
         n, nbad = _advance_nb(accept, self.floor, self.live, self.tried, self.bad, run.healthy, self.lane_of,
                               self.accepted, self.rejected, self.i, self.j, run.y, self.y_new, self.done, self.failing,

@@ -312,3 +312,20 @@ def test_an_adaptive_controller_whose_error_ratio_returns_none_is_refused():
         with pytest.raises(TypeError, match=r"Forgetful\.error_ratio returned None"):
             rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(),
                      step_control=Forgetful(1e-2, 1e-2), shared_steps=shared)
+
+
+def test_a_controller_whose_adapt_returns_none_is_refused():
+    """adapt returning None (a missing return) became np.asarray(None, bool) == False: every attempt rejected until
+    max_steps, then 'took 1000 attempts ... loosen rtol/atol', which misnames the fault."""
+    class NoVerdict(rp.StepController):
+        max_steps = 1000
+
+        def init(self, t0, t1, lanes, error_order):
+            return {"h": np.full(lanes, 0.125)}
+
+        def adapt(self, state, t, h, r):
+            state["h"] = h
+
+    V = rp.LinearVectorFields(M)
+    with pytest.raises(TypeError, match=r"NoVerdict\.adapt returned None"):
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(), step_control=NoVerdict())
