@@ -140,6 +140,10 @@ class _TreeSteps:
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
         order = solver.error_order if solver.error_order is not None else solver.order
         self.state = control.init(t0, t1, n, order)
+        if not isinstance(self.state, dict) or "h" not in self.state:     # else a bare KeyError or TypeError below
+            raise TypeError(f"{type(control).__name__}.init returned {type(self.state).__name__}"
+                            f"{' without the key h' if isinstance(self.state, dict) else ''}; it must return a fresh "
+                            f"dict holding at least 'h', the first step of each of the {n} lane(s) (contract item 2).")
         self.dt_min = dt_min = control.dt_min(T)
         if isinstance(dt_min, (bool, np.bool_)) or not isinstance(dt_min, (numbers.Real, np.floating, np.integer)) \
                 or not 0 <= dt_min < math.inf:         # the cell count below is ceil(dt_min / cell)

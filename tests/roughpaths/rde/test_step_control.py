@@ -329,3 +329,19 @@ def test_a_controller_whose_adapt_returns_none_is_refused():
     V = rp.LinearVectorFields(M)
     with pytest.raises(TypeError, match=r"NoVerdict\.adapt returned None"):
         rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(), step_control=NoVerdict())
+
+
+@pytest.mark.parametrize("state", [None, {"step": 0.125}, [0.125]])
+def test_a_controller_whose_init_returns_no_state_with_h_is_refused(state):
+    """init must return a dict holding 'h' (contract item 2); None or a dict without 'h' raised a bare TypeError
+    ('NoneType' object is not subscriptable) or KeyError: 'h' from inside the loop."""
+    class NoState(rp.StepController):
+        def init(self, t0, t1, lanes, error_order):
+            return state
+
+        def adapt(self, state, t, h, r):
+            return np.ones(np.shape(h), dtype=bool)
+
+    V = rp.LinearVectorFields(M)
+    with pytest.raises(TypeError, match=r"NoState\.init returned .*contract item 2"):
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(), step_control=NoState())
