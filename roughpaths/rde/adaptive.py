@@ -183,8 +183,8 @@ class _TreeSteps:
         if not live.any():
             return []
         self.iterations += 1                   # a lane's attempts so far are at most the iterations before this
-        over = live & (self.accepted + self.rejected >= self.control.max_steps)
-        if self.iterations > self.control.max_steps and over.any():
+        if self.iterations > self.control.max_steps and \
+                (over := live & (self.accepted + self.rejected >= self.control.max_steps)).any():
             k = int(np.argmax(over))            # a lane still short of t1 (one done in max_steps attempts is fine)
             who = ("the batch's shared steps" if self.shared else
                    f"batch member {tuple(int(v) for v in np.unravel_index(k, self.run.batch))}")
@@ -194,8 +194,8 @@ class _TreeSteps:
                              f"or raise the controller's max_steps.")
         h = self.state["h"] = _one_each(self.state["h"], self.lanes, np.float64,
                                         f'the step control\'s state["h"] ({type(self.control).__name__})')
-        bad = live & ~((h > 0) & (h < math.inf))    # the snapping kernel takes log2(span / h): NaN, 0 or < 0 there
-        if bad.any():                               # gave one step to t1 or a division by zero, never an error
+        # the snapping kernel takes log2(span / h): NaN, 0 or < 0 there gave one step to t1 or a division by zero
+        if not (h.min() > 0 and h.max() < math.inf) and (bad := live & ~((h > 0) & (h < math.inf))).any():
             k = int(np.argmax(bad))
             raise ValueError(f'the step control\'s state["h"] ({type(self.control).__name__}) holds the step {h[k]!r} '
                              f"for lane {k} at t = {self.t0 + int(self.i[k]) * self.cell:.6g}; a step must be a finite "
