@@ -28,19 +28,31 @@ re-optimises inside the walk is only about a third of a kernel's compile), and `
 ``_solve_pairs`` inlined cost 0.3-0.8 s more than compiled apart. Converting and checking the query's times in the
 walk (and adding the ``½ W ⊗ W`` of the Stratonovich areas there) added about 0.2 s to its compile and took about
 20 µs of numpy calls off each query.
+
+Large queries are walked on numba's threads (:mod:`roughpaths._threads`), in about two contiguous ranges of rows per
+thread, once they hold about ``2^20 / 5000`` path-cells (200 paths of an attempt's two halves): the rows are
+independent, each keeps its own nodes, so a row's answer is bitwise the same on any number of threads. A query that
+asks a tree row twice is walked on the calling thread (two threads would write that row's kept nodes). Adaptive steps
+of the stochastic rigid body (1000 paths, rtol 1e-3, quiet 2-core machine, interleaved runs): 0.59-0.62 s of wall
+time against 0.87-0.89 s on one thread, for 2-4 % more CPU time; the walk alone (1000 rows) 0.46 against 0.88 s.
+The noise burst's 64 paths stay on one thread.
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numba import njit
 
+from .. import _threads
 from ._random import _pcg64_fill, _stream_states
 from ._tree_kernels import _refine_segments_nb, split_width
 
 __all__ = ["member_cells"]
 
 _WALK_CACHE_BYTES = 64 * 2 ** 20
+#: A row's walk per cell, in the work units of :func:`roughpaths._threads.ranges` (about 5 us: 3 splits)
+_WALK_WORK = 5000.0
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
@@ -173,6 +185,17 @@ def _walk_nb(prefix, root_w, root_G, rows, keys, times, t0, t1, idx, L, span, ta
     return 0
 
 
+def _walk_parts(Q, n, rows):
+    """Ranges of the query's rows for the threads: about ``2 x`` numba's threads of them (a range's call costs
+    some 10 us of dispatch) once the walk is worth a hand-off, if no tree row is asked twice (a row's kept
+    nodes are written by its walk: two threads must not walk one row)."""
+    if Q * n * _WALK_WORK < _threads.SERIAL_WORK or not np.all(rows[1:] > rows[:-1]):
+        return [(0, Q)]
+    k = min(2 * numba.get_num_threads(), Q)
+    step = -(-Q // k)
+    return [(lo, min(lo + step, Q)) for lo in range(0, Q, step)]
+
+
 def member_cells(tree, rows, times, tag):
     """``(W (Q, n, d), XX (Q, n, d, d))``, increments and Stratonovich areas: row ``q`` of ``tree`` (flat index
     ``rows[q]``) between its ``times[q]`` (``(Q, n + 1)``, strictly increasing on the tree's grid in ``[t0, t1]``,
@@ -193,8 +216,20 @@ def member_cells(tree, rows, times, tag):
     Q, n, d = times.shape[0], times.shape[1] - 1, w.shape[2]
     W, A, idx = np.empty((Q, n, d)), np.empty((Q, n, d, d)), np.empty((Q, n + 1), dtype=np.int64)
     rows = np.ascontiguousarray(rows, dtype=np.int64)
-    q = _walk_nb(tree._prefix, w, G, rows, tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64), t0, t1,
-                 idx, L, span, tag, width, W, A, *cache)
+    keys, times = tree._paths[rows], np.ascontiguousarray(times, dtype=np.float64)
+    parts = _walk_parts(Q, n, rows)
+    bad = np.zeros(len(parts), dtype=np.int64)
+
+    def walk(i, lo, hi):
+        bad[i] = _walk_nb(tree._prefix, w, G, rows[lo:hi], keys[lo:hi], times[lo:hi], t0, t1, idx[lo:hi], L, span,
+                          tag, width, W[lo:hi], A[lo:hi], *cache)
+
+    if len(parts) == 1:
+        walk(0, 0, Q)
+    else:
+        index = {p: i for i, p in enumerate(parts)}
+        _threads.run(lambda lo, hi: walk(index[lo, hi], lo, hi), parts)
+    q = next((int(b) + lo for b, (lo, _) in zip(bad, parts) if b), 0)
     if q:
         raise ValueError(f"times must increase strictly in [t0, t1] = [{tree.t0}, {tree.t1}] on the tree's grid "
                          f"(t1 - t0)·2^-{L}, row by row; row {q - 1} is {np.asarray(times)[q - 1]!r}.")

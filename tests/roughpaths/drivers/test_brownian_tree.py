@@ -222,3 +222,39 @@ def test_per_path_queries_reach_t1_where_t0_plus_the_span_rounds_below_it():
     np.testing.assert_allclose(W.sum(axis=1), whole[:, 0], rtol=0, atol=1e-12)
     with pytest.raises(ValueError, match=r"times must increase strictly in \[t0, t1\]"):
         tree.increments_and_areas([[t0, 4.0, np.nextafter(t1, np.inf)], [t0, 2.5, t1]], [0, 1])
+
+
+def test_per_path_queries_walked_on_threads_answer_each_row_as_alone():
+    """A per-path query of 300 rows is walked in ranges on numba's threads: every row's answer is bitwise its
+    answer asked alone (the naive route, one query per row), whatever the thread count; a bad row in a late range
+    is named by its own index."""
+    numba = pytest.importorskip("numba")
+    from roughpaths.drivers import _tree_members
+
+    P = 300
+    tree = rp.BrownianTree(3, seed=5, batch_shape=(P,))
+    rng = np.random.default_rng(1)
+    cell = 2.0 ** -tree.resolution
+    a = rng.uniform(0.0, 0.8, P)
+    h = rng.uniform(0.01, 0.1, P)
+    times = np.round(np.stack([a, a + h / 2, a + h], axis=1) / cell) * cell
+    rows = np.arange(P)
+    assert len(_tree_members._walk_parts(P, 2, rows)) > 1          # the query is split
+    before = numba.get_num_threads()
+    try:
+        answers = []
+        for threads in (1, numba.config.NUMBA_NUM_THREADS):
+            numba.set_num_threads(threads)
+            answers.append(rp.BrownianTree(3, seed=5, batch_shape=(P,)).increments_and_areas(times, rows))
+    finally:
+        numba.set_num_threads(before)
+    alone = rp.BrownianTree(3, seed=5, batch_shape=(P,))
+    for k in range(0, P, 23):
+        w, xx = alone.increments_and_areas(times[k:k + 1], [k])
+        for W, XX in answers:
+            assert np.array_equal(W[k], w[0]) and np.array_equal(XX[k], xx[0])
+    assert all(np.array_equal(x, y) for x, y in zip(answers[0], answers[1]))
+    bad = times.copy()
+    bad[250, 2] = bad[250, 1]
+    with pytest.raises(ValueError, match="row 250 is"):
+        tree.increments_and_areas(bad, rows)
