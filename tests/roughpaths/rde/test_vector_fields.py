@@ -17,7 +17,7 @@ import numpy as np
 from _oracles import rk4_flow
 import pytest
 import scipy.linalg
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from roughpaths import expm_batched, LinearDrift, LinearVectorFields, VectorFields
@@ -161,11 +161,16 @@ def test_with_drift_returns_new_family(rng):
 
 
 @given(st.floats(-6, 1.5), st.integers(1, 5))
+@example(1.27734375, 2)
 def test_expm_batched_matches_scipy(log_scale, n):
+    """Normwise, matrix by matrix: scipy's expm is itself accurate only normwise. At ``(1.27734375, 2)`` (a norm of
+    40, entries up to 4e10) its [0, 1] entry is 2.2e-11 off relative to itself (1.8e-12 of the norm, against a
+    50-digit mpmath reference), while ours is 8.6e-15 off; an elementwise tolerance failed on scipy's error."""
     rng = np.random.default_rng(n)
     A = rng.standard_normal((7, n, n)) * 10.0 ** log_scale
     ref = np.stack([scipy.linalg.expm(a) for a in A])
-    np.testing.assert_allclose(expm_batched(A), ref, rtol=1e-11, atol=1e-12 * np.max(np.abs(ref)))
+    err = np.max(np.abs(expm_batched(A) - ref), axis=(1, 2))
+    assert np.all(err <= 1e-11 * np.max(np.abs(ref), axis=(1, 2))), err / np.max(np.abs(ref), axis=(1, 2))
 
 
 def test_linear_fast_paths_agree_with_generic_fields(rng):
