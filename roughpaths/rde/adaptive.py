@@ -252,7 +252,8 @@ class _TreeSteps:
     def adapt(self, attempts):
         """Fail the members that miss the tolerance at ``dt_min``, let the controller decide, advance the lanes."""
         run, cell, r, adaptive = self.run, self.cell, self.r, self.control.adaptive
-        if _ratios_nb(self.err, self.tried, self.bad, run.healthy, self.lane_of, self.floor, adaptive, r, self.unmet):
+        failed = _ratios_nb(self.err, self.tried, self.bad, run.healthy, self.lane_of, self.floor, adaptive, r, self.unmet)
+        if failed:
             m = np.flatnonzero(self.unmet)          # the tolerance cannot be met at dt_min: fail, never crawl
             np.add.at(self.at_min, self.lane_of[m], 1)
             k = self.lane_of[m[0]]
@@ -272,8 +273,14 @@ class _TreeSteps:
             run.fail(m, self.accepted[self.lane_of[m]], times=self._times_of)
             self.accepted += self.held
             np.copyto(self.i, self.j, where=self.held)
-        if n == 0:
-            return
+        if n:
+            self._save(n)
+        if failed or nbad:                        # (on_failure="mask") a lane left without a healthy member stops
+            self._stop_failed_lanes()
+
+    def _save(self, n):
+        """Save the states of the ``n`` lanes just accepted (``self.done[:n]``) that are at a save time."""
+        run, cell = self.run, self.cell
         lanes = self.done[:n].copy()             # kept in self.saved: not a view of the reused buffer
         at = self.i[lanes]
         if not self.save_all:
@@ -289,6 +296,19 @@ class _TreeSteps:
         if reached > self.reached:
             self.reached = reached
             run.progress(reached)
+
+    def _stop_failed_lanes(self):
+        """Lanes whose members have all failed (masked) jump to ``t1``: their states are NaN at the save times left
+        (``t1`` only, with ``save_at="all"``), and no more steps are taken or counted for them (before, they went on
+        stepping NaN states, counted as accepted, to ``t1``)."""
+        dead = np.flatnonzero((self.i < self.end) & ~self.run.healthy[self.lane_members].any(axis=1))
+        for k in dead.tolist():
+            at = np.array([self.end]) if self.save_all else self.save_list[self.save_list > self.i[k]]
+            if at.size:
+                self.saved.append((np.full(at.size, k), np.where(at < self.end, self.t0 + at * self.cell, self.t1),
+                                   np.full((at.size,) + self.lane_members.shape[1:] + (self.run.e,), np.nan)))
+                self.n_saved += at.size
+            self.i[k] = self.end
 
     def _times_of(self, member):
         """The step ends the failure message of ``member`` (flat index) reads: its failed attempt's start and end

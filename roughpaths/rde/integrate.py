@@ -97,8 +97,10 @@ def solve(fields, driver, y0, solver=None, *, drift=None, save_at="all", on_fail
     on_failure : "raise" or "mask"
         What to do when batch members become non-finite: raise :class:`NonFiniteStateError` naming every
         failed member and its step (default), or finish the healthy members and return them, with
-        ``Solution.failed_step`` marking the failed ones (their states are NaN from the failure on).
-        Either way a healthy member's result is the one it has when solved alone.
+        ``Solution.failed_step`` marking the failed ones (their states are NaN from the failure on; with steps
+        per member a failed member takes no more steps, its states NaN at the save times left). Either way a
+        healthy member's result is the one it has when solved alone (with ``shared_steps=True`` the steps, and
+        so the results, depend on the whole batch by design).
     block_steps : int, optional
         Steps per block requested from a :class:`~roughpaths.Driver` (its default if ``None``);
         it changes memory use, never the numbers.

@@ -75,7 +75,9 @@ class FixedSteps(StepController):
 
     On a grid driver (a ``RoughPath`` or a lazy ``Driver``) the steps are the grid's. On a driver that answers
     on any times (a :class:`~roughpaths.BrownianTree`) they are ``dt`` long (the last one shortened to end at
-    ``t1`` or a save time).
+    ``t1`` or a save time), with their ends snapped to the tree's dyadic grid (spacing at most ``dt/8``: a step
+    of 0.3 on ``[0, 1]`` is 0.3125 long; a dyadic ``dt`` is kept exactly). A ``dt`` shorter than 8 cells of the
+    tree's grid is refused, naming the resolution that resolves it.
 
     Parameters
     ----------

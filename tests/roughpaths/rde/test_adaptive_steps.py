@@ -157,11 +157,37 @@ def test_a_member_non_finite_on_an_accepted_step_is_reported_at_that_step():
                                                      r"member \(1,\)"):
         rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl)
     sol = rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl, on_failure="mask")
-    assert sol.failed_step.tolist() == [-1, 3, -1] and sol.stats["accepted"].tolist() == [64, 64, 64]
+    assert sol.failed_step.tolist() == [-1, 3, -1] and sol.stats["accepted"].tolist() == [64, 4, 64]
     assert np.isfinite(sol.states[1, :4]).all() and np.isnan(sol.states[1, 4:]).all()
+    assert sol.times[1, 4] == 0.0625 and np.all(sol.times[1, 5:] == 1.0)     # stopped: NaN at t1, no more steps
     for k in (0, 2):
         alone = rp.solve(V, tree.select([k]), y0[k], rp.Davie(), step_control=ctrl)
         np.testing.assert_array_equal(sol.states[k], alone.states[0])
+
+
+def test_a_masked_member_stops_at_its_failure_and_is_nan_at_the_save_times_left():
+    """With steps per member, a member masked at its failure takes no more steps: its accepted steps end with the
+    failing one, its states are NaN at the save times after it (t1 with save_at='all'), and the other members are
+    what they are alone, bitwise (before, it went on stepping NaN states to t1, counted as accepted steps)."""
+    V = rp.VectorFields(lambda y: np.stack([y ** 2, 0.1 * y], axis=-1),               # V_1 = y², V_2 = y / 10
+                        lambda y: np.stack([2 * y, np.full_like(y, 0.1)], axis=-2)[..., None], dim_state=1, dim_noise=2)
+    tree = rp.BrownianTree(2, seed=3, batch_shape=(3,))
+    y0 = np.array([[0.1], [30.0], [0.2]])
+    ctrl = rp.PIController(1e-2, 1e-2)
+    sol = rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl, on_failure="mask")
+    k = int(sol.failed_step[1])
+    assert k > 0 and sol.failed_step[[0, 2]].tolist() == [-1, -1]
+    assert sol.stats["accepted"][1] == k + 1
+    assert np.isfinite(sol.states[1, :k + 1]).all() and np.isnan(sol.states[1, k + 1:]).all()
+    assert sol.times[1, k + 1] < 0.01 and np.all(sol.times[1, k + 2:] == 1.0)
+    for j in (0, 2):
+        alone = rp.solve(V, tree.select([j]), y0[j], rp.Davie(), step_control=ctrl)
+        K = alone.times.shape[-1]
+        assert np.array_equal(sol.times[j, :K], alone.times[0]) and np.array_equal(sol.states[j, :K], alone.states[0])
+    at = rp.solve(V, tree, y0, rp.Davie(), step_control=ctrl, on_failure="mask", save_at=[0.0, 0.5, 1.0])
+    assert at.stats["accepted"][1] == k + 1
+    np.testing.assert_array_equal(at.times, [0.0, 0.5, 1.0])
+    assert at.states[1, 0, 0] == 30.0 and np.isnan(at.states[1, 1:]).all() and np.isfinite(at.states[[0, 2]]).all()
 
 
 def test_bad_input_names_the_fix():
