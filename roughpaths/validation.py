@@ -21,6 +21,7 @@ __all__ = [
     "check_times",
     "check_antisymmetric",
     "check_rng",
+    "check_seed",
     "check_positive_int",
     "check_positive_real",
     "check_real",
@@ -33,6 +34,21 @@ __all__ = [
     "work_budget",
     "arrays_equal",
 ]
+
+
+def check_seed(seed) -> np.random.SeedSequence:
+    """``seed`` as a ``SeedSequence``: an int ``>= 0`` or a ``SeedSequence`` (as is); a ``Generator`` is refused with the
+    reason (the results would depend on what it drew before), anything else names ``seed`` and what it takes."""
+    if isinstance(seed, np.random.SeedSequence):
+        return seed
+    if isinstance(seed, numbers.Integral) and not isinstance(seed, bool):
+        if seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {seed}.")
+        return np.random.SeedSequence(int(seed))
+    if isinstance(seed, np.random.Generator):
+        raise TypeError("seed must be an int or a numpy.random.SeedSequence, got a Generator: a Generator's "
+                        "state would make the paths depend on what was drawn before. Pass seed=<int>.")
+    raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
 
 
 def arrays_equal(a, b) -> bool:

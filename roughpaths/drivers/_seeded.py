@@ -14,21 +14,7 @@ import os
 import numpy as np
 
 from .base import Driver
-from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_times
-
-
-def check_seed(seed) -> np.random.SeedSequence:
-    """An int ``>= 0`` or a ``SeedSequence`` (as is); a ``Generator`` is refused with the reason."""
-    if isinstance(seed, np.random.SeedSequence):
-        return seed
-    if isinstance(seed, numbers.Integral) and not isinstance(seed, bool):
-        if seed < 0:
-            raise ValueError(f"seed must be a non-negative integer, got {seed}.")
-        return np.random.SeedSequence(int(seed))
-    if isinstance(seed, np.random.Generator):
-        raise TypeError("seed must be an int or a numpy.random.SeedSequence, got a Generator: a Generator's "
-                        "state would make the paths depend on what was drawn before. Pass seed=<int>.")
-    raise TypeError(f"seed must be an int >= 0 or a numpy.random.SeedSequence, got {type(seed).__name__}.")
+from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_seed, check_times
 
 
 def grid(times, dt, n_steps, t0):

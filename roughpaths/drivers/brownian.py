@@ -91,13 +91,13 @@ import numbers
 
 import numpy as np
 
-from ..validation import as_float_array, check_memory, check_positive_int
+from ..validation import as_float_array, check_memory, check_positive_int, check_seed as _check_seed
 from .. import _threads
 from ._area_kernels import _scale_accumulate
 from ._fourier_kernels import step_tables
 from ._random import PathStreams, _fast_streams_ok, _pcg64_normals
 from .areas import _Sampler
-from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape, check_seed as _check_seed
+from ._seeded import SeededDriver, check_batch_shape as _check_batch_shape
 from ..paths.rough_path import RoughPath
 from .refinement import RefinedBrownianDriver
 

@@ -57,8 +57,8 @@ import numpy as np
 
 from ..paths.rough_path import RoughPath
 from ..validation import (as_float_array, check_batch_shape, check_memory, check_positive_int, check_positive_real,
-                          check_work)
-from ._seeded import SeededDriver, check_seed
+                          check_seed, check_work)
+from ._seeded import SeededDriver
 
 __all__ = ["ChaoticMap", "cat_map", "lorenz63_map", "ChaoticDriver", "observable_orbits"]
 

@@ -68,9 +68,9 @@ from collections import OrderedDict
 import numpy as np
 
 from ..paths.rough_path import RoughPath
-from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_real
+from ..validation import as_float_array, check_batch_shape, check_memory, check_positive_int, check_real, check_seed
 from ._random import PathStreams
-from ._seeded import check_seed, selected_paths
+from ._seeded import selected_paths
 from .base import Driver
 from ._tree_members import member_cells
 from ._tree_kernels import polygon_area, reduce_node, refine_segments_fast, seed_prefix, split_seeded, split_width

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from ..validation import check_memory, check_positive_int, check_work
+from ..validation import check_memory, check_positive_int, check_seed, check_work
 from .kernel import _pairs_kernel, _scaled, _setup
 
 __all__ = ["MMDTestResult", "sig_mmd_test"]
@@ -181,10 +181,7 @@ def sig_mmd_test(X, Y, *, seed, n_permutations: int = 1000, dyadic_order: int = 
             raise ValueError(f"{name} holds {Z.shape[0]} path(s); the unbiased MMD² needs at least 2 paths "
                              f"in each sample.")
     n_perm = check_positive_int(n_permutations, "n_permutations")
-    if isinstance(seed, (bool, np.bool_)) or seed is None:
-        raise TypeError(f"seed must be an int or a numpy.random.SeedSequence, got {seed!r}; pass e.g. seed=0 "
-                        f"(the test is reproducible from it).")
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(check_seed(seed))        # an int >= 0 or a SeedSequence, named if not
     a, b = X.shape[0], Y.shape[0]
     check_memory(_memory_estimate(a, b, n_perm), f"the permutation test of {a} against {b} paths with "
                  f"n_permutations={n_perm} (the pooled Gram matrix of {a + b} x {a + b} kernels and "

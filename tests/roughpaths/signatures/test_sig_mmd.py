@@ -109,6 +109,9 @@ def test_power_brownian_against_fbm():
     (lambda: rp.sig_mmd_test(np.zeros((1, 4, 2)), np.zeros((3, 4, 2)), seed=0), "at least 2 paths"),
     (lambda: rp.sig_mmd_test(np.zeros((2, 3, 4, 2)), np.zeros((2, 3, 4, 2)), seed=0), "samples, points, d"),
     (lambda: rp.sig_mmd_test(np.zeros((3, 4, 2)), np.zeros((3, 4, 2)), seed=None), "seed"),
+    (lambda: rp.sig_mmd_test(np.zeros((3, 4, 2)), np.zeros((3, 4, 2)), seed=1.5), "seed must be an int"),
+    (lambda: rp.sig_mmd_test(np.zeros((3, 4, 2)), np.zeros((3, 4, 2)), seed=-1), "seed must be a non-negative"),
+    (lambda: rp.sig_mmd_test(np.zeros((3, 4, 2)), np.zeros((3, 4, 2)), seed=np.random.default_rng(0)), "Generator"),
     (lambda: rp.sig_mmd_test(np.zeros((3, 4, 2)), np.zeros((3, 4, 2)), seed=0, n_permutations=0), "n_permutations"),
     (lambda: rp.sig_mmd_test(np.zeros((3, 4, 2)), np.zeros((3, 4, 1)), seed=0), "d=2 coordinates"),
 ])
