@@ -46,6 +46,7 @@ from functools import lru_cache
 import numpy as np
 from llvmlite import ir
 from numba import cfunc, njit, types
+from numba.core import cgutils
 from numba.extending import intrinsic
 
 from ._threads import ranges
@@ -168,11 +169,20 @@ def _call(typingctx, fn, arg):
 
 
 @intrinsic
-def _message(typingctx):
-    """The address of :data:`_MESSAGE` (a constant NUL-terminated string of the compiled code)."""
+def _create_error(typingctx, create):
+    """``create(&args)`` for the address ``create`` of XLA's ``XLA_FFI_Error_Create``: an ``INTERNAL`` error saying
+    :data:`_MESSAGE` (a constant string of the compiled code); the arguments struct lives on the stack."""
     def codegen(context, builder, sig, args):
-        return builder.ptrtoint(context.insert_const_string(builder.module, _MESSAGE), ir.IntType(64))
-    return types.int64(), codegen
+        i64 = ir.IntType(64)
+        fields = cgutils.alloca_once(builder, i64, size=_ERROR_ARGS_SIZE // 8)
+        message = builder.ptrtoint(context.insert_const_string(builder.module, _MESSAGE), i64)
+        for k, value in enumerate((ir.Constant(i64, _ERROR_ARGS_SIZE), ir.Constant(i64, 0), message,
+                                   ir.Constant(i64, _INTERNAL))):         # struct_size, extension_start, message, errc
+            builder.store(value, builder.gep(fields, [ir.Constant(i64, k)]))
+        vp = ir.IntType(8).as_pointer()
+        fn = builder.inttoptr(args[0], ir.FunctionType(vp, [vp]).as_pointer())
+        return builder.ptrtoint(builder.call(fn, [builder.bitcast(fields, vp)]), i64)
+    return types.int64(types.int64), codegen
 
 
 # ------------------------------------------------------------------------------ the call frame
@@ -227,11 +237,7 @@ def _error(frame):
     api = _i64(frame + 16) if _i64(frame) >= 24 else 0
     if api == 0 or _i64(api + _ERROR_CREATE) == 0:
         return 0
-    a = np.zeros(_ERROR_ARGS_SIZE // 8, dtype=np.int64)
-    a[0] = _ERROR_ARGS_SIZE
-    a[2] = _message()
-    a[3] = _INTERNAL
-    return _call(_i64(api + _ERROR_CREATE), a.ctypes.data)
+    return _create_error(_i64(api + _ERROR_CREATE))
 
 
 @njit(**_JIT)
@@ -462,7 +468,7 @@ def _forward(frame_pointer):
     if status != 0:
         return _voidptr(0 if status == 1 else _error(frame))
     d, m = _i64(p + 16), _i64(p + 24)
-    nb, n, xb, _, ob = _operands(frame, False, d, m, _i64(p + 32))
+    nb, n, xb, _, ob = _operands(frame, np.bool_(False), d, m, _i64(p + 32))   # (one compile for both)
     if nb == 0:
         return _voidptr(_call(_i64(p), frame))         # the Python handler: the numpy API (and its errors)
     ub, ulo, uhi, off = _layout(nb, n, d, m)
@@ -484,7 +490,7 @@ def _backward(frame_pointer):
     if status != 0:
         return _voidptr(0 if status == 1 else _error(frame))
     d, m, vjp = _i64(p + 16), _i64(p + 24), _i64(p + 8 * _VJP)
-    nb, n, xb, gb, ob = _operands(frame, True, d, m, _i64(p + 32))
+    nb, n, xb, gb, ob = _operands(frame, np.bool_(True), d, m, _i64(p + 32))
     if nb == 0 or vjp == 0:
         return _voidptr(_call(_i64(p), frame))
     ub, ulo, uhi, off = _layout(nb, n, d, m)

@@ -302,3 +302,15 @@ def test_compiled_handlers_leave_errors_to_the_numpy_api(x64, where):
     x[3] = np.inf
     with pytest.raises(Exception, match="non-finite"):
         jax.block_until_ready(_step(3)(x, np.ones(rp.sigdim(3, 3))))
+
+
+def test_a_compiled_handler_without_its_parameters_returns_an_error():
+    """A call of a compiled handler without (or with another) attribute is refused with an XLA error, not a crash:
+    without the parameters there is no Python handler to hand it to."""
+    target = rpj._compiled_target("forward")
+    assert target is not None
+    x = jnp.asarray(_paths((8, 3)), dtype=jnp.float32)
+    result = jax.ShapeDtypeStruct((rp.sigdim(3, 3),), jnp.float32)
+    for attributes in ({}, {"other": np.zeros(7, dtype=np.int64)}, {"roughpaths": np.zeros(3, dtype=np.int64)}):
+        with pytest.raises(Exception, match="compiled signature handler without its parameters"):
+            jax.block_until_ready(jax.ffi.ffi_call(target, result)(x, **attributes))
