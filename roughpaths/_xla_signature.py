@@ -447,9 +447,17 @@ def _vjp_units(typingctx, addr, x, ub, ulo, uhi, nchunks, m, off, part, g_rev, l
 
 def kernel_address(dispatcher, argtypes: tuple) -> int:
     """The address of ``dispatcher``'s native function for ``argtypes`` (compiled, or loaded from numba's cache,
-    if this process has not run it yet: what the numpy API's first call would compile)."""
+    if this process has not run it yet: what the numpy API's first call would compile).
+
+    The symbol is looked up by name in the whole process, so the name must be the variant's own: a function
+    compiled before the variants had their key in their names (:func:`roughpaths._variants._named`), loaded
+    from an older cache, may share its name with another variant, and is refused (``RuntimeError``: the calls
+    stay with the Python handler until numba compiles it again).
+    """
     dispatcher.compile(argtypes)
     cres = dispatcher.overloads[argtypes]
+    if cres.fndesc.qualname != dispatcher.py_func.__qualname__ or not cres.fndesc.qualname.endswith("]"):
+        raise RuntimeError(f"{cres.fndesc.qualname} was compiled under another name than its variant's")
     return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
 
 

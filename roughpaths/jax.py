@@ -5,9 +5,11 @@ r"""JAX front end: the library's signatures and signature kernels as differentia
 forward and backward passes are host calls of the library's numpy API and its vector–Jacobian
 product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation. On the CPU
 backend a host call is an XLA FFI custom call (``jax.ffi.ffi_call``) of a handler made with
-:mod:`ctypes` (``roughpaths._xla_ffi``: nothing compiled, at install or at run time), which wraps
-XLA's buffers as numpy arrays and calls the numpy function; elsewhere, or where the handler cannot
-be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
+:mod:`ctypes` (``roughpaths._xla_ffi``), which wraps XLA's buffers as numpy arrays and calls the numpy
+function; small :func:`signature` calls go to compiled handlers instead (``roughpaths._xla_signature``:
+numba C callbacks that read XLA's call frame and run the numpy API's own compiled kernels, the same
+bits; see **Cost**); elsewhere, or where a handler cannot be registered, a :func:`jax.pure_callback`.
+They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
 (and their compositions):
 
 * **vmap** is one batched call, not a loop: the calls are declared with

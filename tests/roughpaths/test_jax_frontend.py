@@ -240,8 +240,11 @@ def _step(depth):
     return jax.jit(jax.value_and_grad(lambda p, g: jnp.sum(rpj.signature(p, depth) * g)))
 
 
-@pytest.mark.parametrize("shape, depth", [((8, 3), 3), ((1, 8, 3), 3), ((2, 5, 3), 4), ((2, 40, 2), 3),
-                                          ((1, 2, 1), 5), ((3, 6, 4), 5), ((2, 1, 6, 5), 4), ((1, 9, 7), 3)])
+# paths smaller than their signature (run reversed in time) and larger (30 x 3, 40 x 1: the layout permuted);
+# kernel variants that tools/warm_kernels.py --more compiles (one-unit gradients of d = 1, 3, 4, 6, 7)
+@pytest.mark.parametrize("shape, depth", [((8, 3), 3), ((1, 8, 3), 3), ((2, 5, 3), 4), ((2, 30, 3), 3),
+                                          ((2, 40, 1), 3), ((1, 2, 1), 5), ((3, 6, 4), 5), ((2, 1, 6, 6), 4),
+                                          ((1, 9, 7), 3)])
 @pytest.mark.parametrize("dtype", ["float64", "float32"])
 def test_compiled_handlers_give_the_numpy_bits(shape, depth, dtype):
     """Where the compiled handlers run (paths the numpy API runs as single work units; the counter says they
@@ -314,3 +317,19 @@ def test_a_compiled_handler_without_its_parameters_returns_an_error():
     for attributes in ({}, {"other": np.zeros(7, dtype=np.int64)}, {"roughpaths": np.zeros(3, dtype=np.int64)}):
         with pytest.raises(Exception, match="compiled signature handler without its parameters"):
             jax.block_until_ready(jax.ffi.ffi_call(target, result)(x, **attributes))
+
+
+def test_kernel_variants_have_their_own_symbols():
+    """The compiled handlers call a kernel by the address of its symbol, looked up by name: the variants of one
+    kernel factory must not share a name (two variants compiled in two processes and loaded from numba's cache
+    did, and the lookup found the other variant: a write past the signature, then a crash)."""
+    from roughpaths import _xla_signature
+    from roughpaths.signatures import _blocked
+
+    addresses = {key: _xla_signature.kernel_address(_blocked._block_units_kernel(*key), _xla_signature.BLOCK_ARGS)
+                 for key in [(0, 0, False), (6, 4, True), (4, 0, False)]}
+    assert len(set(addresses.values())) == 3
+    names = {key: _blocked._block_units_kernel(*key).overloads[_xla_signature.BLOCK_ARGS].fndesc.llvm_func_name
+             for key in addresses}
+    assert len(set(names.values())) == 3
+    assert _xla_signature.kernels(7, 3, False)[0] == addresses[0, 0, False]
