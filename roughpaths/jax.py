@@ -24,19 +24,22 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
   is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
-* **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls), CPU time on a loaded
+* **Cost.** A jitted forward plus backward (``value_and_grad``, two custom calls), CPU time on a loaded
   2-core machine, against pysiglib's XLA FFI calls into compiled C++ timed in the same process
-  (``benchmarks/bench_frameworks.py`` prints the same comparison): one path of 8 points in d = 3 at
-  depth 3, 0.106 against 0.023 ms (4.6x; 7.3x before the numpy API's fixed cost and the handler were
-  trimmed, medians of 6 alternating process pairs at load 2-3.7; through ``pure_callback`` it was
-  24.5x). On that tiny input the time splits into the XLA program with its two host calls (0.038-0.050
-  ms with host functions that only allocate zero results: 2.2x pysiglib's whole call by itself, the
-  frames read and wrapped in Python) and the two numpy calls (about 0.027 ms alone on a quiet
-  machine): the numpy API's own fixed cost and the Python handler, not the XLA call, are the floor, so
-  the target of 2x pysiglib is out of reach without compiled code. 32 paths of 128 points: 1.03x
-  (1.19x before); in d = 8, about 0.75x. Batch many paths into one call (``vmap`` does) to amortise
-  the fixed cost. First ``jax.grad`` step in a new process: about 0.2 s CPU of XLA compiles (and
-  ``import jax`` about 1.1 s); the handler adds no numba compile.
+  (``benchmarks/bench_frameworks.py`` prints the same comparison; medians of 11 interleaved pairs, two
+  runs): one path of 8 points in d = 3 at depth 3, 0.021-0.023 against 0.017-0.018 ms (1.24-1.27x).
+  Such calls go to the compiled handlers (``roughpaths._xla_signature``): paths the numpy API runs as
+  single work units (depth >= 3, d <= 7, up to a few hundred points) and at most as many as it runs
+  one at a time (2 at d <= 3; any number where the signature is too large for its lanes), float32 or
+  float64; they hand every other call, and every NaN or inf, to the Python handler. Through the
+  Python handler the same step cost 0.075-0.088 ms (4.2-5.3x), above its "host floor" of 0.036-0.040 ms
+  (the same XLA program with Python host functions that only allocate zero results). Larger calls
+  keep the Python handler, whose fixed cost they amortise: 32 paths of 128 points 1.1-1.2x (1.6-1.7x
+  in the runs of the code before, within the noise of this loaded machine), in d = 8 0.8x. Batch
+  many paths into one call (``vmap`` does). First ``jax.grad`` step in a new process: about 0.2 s
+  CPU of XLA compiles (and ``import jax`` about 1.1 s); the compiled handlers, on the first call they
+  take, about 2-3 s CPU of numba compiles (cached on disk), beside the kernels the numpy API compiles
+  for any first call (a lone path's gradient kernel: about 12 s at d = 3).
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
 :func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``
