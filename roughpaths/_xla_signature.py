@@ -32,7 +32,7 @@ one-unit kernels on XLA's buffers:
   checked the way :mod:`roughpaths._xla_ffi` checks them; what does not fit goes to the Python
   handler, and a frame without this module's attribute gets an ``INTERNAL`` XLA error.
 * **Compile cost**: the two handlers are compiled on first use (a traced call they can take) and cached
-  on disk by numba: about 1.6 s and 0.9 s of CPU with an empty cache (their checks and copies: each
+  on disk by numba: 1.6-2.2 s and 0.9-1.2 s of CPU with an empty cache (two runs; their checks and copies: each
   helper is a small function compiled once; the kernels are not linked in, so not compiled again). A
   cold first ``jax.grad`` step on one path of 8 points (``benchmarks/bench_first_call.py``, "jax step,
   one path"): 24.0 s of CPU against 22.1 s through the Python handler (same session, loaded machine;

@@ -38,7 +38,7 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
   in the runs of the code before, within the noise of this loaded machine), in d = 8 0.8x. Batch
   many paths into one call (``vmap`` does). First ``jax.grad`` step in a new process: about 0.2 s
   CPU of XLA compiles (and ``import jax`` about 1.1 s); the compiled handlers, on the first call they
-  take, about 2-3 s CPU of numba compiles (cached on disk), beside the kernels the numpy API compiles
+  take, 2.5-3.4 s CPU of numba compiles (cached on disk), beside the kernels the numpy API compiles
   for any first call (a lone path's gradient kernel: about 12 s at d = 3).
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
