@@ -19,6 +19,22 @@ import threading
 from functools import wraps
 
 
+def _named(kernel, key: tuple):
+    """``kernel`` with its key in its qualified name (``block_units_variant[0, 0, False]``), before it compiles.
+
+    numba names a compiled function's symbols after its qualified name and a counter of the compiling
+    process, and the variants of one factory share a qualified name: two variants compiled in two
+    processes and loaded from the cache into one can define the same symbol, and a lookup of the symbol by
+    name (``library.get_pointer_to_function``, which :mod:`roughpaths._xla_signature` uses to call a kernel
+    by its address) may then find the other variant. With the key in the name, the symbols of different
+    variants differ. (numba's cache files keep the name the dispatcher was made with.)
+    """
+    py_func = getattr(kernel, "py_func", None)
+    if py_func is not None:
+        py_func.__qualname__ = f"{py_func.__qualname__}[{', '.join(map(repr, key))}]"
+    return kernel
+
+
 def variants(factory):
     """Decorate ``factory(*key) -> kernel`` so that each key's kernel is made once (thread-safe).
 
@@ -35,7 +51,7 @@ def variants(factory):
             with lock:
                 kernel = cache.get(key)
                 if kernel is None:
-                    kernel = cache[key] = factory(*key)
+                    kernel = cache[key] = _named(factory(*key), key)
         return kernel
 
     return get

@@ -5,9 +5,11 @@ r"""JAX front end: the library's signatures and signature kernels as differentia
 forward and backward passes are host calls of the library's numpy API and its vector–Jacobian
 product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation. On the CPU
 backend a host call is an XLA FFI custom call (``jax.ffi.ffi_call``) of a handler made with
-:mod:`ctypes` (``roughpaths._xla_ffi``: nothing compiled, at install or at run time), which wraps
-XLA's buffers as numpy arrays and calls the numpy function; elsewhere, or where the handler cannot
-be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
+:mod:`ctypes` (``roughpaths._xla_ffi``), which wraps XLA's buffers as numpy arrays and calls the numpy
+function; small :func:`signature` calls go to compiled handlers instead (``roughpaths._xla_signature``:
+numba C callbacks that read XLA's call frame and run the numpy API's own compiled kernels, the same
+bits; see **Cost**); elsewhere, or where a handler cannot be registered, a :func:`jax.pure_callback`.
+They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
 (and their compositions):
 
 * **vmap** is one batched call, not a loop: the calls are declared with
@@ -22,19 +24,22 @@ be registered, a :func:`jax.pure_callback`. They work under ``jax.jit``, ``jax.v
   is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
-* **Cost.** A jitted forward plus backward (``value_and_grad``, two host calls), CPU time on a loaded
+* **Cost.** A jitted forward plus backward (``value_and_grad``, two custom calls), CPU time on a loaded
   2-core machine, against pysiglib's XLA FFI calls into compiled C++ timed in the same process
-  (``benchmarks/bench_frameworks.py`` prints the same comparison): one path of 8 points in d = 3 at
-  depth 3, 0.106 against 0.023 ms (4.6x; 7.3x before the numpy API's fixed cost and the handler were
-  trimmed, medians of 6 alternating process pairs at load 2-3.7; through ``pure_callback`` it was
-  24.5x). On that tiny input the time splits into the XLA program with its two host calls (0.038-0.050
-  ms with host functions that only allocate zero results: 2.2x pysiglib's whole call by itself, the
-  frames read and wrapped in Python) and the two numpy calls (about 0.027 ms alone on a quiet
-  machine): the numpy API's own fixed cost and the Python handler, not the XLA call, are the floor, so
-  the target of 2x pysiglib is out of reach without compiled code. 32 paths of 128 points: 1.03x
-  (1.19x before); in d = 8, about 0.75x. Batch many paths into one call (``vmap`` does) to amortise
-  the fixed cost. First ``jax.grad`` step in a new process: about 0.2 s CPU of XLA compiles (and
-  ``import jax`` about 1.1 s); the handler adds no numba compile.
+  (``benchmarks/bench_frameworks.py`` prints the same comparison; medians of 11 interleaved pairs, two
+  runs): one path of 8 points in d = 3 at depth 3, 0.021-0.023 against 0.017-0.018 ms (1.24-1.27x).
+  Such calls go to the compiled handlers (``roughpaths._xla_signature``): paths the numpy API runs as
+  single work units (depth >= 3, d <= 7, up to a few hundred points) and at most as many as it runs
+  one at a time (2 at d <= 3; any number where the signature is too large for its lanes), float32 or
+  float64; they hand every other call, and every NaN or inf, to the Python handler. Through the
+  Python handler the same step cost 0.075-0.088 ms (4.2-5.3x), above its "host floor" of 0.036-0.040 ms
+  (the same XLA program with Python host functions that only allocate zero results). Larger calls
+  keep the Python handler, whose fixed cost they amortise: 32 paths of 128 points 1.1-1.2x (1.6-1.7x
+  in the runs of the code before, within the noise of this loaded machine), in d = 8 0.8x. Batch
+  many paths into one call (``vmap`` does). First ``jax.grad`` step in a new process: about 0.2 s
+  CPU of XLA compiles (and ``import jax`` about 1.1 s); the compiled handlers, on the first call they
+  take, 2.5-3.4 s CPU of numba compiles (cached on disk), beside the kernels the numpy API compiles
+  for any first call (a lone path's gradient kernel: about 12 s at d = 3).
 
 The path transforms :func:`lead_lag`, :func:`time_augment`, :func:`basepoint` and
 :func:`invisibility_reset` are :mod:`roughpaths.signatures.transforms`'s, written in ``jax.numpy``
@@ -56,6 +61,8 @@ Array([[-1. , -0.5],
 
 from __future__ import annotations
 
+import ctypes
+import math
 import os
 
 import numpy as np
@@ -87,7 +94,7 @@ _TARGETS: list = []                     # the registered handlers, alive as long
 _PREFIX = f"roughpaths_host_{os.urandom(6).hex()}_"
 
 
-def _host_call(host, register: bool = True):
+def _host_call(host, register: bool = True, compiled=None):
     """``call(result_shape_dtypes, *args)`` computing ``host(*numpy arrays) -> tuple of arrays`` on the host.
 
     On the CPU backend an XLA FFI custom call of a ctypes handler (:mod:`roughpaths._xla_ffi`),
@@ -95,7 +102,10 @@ def _host_call(host, register: bool = True):
     a ``jax.pure_callback`` (the same results; about 0.1 ms more per call, and JAX copies device
     arrays to the host and back). Under ``vmap`` one batched call, with the mapped axes in front of
     every operand. ``register=False``: always the callback (a function built for one call only, whose
-    target XLA would keep for the life of the process).
+    target XLA would keep for the life of the process). ``compiled(*args)``, asked when a call is
+    traced: ``(target, attribute)``, a compiled handler (:func:`_compiled_target`) to call instead and
+    ``attribute(fallback)``, its keyword attributes given the address of this call's Python handler
+    (which it hands what it does not take), or ``None``.
     """
     name = f"{_PREFIX}{len(_TARGETS)}" if register else None
     try:
@@ -108,11 +118,74 @@ def _host_call(host, register: bool = True):
 
     def call(result, *args):
         if name is not None and jax.default_backend() == "cpu":
+            fast = compiled(*args) if compiled is not None else None
+            if fast is not None:                # (kept alive in _TARGETS with the handler: its address stays valid)
+                target, attribute = fast
+                fallback = ctypes.cast(handler, ctypes.c_void_p).value
+                return jax.ffi.ffi_call(target, result, vmap_method="broadcast_all")(*args, **attribute(fallback))
             return jax.ffi.ffi_call(name, result, vmap_method="broadcast_all")(*args)
         callback = host if isinstance(result, tuple) else lambda *arrays: host(*arrays)[0]
         return jax.pure_callback(callback, result, *args, vmap_method="broadcast_all")
 
     return call
+
+
+#: The compiled handlers' target names by direction (``"forward"``, ``"backward"``), or None where one could not be
+#: compiled or registered (those calls stay with the Python handler).
+_COMPILED: dict = {}
+
+
+def _compiled_target(direction: str):
+    """The XLA target name of the compiled ``direction`` signature handler (:mod:`roughpaths._xla_signature`),
+    compiled (or loaded from numba's cache) and registered on first use; ``None`` if that fails."""
+    if direction not in _COMPILED:
+        name = None
+        try:
+            from roughpaths import _xla_signature
+
+            handler = _xla_signature.handler(direction)
+            name = f"{_PREFIX}compiled_signature_{direction}"
+            jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler.ctypes), platform="cpu", api_version=1)
+            _TARGETS.append(handler)
+        except Exception:                    # noqa: BLE001 -- no compiler, no FFI: the Python handler
+            name = None
+        _COMPILED[direction] = name
+    return _COMPILED[direction]
+
+
+def _signature_compiled(params: dict, dtype):
+    """``(forward, backward)``: :func:`_host_call`'s ``compiled`` choosers for :func:`signature`'s calls.
+
+    A call goes to a compiled handler where :func:`roughpaths._xla_signature.plan` covers its paths'
+    ``(n, d, depth)`` and the paths traced (the batch axes that are not ``vmap``'s) are at most its
+    ``most``; the handler checks the rest (``vmap``'s axes, the values) when it runs, and hands what it
+    does not take to the Python handler.
+    """
+    depth = params["depth"]
+    if type(depth) is not int:
+        return None
+
+    def chooser(direction):
+        def choose(x, *rest):
+            from roughpaths import _xla_signature as xs
+
+            if x.ndim < 2:
+                return None
+            n, d = x.shape[-2:]
+            most = xs.plan(n, d, depth)
+            if not 1 <= math.prod(x.shape[:-2]) <= most:
+                return None
+            target = _compiled_target(direction)
+            if target is None:
+                return None
+            try:
+                kernels = xs.kernels(d, depth, direction == "backward")
+            except Exception:                # noqa: BLE001 -- the kernels did not compile: the Python handler
+                return None
+            return target, lambda fallback: {xs.ATTRIBUTE: xs.parameters(fallback, d, depth, most, kernels)}
+        return choose
+
+    return chooser("forward"), chooser("backward")
 
 
 def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
@@ -145,6 +218,12 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
     >>> jax.grad(lambda a: square(a).sum())(jnp.array([3.0]))
     Array([6.], dtype=float32)
     """
+    return _differentiable(forward, vjp, out_shape, names, core)
+
+
+def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled=None):
+    """:func:`differentiable`, whose host calls may go to compiled handlers: ``compiled(params, dtype)`` gives the
+    choosers (forward, backward) of :func:`_host_call`'s ``compiled``, or ``None``."""
 
     def build(params: dict, dtype, register: bool = True):
         def forward_host(*arrs):
@@ -166,7 +245,9 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
             grads = tuple(vjp(*arrays, g, **params))
             return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
 
-        forward_call, backward_call = _host_call(forward_host, register), _host_call(backward_host, register)
+        hooks = compiled(params, dtype) if compiled is not None and register else None
+        forward_call = _host_call(forward_host, register, hooks[0] if hooks else None)
+        backward_call = _host_call(backward_host, register, hooks[1] if hooks else None)
 
         @jax.custom_vjp
         def f(*args):
@@ -213,10 +294,10 @@ def _paths_core(cores, name="paths"):
     return d
 
 
-_signature = differentiable(lambda x, depth: _rp.signature(x, depth),
-                            lambda x, g, depth: _rp.signature_vjp(x, depth, g),
-                            lambda batch, cores, depth: batch + (_rp.sigdim(_paths_core(cores), depth),),
-                            names=("paths",), core=(2,))
+_signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
+                             lambda x, g, depth: _rp.signature_vjp(x, depth, g),
+                             lambda batch, cores, depth: batch + (_rp.sigdim(_paths_core(cores), depth),),
+                             ("paths",), (2,), _signature_compiled)
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
                                lambda batch, cores, depth: batch + (_rp.logsigdim(_paths_core(cores), depth),),

@@ -444,7 +444,8 @@ def block_units(d: int, m: int):
     units ``lo..hi-1`` into ``part`` (units, sigdim).
 
     Unit ``u`` covers points ``ulo[u]..uhi[u]`` of path ``ub[u]``. The same bits as
-    :func:`~roughpaths.signatures._lanes.scalar_units`.
+    :func:`~roughpaths.signatures._lanes.scalar_units`. Each variant's compiled symbols carry its key
+    (:func:`roughpaths._variants._named`): :mod:`roughpaths._xla_signature` finds the kernel by its name.
     """
     return _block_units_kernel(*block_key(d, m))
 

@@ -13,6 +13,7 @@ broadcasting, ``check_grads``, jit/vmap, gradient steps).
 from __future__ import annotations
 
 import importlib.util
+import math
 import os
 import re
 import subprocess
@@ -226,3 +227,109 @@ def test_host_functions_get_fresh_views_of_the_buffers(x64):
     g = jax.jit(lambda a: f(a))
     for _ in range(3):
         np.testing.assert_allclose(np.asarray(g(x)), np.asarray(x).sum(axis=-1), rtol=1e-12)
+
+
+# ------------------------------------------------------------------ compiled handlers of the signature
+def _calls():
+    from roughpaths import _xla_signature
+    return _xla_signature.CALLS.copy()
+
+
+def _step(depth):
+    """A jitted value and gradient of <signature(x, depth), G> (the forward and the backward call)."""
+    return jax.jit(jax.value_and_grad(lambda p, g: jnp.sum(rpj.signature(p, depth) * g)))
+
+
+# paths smaller than their signature (run reversed in time) and larger (30 x 3, 40 x 1: the layout permuted);
+# kernel variants that tools/warm_kernels.py --more compiles (one-unit gradients of d = 1, 3, 4, 6, 7)
+@pytest.mark.parametrize("shape, depth", [((8, 3), 3), ((1, 8, 3), 3), ((2, 5, 3), 4), ((2, 30, 3), 3),
+                                          ((2, 40, 1), 3), ((1, 2, 1), 5), ((3, 6, 4), 5), ((2, 1, 6, 6), 4),
+                                          ((1, 9, 7), 3)])
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_compiled_handlers_give_the_numpy_bits(shape, depth, dtype):
+    """Where the compiled handlers run (paths the numpy API runs as single work units; the counter says they
+    did), the signature and its gradient are the numpy API's to the bit (float64), or its results rounded to
+    float32, under jit, eagerly and under vmap (whose axis the handler meets at run time)."""
+    old = jax.config.read("jax_enable_x64")
+    jax.config.update("jax_enable_x64", dtype == "float64")
+    try:
+        x = _paths(shape, seed=21).astype(dtype)
+        G = np.random.default_rng(22).standard_normal(shape[:-2] + (rp.sigdim(shape[-1], depth),)).astype(dtype)
+        want = rp.signature(x.astype(np.float64), depth).astype(dtype)
+        want_g = rp.signature_vjp(x.astype(np.float64), depth, G.astype(np.float64)).astype(dtype)
+        before = _calls()
+        value, grad = _step(depth)(x, G)
+        assert np.array_equal(np.asarray(grad), want_g) and grad.dtype == dtype
+        assert np.array_equal(np.asarray(rpj.signature(x, depth)), want)
+        assert np.array_equal(np.asarray(jax.jit(lambda p: rpj.signature(p, depth))(x)), want)
+        assert np.all(_calls() - before == [3, 1]), "the compiled handlers were not called"
+        if len(shape) > 2:
+            before = _calls()
+            per_path = jax.vmap(jax.grad(lambda p, g: jnp.sum(rpj.signature(p, depth) * g)))
+            assert np.array_equal(np.asarray(jax.jit(jax.vmap(lambda p: rpj.signature(p, depth)))(x)), want)
+            assert np.array_equal(np.asarray(jax.jit(per_path)(x, G)), want_g)
+            from roughpaths._xla_signature import plan
+            if math.prod(shape[:-2]) <= plan(*shape[-2:], depth):     # (not where the numpy API runs lanes)
+                assert np.all(_calls() - before == [1, 1])          # (grad alone: XLA drops the unused forward)
+    finally:
+        jax.config.update("jax_enable_x64", old)
+
+
+def test_what_the_compiled_handlers_leave_gives_the_numpy_values(x64):
+    """Calls the compiled handlers do not take (more paths than the numpy API runs one at a time, found at trace
+    time or, under vmap, at run time; depth 2; d = 8) go to the Python handler: the same values."""
+    cases = [(_paths((5, 8, 3)), 3, jax.jit), (_paths((8, 3)), 2, jax.jit), (_paths((1, 6, 8)), 3, jax.jit),
+             (_paths((6, 8, 3)), 3, lambda f: jax.jit(jax.vmap(f)))]
+    for x, depth, wrap in cases:
+        before = _calls()
+        got = wrap(lambda p: rpj.signature(p, depth))(x)
+        assert np.array_equal(np.asarray(got), rp.signature(x, depth))
+        assert np.all(_calls() == before)
+
+
+@pytest.mark.parametrize("where", ["a point", "the cotangent"])
+def test_compiled_handlers_leave_errors_to_the_numpy_api(x64, where):
+    """A NaN that the numpy API refuses is refused with its message (the compiled handler hands the call on)."""
+    x, G = _paths((8, 3), seed=23), np.ones(rp.sigdim(3, 3))
+    if where == "a point":
+        x[3, 1] = np.nan
+    else:
+        G[3] = np.nan
+    expected = ("paths contains 1 non-finite value" if where == "a point"
+                else "grad_output contains 1 non-finite value")
+    with pytest.raises(Exception, match=expected):
+        jax.block_until_ready(_step(3)(x, G))
+    if where == "a point":
+        with pytest.raises(Exception, match=expected):
+            jax.block_until_ready(rpj.signature(x, 3))
+    x[3] = np.inf
+    with pytest.raises(Exception, match="non-finite"):
+        jax.block_until_ready(_step(3)(x, np.ones(rp.sigdim(3, 3))))
+
+
+def test_a_compiled_handler_without_its_parameters_returns_an_error():
+    """A call of a compiled handler without (or with another) attribute is refused with an XLA error, not a crash:
+    without the parameters there is no Python handler to hand it to."""
+    target = rpj._compiled_target("forward")
+    assert target is not None
+    x = jnp.asarray(_paths((8, 3)), dtype=jnp.float32)
+    result = jax.ShapeDtypeStruct((rp.sigdim(3, 3),), jnp.float32)
+    for attributes in ({}, {"other": np.zeros(7, dtype=np.int64)}, {"roughpaths": np.zeros(3, dtype=np.int64)}):
+        with pytest.raises(Exception, match="compiled signature handler without its parameters"):
+            jax.block_until_ready(jax.ffi.ffi_call(target, result)(x, **attributes))
+
+
+def test_kernel_variants_have_their_own_symbols():
+    """The compiled handlers call a kernel by the address of its symbol, looked up by name: the variants of one
+    kernel factory must not share a name (two variants compiled in two processes and loaded from numba's cache
+    did, and the lookup found the other variant: a write past the signature, then a crash)."""
+    from roughpaths import _xla_signature
+    from roughpaths.signatures import _blocked
+
+    addresses = {key: _xla_signature.kernel_address(_blocked._block_units_kernel(*key), _xla_signature.BLOCK_ARGS)
+                 for key in [(0, 0, False), (6, 4, True), (4, 0, False)]}
+    assert len(set(addresses.values())) == 3
+    names = {key: _blocked._block_units_kernel(*key).overloads[_xla_signature.BLOCK_ARGS].fndesc.llvm_func_name
+             for key in addresses}
+    assert len(set(names.values())) == 3
+    assert _xla_signature.kernels(7, 3, False)[0] == addresses[0, 0, False]
