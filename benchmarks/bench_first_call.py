@@ -36,7 +36,7 @@ FAMILIES = {
     "torch step (sig depth 3)": ("sig torch", "t = torch.tensor(x, requires_grad=True)\n"
                                               "rt.signature(t, 3).sum().backward()"),
     "jax step (sig depth 3)": ("sig jax", "jax.grad(lambda a: rj.signature(a, 3).sum())(x)"),
-    # one short path: the compiled XLA handlers of roughpaths.jax (roughpaths._xla_signature) take it
+    # one short path: the compiled XLA handlers of roughpaths.jax (roughpaths.signatures.xla_handlers) take it
     "jax step, one path (depth 3)": ("sig jax", "jax.grad(lambda a: rj.signature(a, 3).sum())(x[0, :8])"),
     "signature_coefficients (words)": ("sig", "rp.signature_coefficients(x, [(0, 1), (2, 0, 1), (1, 1, 2, 0)])"),
     "signature kernel + gram": ("sig", "rp.signature_kernel(x[:4], x[4:8]); "

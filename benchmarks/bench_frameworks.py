@@ -21,7 +21,7 @@ after an untimed call of the same function. "ratio" is ours / peer (below 1: our
 3. JAX: a jitted ``value_and_grad`` of ``sum(roughpaths.jax.signature(x, 3) * G)`` (two XLA FFI custom
    calls) against the bare numpy calls and against pysiglib's JAX API (its own XLA FFI custom calls
    into compiled C++) where it loads, at a tiny and a moderate size. The tiny one (one path of 8
-   points) runs in the compiled handlers of ``roughpaths._xla_signature`` (the numpy API's kernels
+   points) runs in the compiled handlers of ``roughpaths.signatures.xla_handlers`` (the numpy API's kernels
    called from numba C callbacks that read XLA's call frame), the others in the Python handler of
    ``roughpaths._xla_ffi`` (the numpy API called from Python). "host floor" is the same program through
    ``roughpaths.jax.differentiable`` with Python host functions that only allocate their (zero)

@@ -25,7 +25,7 @@ def _named(kernel, key: tuple):
     numba names a compiled function's symbols after its qualified name and a counter of the compiling
     process, and the variants of one factory share a qualified name: two variants compiled in two
     processes and loaded from the cache into one can define the same symbol, and a lookup of the symbol by
-    name (``library.get_pointer_to_function``, which :mod:`roughpaths._xla_signature` uses to call a kernel
+    name (``library.get_pointer_to_function``, which :mod:`roughpaths.signatures.xla_handlers` uses to call a kernel
     by its address) may then find the other variant. With the key in the name, the symbols of different
     variants differ. (numba's cache files keep the name the dispatcher was made with.)
     """

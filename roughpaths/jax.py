@@ -6,7 +6,7 @@ forward and backward passes are host calls of the library's numpy API and its ve
 product (the same pairs as :mod:`roughpaths.torch`); there is no second implementation. On the CPU
 backend a host call is an XLA FFI custom call (``jax.ffi.ffi_call``) of a handler made with
 :mod:`ctypes` (``roughpaths._xla_ffi``), which wraps XLA's buffers as numpy arrays and calls the numpy
-function; small :func:`signature` calls go to compiled handlers instead (``roughpaths._xla_signature``:
+function; small :func:`signature` calls go to compiled handlers instead (``roughpaths.signatures.xla_handlers``:
 numba C callbacks that read XLA's call frame and run the numpy API's own compiled kernels, the same
 bits; see **Cost**); elsewhere, or where a handler cannot be registered, a :func:`jax.pure_callback`.
 They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
@@ -28,7 +28,7 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
   2-core machine, against pysiglib's XLA FFI calls into compiled C++ timed in the same process
   (``benchmarks/bench_frameworks.py`` prints the same comparison; medians of 11 interleaved pairs, two
   runs): one path of 8 points in d = 3 at depth 3, 0.021-0.023 against 0.017-0.018 ms (1.24-1.27x).
-  Such calls go to the compiled handlers (``roughpaths._xla_signature``): paths the numpy API runs as
+  Such calls go to the compiled handlers (``roughpaths.signatures.xla_handlers``): paths the numpy API runs as
   single work units (depth >= 3, d <= 7, up to a few hundred points) and at most as many as it runs
   one at a time (2 at d <= 3; any number where the signature is too large for its lanes), float32 or
   float64; they hand every other call, and every NaN or inf, to the Python handler. Through the
@@ -136,14 +136,14 @@ _COMPILED: dict = {}
 
 
 def _compiled_target(direction: str):
-    """The XLA target name of the compiled ``direction`` signature handler (:mod:`roughpaths._xla_signature`),
+    """The XLA target name of the compiled ``direction`` signature handler (:mod:`roughpaths.signatures.xla_handlers`),
     compiled (or loaded from numba's cache) and registered on first use; ``None`` if that fails."""
     if direction not in _COMPILED:
         name = None
         try:
-            from roughpaths import _xla_signature
+            from roughpaths.signatures import xla_handlers
 
-            handler = _xla_signature.handler(direction)
+            handler = xla_handlers.handler(direction)
             name = f"{_PREFIX}compiled_signature_{direction}"
             jax.ffi.register_ffi_target(name, jax.ffi.pycapsule(handler.ctypes), platform="cpu", api_version=1)
             _TARGETS.append(handler)
@@ -156,7 +156,7 @@ def _compiled_target(direction: str):
 def _signature_compiled(params: dict, dtype):
     """``(forward, backward)``: :func:`_host_call`'s ``compiled`` choosers for :func:`signature`'s calls.
 
-    A call goes to a compiled handler where :func:`roughpaths._xla_signature.plan` covers its paths'
+    A call goes to a compiled handler where :func:`roughpaths.signatures.xla_handlers.plan` covers its paths'
     ``(n, d, depth)`` and the paths traced (the batch axes that are not ``vmap``'s) are at most its
     ``most``; the handler checks the rest (``vmap``'s axes, the values) when it runs, and hands what it
     does not take to the Python handler.
@@ -167,7 +167,7 @@ def _signature_compiled(params: dict, dtype):
 
     def chooser(direction):
         def choose(x, *rest):
-            from roughpaths import _xla_signature as xs
+            from roughpaths.signatures import xla_handlers as xs
 
             if x.ndim < 2:
                 return None

@@ -66,7 +66,7 @@ def warm() -> None:
 def warm_more_signatures() -> None:
     """For the test suite (``--more``): lone, wide (d = 6) and long chunked paths, the rough-path signature and
     its gradient, the tensor-algebra kernels, the p-variation and the compiled XLA handlers of
-    :mod:`roughpaths.jax` (``roughpaths._xla_signature``: 2-3 s of CPU; they import no jax), which the tests
+    :mod:`roughpaths.jax` (``roughpaths.signatures.xla_handlers``: 2-3 s of CPU; they import no jax), which the tests
     reach."""
     import roughpaths as rp
 
@@ -90,10 +90,10 @@ def warm_more_signatures() -> None:
     rp.tensor_exp(z, dim=3)
     rp.lyndon_coordinates(z, dim=3)
     rp.p_variation(lone, 2.5)
-    from roughpaths import _xla_signature                   # roughpaths.jax's compiled handlers (numba only)
+    from roughpaths.signatures import xla_handlers                   # roughpaths.jax's compiled handlers (numba only)
 
     for direction in ("forward", "backward"):
-        _xla_signature.handler(direction)
+        xla_handlers.handler(direction)
 
 
 def warm_more_variants() -> None:

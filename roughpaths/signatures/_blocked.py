@@ -445,7 +445,7 @@ def block_units(d: int, m: int):
 
     Unit ``u`` covers points ``ulo[u]..uhi[u]`` of path ``ub[u]``. The same bits as
     :func:`~roughpaths.signatures._lanes.scalar_units`. Each variant's compiled symbols carry its key
-    (:func:`roughpaths._variants._named`): :mod:`roughpaths._xla_signature` finds the kernel by its name.
+    (:func:`roughpaths._variants._named`): :mod:`roughpaths.signatures.xla_handlers` finds the kernel by its name.
     """
     return _block_units_kernel(*block_key(d, m))
 

@@ -262,7 +262,7 @@ def sig_vjp_units(d: int):
     """The one-unit backward kernel for alphabet size ``d`` (compiled on first use, without the GIL):
     ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)`` writes the cotangents of the
     segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d). Each variant's compiled symbols carry its
-    key (:func:`roughpaths._variants._named`): :mod:`roughpaths._xla_signature` finds the kernel by its name."""
+    key (:func:`roughpaths._variants._named`): :mod:`roughpaths.signatures.xla_handlers` finds the kernel by its name."""
     return _sig_vjp_units_kernel(step_key(d), vjp_key(d))
 
 

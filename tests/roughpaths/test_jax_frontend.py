@@ -231,8 +231,8 @@ def test_host_functions_get_fresh_views_of_the_buffers(x64):
 
 # ------------------------------------------------------------------ compiled handlers of the signature
 def _calls():
-    from roughpaths import _xla_signature
-    return _xla_signature.CALLS.copy()
+    from roughpaths.signatures import xla_handlers
+    return xla_handlers.CALLS.copy()
 
 
 def _step(depth):
@@ -268,7 +268,7 @@ def test_compiled_handlers_give_the_numpy_bits(shape, depth, dtype):
             per_path = jax.vmap(jax.grad(lambda p, g: jnp.sum(rpj.signature(p, depth) * g)))
             assert np.array_equal(np.asarray(jax.jit(jax.vmap(lambda p: rpj.signature(p, depth)))(x)), want)
             assert np.array_equal(np.asarray(jax.jit(per_path)(x, G)), want_g)
-            from roughpaths._xla_signature import plan
+            from roughpaths.signatures.xla_handlers import plan
             if math.prod(shape[:-2]) <= plan(*shape[-2:], depth):     # (not where the numpy API runs lanes)
                 assert np.all(_calls() - before == [1, 1])          # (grad alone: XLA drops the unused forward)
     finally:
@@ -315,7 +315,7 @@ def test_a_compiled_handler_without_its_parameters_returns_an_error():
     x = jnp.asarray(_paths((8, 3)), dtype=jnp.float32)
     result = jax.ShapeDtypeStruct((rp.sigdim(3, 3),), jnp.float32)
     for attributes in ({}, {"other": np.zeros(7, dtype=np.int64)}, {"roughpaths": np.zeros(3, dtype=np.int64)}):
-        with pytest.raises(Exception, match="compiled signature handler without its parameters"):
+        with pytest.raises(Exception, match="compiled handler without its parameters"):
             jax.block_until_ready(jax.ffi.ffi_call(target, result)(x, **attributes))
 
 
@@ -323,13 +323,13 @@ def test_kernel_variants_have_their_own_symbols():
     """The compiled handlers call a kernel by the address of its symbol, looked up by name: the variants of one
     kernel factory must not share a name (two variants compiled in two processes and loaded from numba's cache
     did, and the lookup found the other variant: a write past the signature, then a crash)."""
-    from roughpaths import _xla_signature
+    from roughpaths.signatures import xla_handlers
     from roughpaths.signatures import _blocked
 
-    addresses = {key: _xla_signature.kernel_address(_blocked._block_units_kernel(*key), _xla_signature.BLOCK_ARGS)
+    addresses = {key: xla_handlers.kernel_address(_blocked._block_units_kernel(*key), xla_handlers.BLOCK_ARGS)
                  for key in [(0, 0, False), (6, 4, True), (4, 0, False)]}
     assert len(set(addresses.values())) == 3
-    names = {key: _blocked._block_units_kernel(*key).overloads[_xla_signature.BLOCK_ARGS].fndesc.llvm_func_name
+    names = {key: _blocked._block_units_kernel(*key).overloads[xla_handlers.BLOCK_ARGS].fndesc.llvm_func_name
              for key in addresses}
     assert len(set(names.values())) == 3
-    assert _xla_signature.kernels(7, 3, False)[0] == addresses[0, 0, False]
+    assert xla_handlers.kernels(7, 3, False)[0] == addresses[0, 0, False]

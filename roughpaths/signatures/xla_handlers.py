@@ -1,4 +1,4 @@
-"""Compiled XLA FFI handlers of the signature and its VJP: :mod:`roughpaths.jax`'s fast path (private).
+"""Compiled XLA FFI handlers of the signature and its VJP: :mod:`roughpaths.jax`'s fast path (not a user API).
 
 :mod:`roughpaths._xla_ffi` runs every host call of :mod:`roughpaths.jax` in Python (the frame read
 with :mod:`ctypes`, the buffers wrapped as numpy arrays, the numpy API called): about 0.04 ms of
@@ -23,7 +23,7 @@ one-unit kernels on XLA's buffers:
 * **Per-process addresses at run time**: a cached ``cfunc`` cannot hold this process's addresses, so
   the Python handler's, the kernels' (:func:`kernels`) and that of :data:`CALLS`, with ``d``, the depth
   and ``most``, are one int64 array attribute of the custom call (:data:`ATTRIBUTE`), read from the
-  frame. The kernels are called with numba's own calling convention (:func:`_native_call`) and the
+  frame. The kernels are called with numba's own calling convention (:func:`roughpaths._xla_native.native_call`) and the
   argument types the numpy API calls them with (:data:`BLOCK_ARGS`, :data:`VJP_ARGS`), so both share one
   compiled function and the handlers do not compile the kernels again. The target names of
   :mod:`roughpaths.jax` are unique to the process, so a program compiled in another process (jax's
@@ -39,8 +39,9 @@ one-unit kernels on XLA's buffers:
   both dominated by the one-unit gradient kernel, about 12 s); the 16-path "jax step" does not reach
   the handlers (8.6 s against 8.7 s).
 
-The frame layout is XLA FFI API version 0.1's (``xla/ffi/api/c_api.h``), as in :mod:`roughpaths._xla_ffi`.
-This module imports neither jax nor any framework.
+The frame is read with :mod:`roughpaths._xla_native` (XLA FFI API version 0.1's layout). This module imports neither
+jax nor any framework; it lives beside the kernels it runs (a module of :mod:`roughpaths.signatures`, not exported by
+it), and :mod:`roughpaths.jax` imports it where it registers its targets.
 """
 
 from __future__ import annotations
@@ -48,14 +49,15 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from llvmlite import ir
 from numba import cfunc, njit, types
-from numba.core import cgutils
 from numba.extending import intrinsic
 
-from ._threads import ranges
-from .signatures import _blocked, _vjp
-from .signatures._engine import _WIDE, _horner_chunks, _split_units
+from .._threads import ranges
+from .._xla_native import (ARRAY_ATTR, ATTRS, ATTRS_SIZE, EXECUTE, F64, FRAME_SIZE, HANDLER, JIT, METADATA_EXTENSION,
+                           METADATA_SIZE, S64, address, buffer, call, error, f32p, f64p, i32, i64, kernel_address,
+                           native_call, set_i32, set_i64, u8, voidptr)
+from . import _blocked, _vjp
+from ._engine import _WIDE, _horner_chunks, _split_units
 
 __all__ = ["ATTRIBUTE", "CALLS", "handler", "plan", "kernels", "parameters"]
 
@@ -69,201 +71,54 @@ _BLOCK, _VJP = 5, 6                             # the kernels' entries
 #: clock: the tests read it to see that the compiled path was taken).
 CALLS = np.zeros(2, dtype=np.int64)
 
-_FRAME_SIZE, _ARGS_SIZE, _ATTRS_SIZE, _BUFFER_SIZE = 168, 40, 48, 48
-_ARGS, _RETS, _ATTRS = 40, 80, 120             # offsets of XLA_FFI_Args, XLA_FFI_Rets, XLA_FFI_Attrs in the frame
-_BUFFER_KIND, _ARRAY_ATTR = 1, 1                # XLA_FFI_ArgType_BUFFER (= RetType), XLA_FFI_AttrType_ARRAY
-_F32, _F64, _S64 = 11, 12, 5                    # XLA_FFI_DataType codes
-_METADATA_EXTENSION, _METADATA_SIZE, _EXECUTE = 1, 36, 3
-_INTERNAL = 13
-_ERROR_ARGS_SIZE = 32                           # XLA_FFI_Error_Create_Args
-_ERROR_CREATE = 48                              # offset of XLA_FFI_Error_Create in XLA_FFI_Api
-_MESSAGE = ("roughpaths: an XLA FFI call of a compiled signature handler without its parameters "
-            f"(an int64 array attribute {ATTRIBUTE!r} of {_PARAMS} entries); this is a bug of roughpaths.jax")
-
-_HANDLER = types.voidptr(types.voidptr)          # XLA_FFI_Error* (XLA_FFI_CallFrame*)
-
 #: The most floats (paths and signatures) a compiled call handles; larger calls go to the Python handler,
 #: whose memory check they then meet (the numpy API checks requests of 64 MiB and more).
 _MOST_FLOATS = 1 << 21
 
 
-# ------------------------------------------------------------------------------ raw memory
-@intrinsic
-def _i64(typingctx, addr):
-    """The int64 at address ``addr``."""
-    def codegen(context, builder, sig, args):
-        return builder.load(builder.inttoptr(args[0], ir.IntType(64).as_pointer()))
-    return types.int64(types.int64), codegen
-
-
-@intrinsic
-def _i32(typingctx, addr):
-    """The int32 at address ``addr``, as an int64."""
-    def codegen(context, builder, sig, args):
-        v = builder.load(builder.inttoptr(args[0], ir.IntType(32).as_pointer()))
-        return builder.sext(v, ir.IntType(64))
-    return types.int64(types.int64), codegen
-
-
-@intrinsic
-def _u8(typingctx, addr):
-    """The byte at address ``addr``, as an int64."""
-    def codegen(context, builder, sig, args):
-        v = builder.load(builder.inttoptr(args[0], ir.IntType(8).as_pointer()))
-        return builder.zext(v, ir.IntType(64))
-    return types.int64(types.int64), codegen
-
-
-@intrinsic
-def _set_i64(typingctx, addr, value):
-    """Store the int64 ``value`` at ``addr``."""
-    def codegen(context, builder, sig, args):
-        builder.store(args[1], builder.inttoptr(args[0], ir.IntType(64).as_pointer()))
-        return context.get_dummy_value()
-    return types.none(types.int64, types.int64), codegen
-
-
-@intrinsic
-def _set_i32(typingctx, addr, value):
-    """Store ``value`` as an int32 at ``addr``."""
-    def codegen(context, builder, sig, args):
-        builder.store(builder.trunc(args[1], ir.IntType(32)), builder.inttoptr(args[0], ir.IntType(32).as_pointer()))
-        return context.get_dummy_value()
-    return types.none(types.int64, types.int64), codegen
-
-
-def _pointer_intrinsic(numba_type, llvm_type):
-    @intrinsic
-    def pointer(typingctx, addr):
-        def codegen(context, builder, sig, args):
-            return builder.inttoptr(args[0], llvm_type.as_pointer())
-        return types.CPointer(numba_type)(types.int64), codegen
-    return pointer
-
-
-_f64p = _pointer_intrinsic(types.float64, ir.DoubleType())
-_f32p = _pointer_intrinsic(types.float32, ir.FloatType())
-
-
-@intrinsic
-def _address(typingctx, p):
-    """A ``void*`` as an int64."""
-    def codegen(context, builder, sig, args):
-        return builder.ptrtoint(args[0], ir.IntType(64))
-    return types.int64(types.voidptr), codegen
-
-
-@intrinsic
-def _voidptr(typingctx, addr):
-    """An int64 as a ``void*`` (the handler's result)."""
-    def codegen(context, builder, sig, args):
-        return builder.inttoptr(args[0], ir.IntType(8).as_pointer())
-    return types.voidptr(types.int64), codegen
-
-
-@intrinsic
-def _call(typingctx, fn, arg):
-    """``fn(arg)`` for the address ``fn`` of a C function ``void* (void*)``: an XLA FFI handler, or
-    ``XLA_FFI_Error_Create``."""
-    def codegen(context, builder, sig, args):
-        vp = ir.IntType(8).as_pointer()
-        f = builder.inttoptr(args[0], ir.FunctionType(vp, [vp]).as_pointer())
-        return builder.ptrtoint(builder.call(f, [builder.inttoptr(args[1], vp)]), ir.IntType(64))
-    return types.int64(types.int64, types.int64), codegen
-
-
-@intrinsic
-def _create_error(typingctx, create):
-    """``create(&args)`` for the address ``create`` of XLA's ``XLA_FFI_Error_Create``: an ``INTERNAL`` error saying
-    :data:`_MESSAGE` (a constant string of the compiled code); the arguments struct lives on the stack."""
-    def codegen(context, builder, sig, args):
-        i64 = ir.IntType(64)
-        fields = cgutils.alloca_once(builder, i64, size=_ERROR_ARGS_SIZE // 8)
-        message = builder.ptrtoint(context.insert_const_string(builder.module, _MESSAGE), i64)
-        for k, value in enumerate((ir.Constant(i64, _ERROR_ARGS_SIZE), ir.Constant(i64, 0), message,
-                                   ir.Constant(i64, _INTERNAL))):         # struct_size, extension_start, message, errc
-            builder.store(value, builder.gep(fields, [ir.Constant(i64, k)]))
-        vp = ir.IntType(8).as_pointer()
-        fn = builder.inttoptr(args[0], ir.FunctionType(vp, [vp]).as_pointer())
-        return builder.ptrtoint(builder.call(fn, [builder.bitcast(fields, vp)]), i64)
-    return types.int64(types.int64), codegen
-
-
 # ------------------------------------------------------------------------------ the call frame
-_JIT = dict(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy")
-
-
-@njit(**_JIT)
+@njit(**JIT)
 def _start(frame):
     """``(status, parameters)``: status 0 to compute (``parameters``: the address of :data:`ATTRIBUTE`'s entries),
     1 done (XLA's metadata query, answered: API version 0.1, no traits; or another stage than execution), 2 an
     error (a frame or metadata struct too small, or a frame without this module's parameters)."""
-    if _i64(frame) < _FRAME_SIZE:
+    if i64(frame) < FRAME_SIZE:
         return 2, 0
-    ext = _i64(frame + 8)
-    if ext != 0 and _i32(ext + 8) == _METADATA_EXTENSION:
-        md = _i64(ext + 24)
-        if md == 0 or _i64(md) < _METADATA_SIZE:
+    ext = i64(frame + 8)
+    if ext != 0 and i32(ext + 8) == METADATA_EXTENSION:
+        md = i64(ext + 24)
+        if md == 0 or i64(md) < METADATA_SIZE:
             return 2, 0
-        _set_i64(md + 8, 24)                        # XLA_FFI_Api_Version: struct_size, extension_start, 0, 1
-        _set_i64(md + 16, 0)
-        _set_i32(md + 24, 0)
-        _set_i32(md + 28, 1)
-        _set_i32(md + 32, 0)                        # traits: none
+        set_i64(md + 8, 24)                        # XLA_FFI_Api_Version: struct_size, extension_start, 0, 1
+        set_i64(md + 16, 0)
+        set_i32(md + 24, 0)
+        set_i32(md + 28, 1)
+        set_i32(md + 32, 0)                        # traits: none
         return 1, 0
-    if _i32(frame + 32) != _EXECUTE:
+    if i32(frame + 32) != EXECUTE:
         return 1, 0
-    a = frame + _ATTRS                              # one attribute: ATTRIBUTE, an int64 array of _PARAMS entries
-    if _i64(a) < _ATTRS_SIZE or _i64(a + 16) != 1:
+    a = frame + ATTRS                              # one attribute: ATTRIBUTE, an int64 array of _PARAMS entries
+    if i64(a) < ATTRS_SIZE or i64(a + 16) != 1:
         return 2, 0
-    kinds, names, attrs = _i64(a + 24), _i64(a + 32), _i64(a + 40)
-    if kinds == 0 or names == 0 or attrs == 0 or _i32(kinds) != _ARRAY_ATTR:
+    kinds, names, attrs = i64(a + 24), i64(a + 32), i64(a + 40)
+    if kinds == 0 or names == 0 or attrs == 0 or i32(kinds) != ARRAY_ATTR:
         return 2, 0
-    span = _i64(names)
-    if span == 0 or _i64(span) == 0 or _i64(span + 8) != len(_NAME):
+    span = i64(names)
+    if span == 0 or i64(span) == 0 or i64(span + 8) != len(_NAME):
         return 2, 0
     for k in range(len(_NAME)):
-        if _u8(_i64(span) + k) != _NAME[k]:
+        if u8(i64(span) + k) != _NAME[k]:
             return 2, 0
-    arr = _i64(attrs)
-    if arr == 0 or _i32(arr) != _S64 or _i64(arr + 8) != _PARAMS:
+    arr = i64(attrs)
+    if arr == 0 or i32(arr) != S64 or i64(arr + 8) != _PARAMS:
         return 2, 0
-    p = _i64(arr + 16)
-    if p == 0 or _i64(p) == 0 or _i64(p + 8 * _BLOCK) == 0:
+    p = i64(arr + 16)
+    if p == 0 or i64(p) == 0 or i64(p + 8 * _BLOCK) == 0:
         return 2, 0
     return 0, p
 
 
-@njit(**_JIT)
-def _error(frame):
-    """An ``INTERNAL`` XLA_FFI_Error saying :data:`_MESSAGE`, made by XLA's ``XLA_FFI_Error_Create`` (0 without
-    an API)."""
-    api = _i64(frame + 16) if _i64(frame) >= 24 else 0
-    if api == 0 or _i64(api + _ERROR_CREATE) == 0:
-        return 0
-    return _create_error(_i64(api + _ERROR_CREATE))
-
-
-@njit(**_JIT)
-def _buffer(frame, rets, i, count):
-    """The address of the XLA_FFI_Buffer ``i`` of the frame's arguments (``rets`` 0) or results (1), or 0 if
-    they are not ``count`` buffers or it is not a non-empty float32 or float64 buffer."""
-    base = frame + (_RETS if rets else _ARGS)
-    if _i64(base) < _ARGS_SIZE or _i64(base + 16) != count:
-        return 0
-    kinds, bufs = _i64(base + 24), _i64(base + 32)
-    if kinds == 0 or bufs == 0 or _i32(kinds + 4 * i) != _BUFFER_KIND:
-        return 0
-    b = _i64(bufs + 8 * i)
-    if b == 0 or _i64(b) < _BUFFER_SIZE or _i64(b + 24) == 0:
-        return 0
-    dtype = _i32(b + 16)
-    if (dtype != _F32 and dtype != _F64) or _i64(b + 32) < 1 or _i64(b + 40) == 0:
-        return 0
-    return b
-
-
-@njit(**_JIT)
+@njit(**JIT)
 def _operands(frame, backward, d, m, most):
     """``(B, n, x, g, out)``: the paths' batch size and points, and the addresses of the buffers of the paths,
     the cotangent (``backward`` only; else 0) and the result; ``B == 0``: not a compiled call.
@@ -271,60 +126,60 @@ def _operands(frame, backward, d, m, most):
     Forward: paths ``(..., n, d)`` in, ``(..., sigdim)`` out; backward: paths and cotangent ``(..., sigdim)`` in,
     ``(..., n, d)`` out; one dtype, the same leading axes, ``B`` and ``n`` within :func:`plan`'s ``most`` and
     :data:`_MOST_FLOATS`."""
-    xb = _buffer(frame, 0, 0, 2 if backward else 1)
-    gb = _buffer(frame, 0, 1, 2) if backward else 0
-    ob = _buffer(frame, 1, 0, 1)
+    xb = buffer(frame, 0, 0, 2 if backward else 1)
+    gb = buffer(frame, 0, 1, 2) if backward else 0
+    ob = buffer(frame, 1, 0, 1)
     if xb == 0 or ob == 0 or (backward and gb == 0):
         return 0, 0, 0, 0, 0
-    dtype, rank = _i32(xb + 16), _i64(xb + 32)
-    xdims, odims = _i64(xb + 40), _i64(ob + 40)
-    if rank < 2 or _i32(ob + 16) != dtype or _i64(ob + 32) != (rank if backward else rank - 1):
+    dtype, rank = i32(xb + 16), i64(xb + 32)
+    xdims, odims = i64(xb + 40), i64(ob + 40)
+    if rank < 2 or i32(ob + 16) != dtype or i64(ob + 32) != (rank if backward else rank - 1):
         return 0, 0, 0, 0, 0
-    if backward and (_i32(gb + 16) != dtype or _i64(gb + 32) != rank - 1):
+    if backward and (i32(gb + 16) != dtype or i64(gb + 32) != rank - 1):
         return 0, 0, 0, 0, 0
     nb = 1
     for k in range(rank - 2):
-        size = _i64(xdims + 8 * k)
-        if _i64(odims + 8 * k) != size or (backward and _i64(_i64(gb + 40) + 8 * k) != size):
+        size = i64(xdims + 8 * k)
+        if i64(odims + 8 * k) != size or (backward and i64(i64(gb + 40) + 8 * k) != size):
             return 0, 0, 0, 0, 0
         nb *= size
-    n = _i64(xdims + 8 * (rank - 2))
+    n = i64(xdims + 8 * (rank - 2))
     dim = 0
     size = 1
     for _ in range(m):
         size *= d
         dim += size
-    if _i64(xdims + 8 * (rank - 1)) != d or d < 1 or m < 3 or n < 2 or nb < 1 or nb > most \
+    if i64(xdims + 8 * (rank - 1)) != d or d < 1 or m < 3 or n < 2 or nb < 1 or nb > most \
             or nb * (n * d + 2 * dim) > _MOST_FLOATS:
         return 0, 0, 0, 0, 0
     if backward:
-        if _i64(_i64(gb + 40) + 8 * (rank - 2)) != dim or _i64(odims + 8 * (rank - 2)) != n \
-                or _i64(odims + 8 * (rank - 1)) != d:
+        if i64(i64(gb + 40) + 8 * (rank - 2)) != dim or i64(odims + 8 * (rank - 2)) != n \
+                or i64(odims + 8 * (rank - 1)) != d:
             return 0, 0, 0, 0, 0
-    elif _i64(odims + 8 * (rank - 2)) != dim:
+    elif i64(odims + 8 * (rank - 2)) != dim:
         return 0, 0, 0, 0, 0
     return nb, n, xb, gb, ob
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _load_paths(b, x, flip):
     """The paths of the buffer at ``b`` into the float64 ``(B, n, d)`` array ``x``, reversed in time and negated with
     ``flip``; whether they are all finite."""
     nb, n, d = x.shape
     finite = True
-    data = _i64(b + 24)
+    data = i64(b + 24)
     for u in range(nb):
         for k in range(n):
             kk = n - 1 - k if flip else k
             for i in range(d):
                 e = (u * n + kk) * d + i
-                v = _f64p(data)[e] if _i32(b + 16) == _F64 else np.float64(_f32p(data)[e])
+                v = f64p(data)[e] if i32(b + 16) == F64 else np.float64(f32p(data)[e])
                 finite &= v - v == 0.0                  # false for NaN and inf
                 x[u, k, i] = -v if flip else v
     return finite
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _reversed(r, k, d):
     """The reversed-layout index, within its level ``k``, of the word at row-major index ``r``
     (:func:`roughpaths.signatures._engine._reversed_to_rowmajor`)."""
@@ -335,35 +190,35 @@ def _reversed(r, k, d):
     return w
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _load_cotangent(b, g, off, d, m):
     """The row-major cotangent of the buffer at ``b`` into the float64 ``(B, sigdim)`` array ``g``, in the kernels'
     reversed layout; whether it is all finite."""
     nb, dim = g.shape
     finite = True
-    data = _i64(b + 24)
+    data = i64(b + 24)
     for k in range(1, m + 1):
         ok = off[k]
         for r in range(off[k + 1] - ok):
             w = ok + _reversed(r, k, d)
             for u in range(nb):
                 e = u * dim + ok + r
-                v = _f64p(data)[e] if _i32(b + 16) == _F64 else np.float64(_f32p(data)[e])
+                v = f64p(data)[e] if i32(b + 16) == F64 else np.float64(f32p(data)[e])
                 finite &= v - v == 0.0
                 g[u, w] = v
     return finite
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _store(b, e, v):
     """``v`` into entry ``e`` of the float32 or float64 buffer at ``b`` (rounded to float32 there)."""
-    if _i32(b + 16) == _F64:
-        _f64p(_i64(b + 24))[e] = v
+    if i32(b + 16) == F64:
+        f64p(i64(b + 24))[e] = v
     else:
-        _f32p(_i64(b + 24))[e] = np.float32(v)
+        f32p(i64(b + 24))[e] = np.float32(v)
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _store_signature(b, part, flipped, off, d, m):
     """The units' signatures (reversed layout; row-major already for flipped paths) into the buffer at ``b``,
     row-major (:func:`roughpaths.signatures._engine._signature_flat`)."""
@@ -376,7 +231,7 @@ def _store_signature(b, part, flipped, off, d, m):
                 _store(b, u * dim + ok + r, part[u, w])
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _store_points(b, gd):
     """The points' cotangent from the increments' ``gd`` ``(B, n - 1, d)`` into the buffer at ``b``, with the
     operations of :func:`roughpaths.signatures.gradients._increments_to_points`: ``(0 + gd[k-1]) - gd[k]``."""
@@ -392,7 +247,7 @@ def _store_points(b, gd):
                 _store(b, (u * (n1 + 1) + k) * d + i, v)
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _layout(nb, n, d, m):
     """``(ub, ulo, uhi, offsets)``: one work unit a path (:func:`roughpaths.signatures._engine._units` with one chunk)
     and :func:`roughpaths.algebra.flat.level_offsets`."""
@@ -421,102 +276,70 @@ BLOCK_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, _I8_1D, types.int64, 
 VJP_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, types.int64, _I8_1D, _F8_2D, _F8_2D, types.int64, types.int64,
             _F8_3D)
 
-
-def _native_call(typingctx, expected, addr, args):
-    """``(signature, codegen)`` of an intrinsic calling the numba-compiled function at ``addr`` (its native entry,
-    numba's calling convention) with ``args`` of the types ``expected``; the result is 0, or 1 if it raised."""
-    if len(args) != len(expected) or any(types.unliteral(a) != e for a, e in zip(args, expected)):
-        return None                             # a typing error at compile time, never a call with other types
-
-    def codegen(context, builder, sig, llargs):
-        fnty = context.call_conv.get_function_type(types.none, expected)
-        fn = builder.inttoptr(llargs[0], fnty.as_pointer())
-        status, _ = context.call_conv.call_function(builder, fn, types.none, expected, llargs[1:])
-        return builder.zext(builder.not_(status.is_ok), ir.IntType(64))
-
-    return types.int64(types.int64, *expected), codegen
-
-
 @intrinsic
 def _block_units(typingctx, addr, x, ub, ulo, uhi, m, off, lo, hi, part):
     """The one-unit signature kernel at ``addr`` (a variant of :func:`roughpaths.signatures._blocked.block_units`)."""
-    return _native_call(typingctx, BLOCK_ARGS, addr, (x, ub, ulo, uhi, m, off, lo, hi, part))
+    return native_call(typingctx, BLOCK_ARGS, addr, (x, ub, ulo, uhi, m, off, lo, hi, part))
 
 
 @intrinsic
 def _vjp_units(typingctx, addr, x, ub, ulo, uhi, nchunks, m, off, part, g_rev, lo, hi, gd):
     """The one-unit VJP kernel at ``addr`` (a variant of :func:`roughpaths.signatures._vjp.sig_vjp_units`)."""
-    return _native_call(typingctx, VJP_ARGS, addr, (x, ub, ulo, uhi, nchunks, m, off, part, g_rev, lo, hi, gd))
+    return native_call(typingctx, VJP_ARGS, addr, (x, ub, ulo, uhi, nchunks, m, off, part, g_rev, lo, hi, gd))
 
 
-def kernel_address(dispatcher, argtypes: tuple) -> int:
-    """The address of ``dispatcher``'s native function for ``argtypes`` (compiled, or loaded from numba's cache,
-    if this process has not run it yet: what the numpy API's first call would compile).
-
-    The symbol is looked up by name in the whole process, so the name must be the variant's own: a function
-    compiled before the variants had their key in their names (:func:`roughpaths._variants._named`), loaded
-    from an older cache, may share its name with another variant, and is refused (``RuntimeError``: the calls
-    stay with the Python handler until numba compiles it again).
-    """
-    dispatcher.compile(argtypes)
-    cres = dispatcher.overloads[argtypes]
-    if cres.fndesc.qualname != dispatcher.py_func.__qualname__ or not cres.fndesc.qualname.endswith("]"):
-        raise RuntimeError(f"{cres.fndesc.qualname} was compiled under another name than its variant's")
-    return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
-
-
-@njit(**_JIT)
+@njit(**JIT)
 def _count(p, k):
     """One more compiled call in :data:`CALLS` ``[k]`` (its address is the parameters' second entry)."""
-    calls = _i64(p + 8)
+    calls = i64(p + 8)
     if calls != 0:
-        _set_i64(calls + 8 * k, _i64(calls + 8 * k) + 1)
+        set_i64(calls + 8 * k, i64(calls + 8 * k) + 1)
 
 
 def _forward(frame_pointer):
     """The forward handler: :func:`roughpaths.signature` of the call's paths into its result buffer."""
-    frame = _address(frame_pointer)
+    frame = address(frame_pointer)
     status, p = _start(frame)
     if status != 0:
-        return _voidptr(0 if status == 1 else _error(frame))
-    d, m = _i64(p + 16), _i64(p + 24)
-    nb, n, xb, _, ob = _operands(frame, np.bool_(False), d, m, _i64(p + 32))   # (one compile for both)
+        return voidptr(0 if status == 1 else error(frame))
+    d, m = i64(p + 16), i64(p + 24)
+    nb, n, xb, _, ob = _operands(frame, np.bool_(False), d, m, i64(p + 32))   # (one compile for both)
     if nb == 0:
-        return _voidptr(_call(_i64(p), frame))         # the Python handler: the numpy API (and its errors)
+        return voidptr(call(i64(p), frame))         # the Python handler: the numpy API (and its errors)
     ub, ulo, uhi, off = _layout(nb, n, d, m)
     flipped = n * d < off[m + 1]                        # S(x)_w = S(-x reversed)_{w*}: row-major out of the kernel
     x = np.empty((nb, n, d))
     part = np.empty((nb, off[m + 1]))
-    if not _load_paths(xb, x, flipped) or _block_units(_i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part):
-        return _voidptr(_call(_i64(p), frame))
+    if not _load_paths(xb, x, flipped) or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part):
+        return voidptr(call(i64(p), frame))
     _store_signature(ob, part, flipped, off, d, m)
     _count(p, 0)
-    return _voidptr(0)
+    return voidptr(0)
 
 
 def _backward(frame_pointer):
     """The backward handler: :func:`roughpaths.signature_vjp` of the call's paths and cotangent into its result
     buffer."""
-    frame = _address(frame_pointer)
+    frame = address(frame_pointer)
     status, p = _start(frame)
     if status != 0:
-        return _voidptr(0 if status == 1 else _error(frame))
-    d, m, vjp = _i64(p + 16), _i64(p + 24), _i64(p + 8 * _VJP)
-    nb, n, xb, gb, ob = _operands(frame, np.bool_(True), d, m, _i64(p + 32))
+        return voidptr(0 if status == 1 else error(frame))
+    d, m, vjp = i64(p + 16), i64(p + 24), i64(p + 8 * _VJP)
+    nb, n, xb, gb, ob = _operands(frame, np.bool_(True), d, m, i64(p + 32))
     if nb == 0 or vjp == 0:
-        return _voidptr(_call(_i64(p), frame))
+        return voidptr(call(i64(p), frame))
     ub, ulo, uhi, off = _layout(nb, n, d, m)
     x = np.empty((nb, n, d))
     g = np.empty((nb, off[m + 1]))
     part = np.empty((nb, off[m + 1]))
     gd = np.zeros((nb, n - 1, d))
     if not _load_paths(xb, x, False) or not _load_cotangent(gb, g, off, d, m) \
-            or _block_units(_i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
+            or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
             or _vjp_units(vjp, x, ub, ulo, uhi, 1, m, off, part, g, 0, nb, gd):
-        return _voidptr(_call(_i64(p), frame))
+        return voidptr(call(i64(p), frame))
     _store_points(ob, gd)
     _count(p, 1)
-    return _voidptr(0)
+    return voidptr(0)
 
 
 _HANDLERS: dict = {}
@@ -528,7 +351,7 @@ def handler(direction: str):
     use."""
     h = _HANDLERS.get(direction)
     if h is None:
-        h = _HANDLERS[direction] = cfunc(_HANDLER, cache=True)(_forward if direction == "forward" else _backward)
+        h = _HANDLERS[direction] = cfunc(HANDLER, cache=True)(_forward if direction == "forward" else _backward)
     return h
 
 
