@@ -53,7 +53,7 @@ from numba import cfunc, njit, types
 from numba.extending import intrinsic
 
 from .._threads import ranges
-from .._xla_native import (ARRAY_ATTR, ATTRS, ATTRS_SIZE, EXECUTE, F64, FRAME_SIZE, HANDLER, JIT, METADATA_EXTENSION,
+from .._xla_native import (ARRAY_ATTR, ATTRS, ATTRS_SIZE, EXECUTE, F64, FRAME_SIZE, HANDLER, METADATA_EXTENSION,
                            METADATA_SIZE, S64, address, buffer, call, error, f32p, f64p, i32, i64, kernel_address,
                            native_call, set_i32, set_i64, u8, voidptr)
 from . import _blocked, _vjp
@@ -77,7 +77,12 @@ _MOST_FLOATS = 1 << 21
 
 
 # ------------------------------------------------------------------------------ the call frame
-@njit(**JIT)
+#: The handlers' helpers are compiled as :mod:`roughpaths._xla_native`'s frame readers are (its ``JIT``; numpy's
+#: error model: no exception paths in code called from XLA).
+_JIT = dict(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy")
+
+
+@njit(**_JIT)
 def _start(frame):
     """``(status, parameters)``: status 0 to compute (``parameters``: the address of :data:`ATTRIBUTE`'s entries),
     1 done (XLA's metadata query, answered: API version 0.1, no traits; or another stage than execution), 2 an
@@ -118,7 +123,7 @@ def _start(frame):
     return 0, p
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _operands(frame, backward, d, m, most):
     """``(B, n, x, g, out)``: the paths' batch size and points, and the addresses of the buffers of the paths,
     the cotangent (``backward`` only; else 0) and the result; ``B == 0``: not a compiled call.
@@ -161,7 +166,7 @@ def _operands(frame, backward, d, m, most):
     return nb, n, xb, gb, ob
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _load_paths(b, x, flip):
     """The paths of the buffer at ``b`` into the float64 ``(B, n, d)`` array ``x``, reversed in time and negated with
     ``flip``; whether they are all finite."""
@@ -179,7 +184,7 @@ def _load_paths(b, x, flip):
     return finite
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _reversed(r, k, d):
     """The reversed-layout index, within its level ``k``, of the word at row-major index ``r``
     (:func:`roughpaths.signatures._engine._reversed_to_rowmajor`)."""
@@ -190,7 +195,7 @@ def _reversed(r, k, d):
     return w
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _load_cotangent(b, g, off, d, m):
     """The row-major cotangent of the buffer at ``b`` into the float64 ``(B, sigdim)`` array ``g``, in the kernels'
     reversed layout; whether it is all finite."""
@@ -209,7 +214,7 @@ def _load_cotangent(b, g, off, d, m):
     return finite
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _store(b, e, v):
     """``v`` into entry ``e`` of the float32 or float64 buffer at ``b`` (rounded to float32 there)."""
     if i32(b + 16) == F64:
@@ -218,7 +223,7 @@ def _store(b, e, v):
         f32p(i64(b + 24))[e] = np.float32(v)
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _store_signature(b, part, flipped, off, d, m):
     """The units' signatures (reversed layout; row-major already for flipped paths) into the buffer at ``b``,
     row-major (:func:`roughpaths.signatures._engine._signature_flat`)."""
@@ -231,7 +236,7 @@ def _store_signature(b, part, flipped, off, d, m):
                 _store(b, u * dim + ok + r, part[u, w])
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _store_points(b, gd):
     """The points' cotangent from the increments' ``gd`` ``(B, n - 1, d)`` into the buffer at ``b``, with the
     operations of :func:`roughpaths.signatures.gradients._increments_to_points`: ``(0 + gd[k-1]) - gd[k]``."""
@@ -247,7 +252,7 @@ def _store_points(b, gd):
                 _store(b, (u * (n1 + 1) + k) * d + i, v)
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _layout(nb, n, d, m):
     """``(ub, ulo, uhi, offsets)``: one work unit a path (:func:`roughpaths.signatures._engine._units` with one chunk)
     and :func:`roughpaths.algebra.flat.level_offsets`."""
@@ -288,7 +293,7 @@ def _vjp_units(typingctx, addr, x, ub, ulo, uhi, nchunks, m, off, part, g_rev, l
     return native_call(typingctx, VJP_ARGS, addr, (x, ub, ulo, uhi, nchunks, m, off, part, g_rev, lo, hi, gd))
 
 
-@njit(**JIT)
+@njit(**_JIT)
 def _count(p, k):
     """One more compiled call in :data:`CALLS` ``[k]`` (its address is the parameters' second entry)."""
     calls = i64(p + 8)
