@@ -5,7 +5,7 @@ index(u) + d^|u| index(w). Pairing <G, S> = sum over words (levels 1..m).
 Backward through S = S_prev ⊗ exp(D) per segment (last to first):
 
 * S_prev = S ⊗ exp(-D) (the same Horner step, nothing of the forward pass stored);
-* then backward through the Horner step itself (:func:`_step_vjp`), which gives both the
+* then backward through the Horner step itself (:func:`_step_vjp_d`), which gives both the
   cotangent of D and G_prev = G ◁ exp(D) for about three Horner steps' work.
 
 :func:`_lcon` / :func:`_rcon` (general contractions) serve the chunk cotangents and the log's
@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .._variants import variants
-from ._lanes import BLOCK, _addto, _axpy, _horner_step, _lane_step_d, mul_inplace, step_key
+from ._lanes import BLOCK, _addto, _axpy, _horner_step_d, _lane_step_d, _wide_step, mul_inplace, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
@@ -89,6 +89,17 @@ def _rcon(x0, g, e, d, m, offsets, out):
 
 @njit(cache=True, inline="always")
 def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
+    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
+
+    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
+    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
+    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
+    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
+    ``gdelta`` (cotangent of delta) are written (levels ``< m`` of ``gprev``: its top level is
+    ``G_m``); ``ga``, ``gb`` are scratch of ``d^m``. The same operations, in the same order, as
+    every lane of :func:`_lane_step_vjp_d`, the dot products in the four sums of :func:`_dot_wide`
+    (one chain of dependent additions measured 3x slower on a lone 4^8 path).
+    """
     for r in range(offsets[m]):                             # levels < m (gprev_m = g_m: never copied)
         gprev[r] = g[r]
     for q in range(d):
@@ -134,49 +145,6 @@ def _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta):
 def vjp_key(d: int) -> int:
     """The compile-time alphabet size of the backward step's variant (0: at run time)."""
     return d if d in (2, 3) else 0
-
-
-@njit(cache=True, inline="always")
-def _step_vjp(s, g, delta, V, d, m, offsets, gprev, tb, ga, gb, gdelta):
-    """Backward through one Horner step ``S_cur = S ⊗ exp(delta)`` (``s`` = S before the step).
-
-    Level ``k`` of the step is ``S_k + B_k`` with ``B_1 = delta/k``, ``T_j = B_j + S_j``,
-    ``B_{j+1} = T_j ⊗ delta / (k - j)``. Per level: recompute the ``T_j`` (kept in ``tb``, at
-    the level offsets), then walk back ``gT_j = (gB_{j+1} ◁ delta)/(k-j)``,
-    ``gdelta += (T_j ▷ gB_{j+1})/(k-j)``. ``gprev <- G ◁ exp(delta)`` (cotangent of S) and
-    ``gdelta`` (cotangent of delta) are written (levels ``< m`` of ``gprev``: its top level is
-    ``G_m``); ``ga``, ``gb`` are scratch of ``d^m``. The same operations, in the same order, as
-    every lane of :func:`_lane_step_vjp_d`, the dot products in the four sums of :func:`_dot_wide`
-    (one chain of dependent additions measured 3x slower on a lone 4^8 path).
-    """
-    if V:                               # V = vjp_key(d), a compile-time constant of the calling kernel
-        _step_vjp_d(s, g, delta, V, m, offsets, gprev, tb, ga, gb, gdelta)
-    else:
-        _step_vjp_d(s, g, delta, d, m, offsets, gprev, tb, ga, gb, gdelta)
-
-
-@njit(cache=True, inline="always")
-def _unit_vjp(x, b, lo, hi, s, g, K, V, d, m, offsets, gd):
-    """Backward over the segments ``lo..hi`` of path ``b``: ``s`` its signature, ``g`` its cotangent."""
-    dim = offsets[m + 1]
-    buf = np.empty(2 * d ** max(m - 1, 1) + d)
-    tb = np.empty(dim)
-    ga = np.empty(d ** m)
-    gb = np.empty(d ** m)
-    gn = np.empty(dim)
-    delta = np.empty(d)
-    neg = np.empty(d)
-    gdelta = np.empty(d)
-    for k in range(hi, lo, -1):
-        for i in range(d):
-            delta[i] = x[b, k, i] - x[b, k - 1, i]
-            neg[i] = -delta[i]
-        _horner_step(s, neg, K, d, m - 1, offsets, buf)     # S_prev: its top level is never read
-        _step_vjp(s, g, delta, V, d, m, offsets, gn, tb, ga, gb, gdelta)
-        for i in range(d):
-            gd[b, k - 1, i] = gdelta[i]
-        for r in range(offsets[m]):                         # the top level of g never changes
-            g[r] = gn[r]
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
@@ -249,11 +217,41 @@ def _sig_vjp_units_kernel(K: int, V: int):
     @njit(**_NOGIL)
     def sig_vjp_units_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
         d = x.shape[2]
-        g = np.empty(offsets[m + 1])
+        dim = offsets[m + 1]
+        g = np.empty(dim)
+        buf = np.empty(2 * d ** max(m - 1, 1) + d)
+        tb = np.empty(dim)
+        ga = np.empty(d ** m)
+        gb = np.empty(d ** m)
+        gn = np.empty(dim)
+        delta = np.empty(d)
+        neg = np.empty(d)
+        gdelta = np.empty(d)
         for u in range(lo, hi):
             _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
             s = part[u].copy()
-            _unit_vjp(x, ub[u], ulo[u], uhi[u], s, g, K, V, d, m, offsets, gd)
+            b = ub[u]
+            for k in range(uhi[u], ulo[u], -1):        # backward over the unit's segments, last first
+                for i in range(d):
+                    delta[i] = x[b, k, i] - x[b, k - 1, i]
+                    neg[i] = -delta[i]
+                # S_prev (its top level is never read): the branches on the constants K and V are here, in the
+                # kernel, where numba prunes them before typing; in an inlined helper taking K or V as an argument
+                # every branch was compiled (14.6 s for this kernel at d = 3, against 5.9 s)
+                if K > 0:
+                    _horner_step_d(s, neg, K, m - 1, offsets, buf)
+                elif K < 0:
+                    _wide_step(s, neg, d, m - 1, offsets, buf)
+                else:
+                    _horner_step_d(s, neg, d, m - 1, offsets, buf)
+                if V > 0:
+                    _step_vjp_d(s, g, delta, V, m, offsets, gn, tb, ga, gb, gdelta)
+                else:
+                    _step_vjp_d(s, g, delta, d, m, offsets, gn, tb, ga, gb, gdelta)
+                for i in range(d):
+                    gd[b, k - 1, i] = gdelta[i]
+                for r in range(offsets[m]):               # the top level of g never changes
+                    g[r] = gn[r]
 
     return sig_vjp_units_variant
 
@@ -275,7 +273,7 @@ def log_vjp_rows(a, g, d, m, offsets, lo, hi, out):
 
 # ---------------------------------------------------------------------------------- lanes
 # The backward pass on LANES units side by side (rows of LANES values, roughpaths.signatures._simd), the
-# operations of _unit_vjp / _step_vjp on every lane; the sums over p are per lane, in the same
+# operations of sig_vjp_units / _step_vjp_d on every lane; the sums over p are per lane, in the same
 # order, so the results are bitwise those of sig_vjp_units. Units are aligned at their last
 # segment: step tau handles segment uhi - tau of every unit that has it; the others get zero
 # increments and their values are not used.
@@ -283,7 +281,7 @@ def log_vjp_rows(a, g, d, m, offsets, lo, hi, out):
 
 @njit(cache=True, inline="always")
 def _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gprev, tb, ga, gb, gdelta):
-    """:func:`_step_vjp` on every lane; the increment is rows ``do/LANES ..`` of ``blk``."""
+    """:func:`_step_vjp_d` on every lane; the increment is rows ``do/LANES ..`` of ``blk``."""
     L = LANES
     dim = offsets[m + 1]
     for r in range(dim):
