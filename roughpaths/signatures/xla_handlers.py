@@ -36,8 +36,9 @@ one-unit kernels on XLA's buffers:
   helper is a small function compiled once; the kernels are not linked in, so not compiled again). A
   cold first ``jax.grad`` step on one path of 8 points (``benchmarks/bench_first_call.py``, "jax step,
   one path"): 24.0 s of CPU against 22.1 s through the Python handler (same session, loaded machine;
-  both dominated by the one-unit gradient kernel, about 12 s); the 16-path "jax step" does not reach
-  the handlers (8.6 s against 8.7 s).
+  both dominated by the one-unit gradient kernel, then 12-15 s), and 15.1-16.1 s once that kernel compiled
+  only its own step variant (4.5-4.9 s); the 16-path "jax step" does not reach the handlers (8.6 s against
+  8.7 s).
 
 The frame is read with :mod:`roughpaths._xla_native` (XLA FFI API version 0.1's layout). This module imports neither
 jax nor any framework; it lives beside the kernels it runs (a module of :mod:`roughpaths.signatures`, not exported by
