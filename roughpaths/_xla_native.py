@@ -53,22 +53,19 @@ def i64(typingctx, addr):
     return types.int64(types.int64), codegen
 
 
-@intrinsic
-def i32(typingctx, addr):
-    """The int32 at address ``addr``, as an int64."""
-    def codegen(context, builder, sig, args):
-        v = builder.load(builder.inttoptr(args[0], ir.IntType(32).as_pointer()))
-        return builder.sext(v, ir.IntType(64))
-    return types.int64(types.int64), codegen
+def _load_intrinsic(bits: int, signed: bool):
+    """An intrinsic ``load(addr)``: the ``bits``-bit integer at ``addr``, sign- or zero-extended to an int64."""
+    @intrinsic
+    def load(typingctx, addr):
+        def codegen(context, builder, sig, args):
+            v = builder.load(builder.inttoptr(args[0], ir.IntType(bits).as_pointer()))
+            return (builder.sext if signed else builder.zext)(v, ir.IntType(64))
+        return types.int64(types.int64), codegen
+    return load
 
 
-@intrinsic
-def u8(typingctx, addr):
-    """The byte at address ``addr``, as an int64."""
-    def codegen(context, builder, sig, args):
-        v = builder.load(builder.inttoptr(args[0], ir.IntType(8).as_pointer()))
-        return builder.zext(v, ir.IntType(64))
-    return types.int64(types.int64), codegen
+#: The int32 at an address, as an int64; the byte at an address, as an int64.
+i32, u8 = _load_intrinsic(32, True), _load_intrinsic(8, False)
 
 
 @intrinsic
