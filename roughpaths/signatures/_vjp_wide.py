@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 
 from .._variants import variants
-from ._lanes import _horner_step, step_key
+from ._lanes import _horner_step_d, _wide_step, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 from ._vjp import _dot_wide, _step_vjp_d, _tb_row, _unit_cotangent
 
@@ -159,37 +159,6 @@ def _top_back(s, g, delta, d, m, offsets, gbt, go, gprev, tb, ga, gb, gdelta):
         gdelta[q] += ga[q] * inv
 
 
-@njit(cache=True, inline="always")
-def _unit_back_d(x, b, lo, hi, s, g, K, d, m, offsets, gd, w):
-    """Backward over the segments ``lo..hi`` of path ``b`` (``s`` its signature, ``g`` its cotangent)."""
-    buf, tb, ga, gb, gn, delta, neg, gdelta, dl, gbt, tk, gdl, tmp = w
-    ok = offsets[m]
-    n = d ** (m - 1)
-    for t0 in range(hi, lo, -KB):                           # segments t0, t0 - 1, ..., last first
-        nk = min(KB, t0 - lo)
-        for k in range(nk):
-            for i in range(d):
-                dl[k * d + i] = x[b, t0 - k, i] - x[b, t0 - k - 1, i]
-        _gb_block(g, ok, n, d, dl, nk, gbt)
-        for k in range(nk):
-            for i in range(d):
-                delta[i] = dl[k * d + i]
-                neg[i] = -delta[i]
-            _horner_step(s, neg, K, d, m - 1, offsets, buf)   # S_prev, levels < m
-            _step_vjp_d(s, g, delta, d, m - 1, offsets, gn, tb, ga, gb, gdelta)
-            _top_back(s, g, delta, d, m, offsets, gbt, k * n, gn, tb, ga, gb, gdelta)
-            for p in range(n):                              # T_{m-1} of this segment
-                tk[k * n + p] = tb[offsets[m - 1] + p]
-            for i in range(d):
-                gdl[k * d + i] = gdelta[i]
-            for r in range(ok):
-                g[r] = gn[r]
-        _gd_block(g, ok, n, d, tk, nk, gdl, tmp)
-        for k in range(nk):
-            for i in range(d):
-                gd[b, t0 - k - 1, i] = gdl[k * d + i]
-
-
 @variants
 def _sig_vjp_wide_kernel(K: int):
     """The compiled wide backward pass for the step variant ``K`` (:func:`~._lanes.step_key`)."""
@@ -202,13 +171,46 @@ def _sig_vjp_wide_kernel(K: int):
         w = (np.empty(2 * n + d), np.empty(dim), np.empty(n), np.empty(n), np.empty(dim), np.empty(d),
              np.empty(d), np.empty(d), np.empty(KB * d), np.empty(KB * n), np.empty(KB * n), np.empty(KB * d),
              np.empty(LANES))
+        buf, tb, ga, gb, gn, delta, neg, gdelta, dl, gbt, tk, gdl, tmp = w
+        ok = offsets[m]
         g = np.empty(dim)
         for u in range(lo, hi):
             _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
             s = part[u].copy()
-            # one run-time d: a compile-time d = 8 variant measured 20% faster at depth 3, but took 100 s
-            # more to compile
-            _unit_back_d(x, ub[u], ulo[u], uhi[u], s, g, K, d, m, offsets, gd, w)
+            # backward over the unit's segments, last first, in blocks of KB; one run-time d: a compile-time
+            # d = 8 variant measured 20% faster at depth 3, but took 100 s more to compile
+            b, lo_u = ub[u], ulo[u]
+            for t0 in range(uhi[u], lo_u, -KB):
+                nk = min(KB, t0 - lo_u)
+                for k in range(nk):
+                    for i in range(d):
+                        dl[k * d + i] = x[b, t0 - k, i] - x[b, t0 - k - 1, i]
+                _gb_block(g, ok, n, d, dl, nk, gbt)
+                for k in range(nk):
+                    for i in range(d):
+                        delta[i] = dl[k * d + i]
+                        neg[i] = -delta[i]
+                    # S_prev, levels < m. The branch on the constant K is here, in the kernel, where numba prunes
+                    # it before typing; in an inlined helper taking K as an argument every step kind was compiled
+                    # (this kernel: 19.7 s to compile at d = 8, depth 3, against 8.0 s)
+                    if K > 0:
+                        _horner_step_d(s, neg, K, m - 1, offsets, buf)
+                    elif K < 0:
+                        _wide_step(s, neg, d, m - 1, offsets, buf)
+                    else:
+                        _horner_step_d(s, neg, d, m - 1, offsets, buf)
+                    _step_vjp_d(s, g, delta, d, m - 1, offsets, gn, tb, ga, gb, gdelta)
+                    _top_back(s, g, delta, d, m, offsets, gbt, k * n, gn, tb, ga, gb, gdelta)
+                    for p in range(n):                              # T_{m-1} of this segment
+                        tk[k * n + p] = tb[offsets[m - 1] + p]
+                    for i in range(d):
+                        gdl[k * d + i] = gdelta[i]
+                    for r in range(ok):
+                        g[r] = gn[r]
+                _gd_block(g, ok, n, d, tk, nk, gdl, tmp)
+                for k in range(nk):
+                    for i in range(d):
+                        gd[b, t0 - k - 1, i] = gdl[k * d + i]
 
     return sig_vjp_wide_variant
 
