@@ -101,7 +101,7 @@ def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
     Every level's Horner chain at once, level ``j`` of ``S`` read once: ``C^l_1 = D/l + S_1`` and
     ``C^l_j = C^l_{j-1} ⊗ D/(l - j + 1) + S_j`` for the levels ``l > j`` (``cb``: two regions of
     ``hs`` entries per ``l``), then ``S_j <- S_j + C^j_{j-1} ⊗ D``: the operations of
-    :func:`~roughpaths.signatures._lanes._horner_step` in another order (the same bits;
+    :func:`~roughpaths.signatures._lanes._horner_step_d` in another order (the same bits;
     ``fac[k] = 1.0 / k``). Every row is whole packed rows (:func:`_row`): no loop ends one entry at a
     time, whatever ``d``.
     """

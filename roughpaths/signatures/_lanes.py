@@ -15,14 +15,14 @@ then ``S_1 <- S_1 + D``. Every product is rounded, then every sum (no fused mult
 *Lanes.* :data:`~roughpaths.signatures._simd.LANES` work units (a path, or a chunk of a long path) advance
 together, one segment per step; every array holds ``(entries, LANES)`` flattened, and every
 operation is one packed instruction on a row of LANES values (:mod:`roughpaths.signatures._simd`). A lane
-does exactly the scalar operations of :func:`_horner_step` on its own unit, so a unit's result
+does exactly the scalar operations of :func:`_horner_step_d` on its own unit, so a unit's result
 does not depend on its lane, its neighbours, the grouping or the thread. A unit's signature is
 copied out at its own last segment; lanes with no segment left get zero increments. The increments
 of a group are gathered and transposed into a ``(BLOCK, d, LANES)`` block first, and the kernel is
 specialised (loops over the letters unrolled) for d = 2..5, and also on the depth for depth 3 with
 d = 2, 3, 5; d = 6, 7 (which run on lanes at depth 3 only) on both.
 
-*One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step`, whose loops
+*One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step_d`, whose loops
 run over the first letters of a level (contiguous, packed ``LANES`` first letters at a time or
 vectorised by LLVM; for d = 6..15 :func:`_wide_step`, the same operations with less loop
 control): the same bits as the lanes. The engine's one-unit kernel is the blocked one
@@ -138,6 +138,13 @@ def _outer(y, yo, ys, x, xo, s, so, n, sc, d, acc):
 
 @njit(cache=True, inline="always")
 def _horner_step_d(s, delta, d, m, offsets, buf):
+    """``s <- s ⊗ exp(delta)`` in place (reversed layout), one unit; ``buf`` scratch of ``2 d^(m-1) + d`` floats.
+
+    Packed over the first letters (:func:`_outer`), so it runs at SIMD width for any ``d``; the same bits as a
+    lane of :func:`_lane_step_d`. Kernels pass a compile-time ``d`` (their step variant ``K``, :func:`step_key`)
+    for d = 2..5 and call :func:`_wide_step` (the same bits) for d = 6..15, branching on ``K`` in their own body:
+    numba prunes a branch on a kernel's constant before typing, not one on an inlined helper's argument.
+    """
     half = d ** max(m - 1, 1)
     so = 2 * half                                           # the scaled increments sc[q]
     sc = buf[so:so + d]
@@ -220,27 +227,9 @@ def _wide_step(s, delta, d, m, offsets, buf):
 
 
 def step_key(d: int) -> int:
-    """The compile-time variant of the one-unit step for alphabet size ``d`` (see :func:`_horner_step`):
+    """The compile-time variant of the one-unit step for alphabet size ``d`` (see :func:`_horner_step_d`):
     ``d`` itself for d = 2..5, -1 for d = 6..15 (:func:`_wide_step`), 0 for a run-time ``d``."""
     return d if 2 <= d <= 5 else (-1 if d < 16 else 0)
-
-
-@njit(cache=True, inline="always")
-def _horner_step(s, delta, K, d, m, offsets, buf):
-    """``s <- s ⊗ exp(delta)`` in place (reversed layout), one unit; ``buf`` scratch of
-    ``2 d^(m-1) + d`` floats; ``K = step_key(d)``, a compile-time constant of the calling kernel.
-
-    Packed over the first letters (:func:`_outer`), so it runs at SIMD width for any ``d``; the
-    same bits as a lane of :func:`_lane_step_d`. ``d = 2..5`` get a compile-time ``d``; ``d = 6..15``
-    run :func:`_wide_step` (the same bits, less loop overhead). Inlined: each kernel compiles only the
-    variant of its ``K`` (the branches on the constant are pruned before typing).
-    """
-    if K > 0:
-        _horner_step_d(s, delta, K, m, offsets, buf)
-    elif K < 0:
-        _wide_step(s, delta, d, m, offsets, buf)
-    else:                           # measured: at d = 20, depth 3 _wide_step is 10% slower
-        _horner_step_d(s, delta, d, m, offsets, buf)
 
 
 @njit(cache=True, inline="always")
@@ -435,13 +424,21 @@ def _scalar_units_kernel(K: int):
             for k in range(ulo[u] + 1, uhi[u] + 1):
                 for i in range(d):
                     delta[i] = x[b, k, i] - x[b, k - 1, i]
-                _horner_step(s, delta, K, d, m, offsets, buf)
+                # s <- s ⊗ exp(delta): d = 2..5 with a compile-time d (K), d = 6..15 _wide_step (the same bits, less
+                # loop overhead), others a run-time d. The branch on the constant K is here, in the kernel, where
+                # numba prunes it before typing (an inlined helper taking K as an argument compiled every branch)
+                if K > 0:
+                    _horner_step_d(s, delta, K, m, offsets, buf)
+                elif K < 0:
+                    _wide_step(s, delta, d, m, offsets, buf)
+                else:                           # measured: at d = 20, depth 3 _wide_step is 10% slower
+                    _horner_step_d(s, delta, d, m, offsets, buf)
 
     return scalar_units_variant
 
 
 def scalar_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
-    """Signatures (reversed layout) of units ``lo..hi-1``, one at a time with :func:`_horner_step`.
+    """Signatures (reversed layout) of units ``lo..hi-1``, one at a time with :func:`_horner_step_d`.
 
     The same arithmetic, operation for operation, as :func:`lane_groups` (the same bits); the
     reference of the blocked one-unit kernel (:mod:`roughpaths.signatures._blocked`) in the tests.
