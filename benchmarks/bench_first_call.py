@@ -32,6 +32,8 @@ FAMILIES = {
     "signature depth 2-4": ("sig", "rp.signature(x, 2); rp.signature(x, 3); rp.signature(x, 4)"),
     "logsignature depth 4": ("sig", "rp.logsignature(x, 4)"),
     "signature_vjp depth 4": ("sig", "rp.signature_vjp(x, 4, np.ones((16, rp.sigdim(3, 4))))"),
+    # one path: the one-unit kernels (forward and backward), not the lanes
+    "signature_vjp, one path": ("sig", "rp.signature_vjp(x[0], 3, np.ones(rp.sigdim(3, 3)))"),
     "logsignature_vjp depth 4": ("sig", "rp.logsignature_vjp(x, 4, np.ones((16, rp.logsigdim(3, 4))))"),
     "torch step (sig depth 3)": ("sig torch", "t = torch.tensor(x, requires_grad=True)\n"
                                               "rt.signature(t, 3).sum().backward()"),
