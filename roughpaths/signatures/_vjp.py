@@ -237,8 +237,8 @@ def _sig_vjp_units_kernel(K: int, V: int):
                     neg[i] = -delta[i]
                 # S_prev (its top level is never read): the branches on the constants K and V are here, in the
                 # kernel, where numba prunes them before typing; in an inlined helper taking K or V as an argument
-                # every branch was compiled (14.6 s for this kernel at d = 3, against 4.5 s). The same branch is written out in
-                # each kernel that steps one unit (scalar_units, the wide VJP): numba prunes it only there
+                # every branch was compiled (14.6 s for this kernel at d = 3, against 4.5 s). The same branch is
+                # written out in each kernel that steps one unit (scalar_units, the wide VJP): pruned only there
                 if K > 0:
                     _horner_step_d(s, neg, K, m - 1, offsets, buf)
                 elif K < 0:
