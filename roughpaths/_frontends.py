@@ -1,4 +1,5 @@
-"""What the framework front ends :mod:`roughpaths.torch` and :mod:`roughpaths.jax` share (private).
+"""What the framework front ends :mod:`roughpaths.torch` and :mod:`roughpaths.jax` share (private), and the
+check of ``time_augment``'s times that they and the numpy function make alike.
 
 Both wrap a numpy map that is batched over leading axes: the inputs' batch axes are broadcast against
 each other before the call, and each input's cotangent is summed back over the axes broadcasting added
@@ -9,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["batch_broadcast", "sum_to"]
+__all__ = ["batch_broadcast", "sum_to", "check_times_batch"]
 
 
 def batch_broadcast(arrays: list, core: tuple) -> list:
@@ -27,3 +28,15 @@ def sum_to(g: np.ndarray, shape: tuple) -> np.ndarray:
     g = g.sum(axis=tuple(range(g.ndim - len(shape))))
     axes = tuple(k for k, (a, b) in enumerate(zip(shape, g.shape)) if a == 1 and b != 1)
     return g.sum(axis=axes, keepdims=True) if axes else g
+
+
+def check_times_batch(t_shape: tuple, x_shape: tuple) -> None:
+    """Refuse ``time_augment`` times of shape ``t_shape`` whose batch axes do not broadcast to the points of
+    paths of shape ``x_shape`` (numpy, torch and JAX alike: the shapes are static, so also under ``jit``)."""
+    try:
+        ok = np.broadcast_shapes(x_shape[:-1], t_shape) == x_shape[:-1]
+    except ValueError:
+        ok = False
+    if not ok:
+        raise ValueError(f"times of shape {t_shape} does not broadcast to the points of paths (shape {x_shape}, points "
+                         f"{x_shape[:-1]}); pass times of shape (n,) or (..., n) with the batch axes of paths.")

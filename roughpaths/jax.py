@@ -71,7 +71,7 @@ import jax
 import jax.numpy as jnp
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, sum_to
+from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
 from roughpaths._xla_ffi import host_handler
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
@@ -412,13 +412,7 @@ def time_augment(paths, times=None):
         t = _as_jax(times, "times").astype(x.dtype)
     if t.ndim < 1 or t.shape[-1] != n:
         raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {t.shape}.")
-    try:
-        ok = np.broadcast_shapes(x.shape[:-1], t.shape) == x.shape[:-1]
-    except ValueError:
-        ok = False
-    if not ok:                                    # as the numpy time_augment refuses them, naming times
-        raise ValueError(f"times of shape {t.shape} does not broadcast to the points of paths (shape {x.shape}, points "
-                         f"{x.shape[:-1]}); pass times of shape (n,) or (..., n) with the batch axes of paths.")
+    check_times_batch(tuple(t.shape), tuple(x.shape))
     return jnp.concatenate([jnp.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)
 
 

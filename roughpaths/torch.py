@@ -65,7 +65,7 @@ import torch
 from torch.autograd.function import once_differentiable
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, sum_to
+from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -283,17 +283,6 @@ def lead_lag(paths: torch.Tensor) -> torch.Tensor:
     return torch.cat([x[..., (k + 1) // 2, :], x[..., k // 2, :]], dim=-1)
 
 
-def _times_batch(t_shape: tuple, x_shape: tuple) -> None:
-    """Refuse times whose batch axes do not broadcast to those of paths (as the numpy ``time_augment`` does)."""
-    try:
-        ok = np.broadcast_shapes(x_shape[:-1], t_shape) == x_shape[:-1]
-    except ValueError:
-        ok = False
-    if not ok:
-        raise ValueError(f"times of shape {t_shape} does not broadcast to the points of paths (shape {x_shape}, points "
-                         f"{x_shape[:-1]}); pass times of shape (n,) or (..., n) with the batch axes of paths.")
-
-
 def time_augment(paths: torch.Tensor, times=None) -> torch.Tensor:
     r"""Differentiable :func:`roughpaths.time_augment`: time as the first channel, ``(..., n, d)`` → ``(..., n, d + 1)``.
 
@@ -317,7 +306,7 @@ def time_augment(paths: torch.Tensor, times=None) -> torch.Tensor:
             raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {tuple(t.shape)}.")
         if n > 1 and not bool(torch.all(t[..., 1:] > t[..., :-1])):
             raise ValueError("times must be strictly increasing along its last axis; sort the points by time.")
-        _times_batch(tuple(t.shape), tuple(x.shape))
+        check_times_batch(tuple(t.shape), tuple(x.shape))
     return torch.cat([t.expand(x.shape[:-1]).unsqueeze(-1), x], dim=-1)
 
 

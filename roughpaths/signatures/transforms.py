@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._frontends import check_times_batch
 from ..validation import as_float_array, check_memory
 
 __all__ = ["lead_lag", "time_augment", "basepoint", "invisibility_reset"]
@@ -140,15 +141,8 @@ def time_augment(paths, times=None) -> np.ndarray:
             raise ValueError(f"times must be strictly increasing along its last axis, but at index {where} it "
                              f"goes from {t[where[:-1] + (where[-1],)]!r} to {t[where[:-1] + (where[-1] + 1,)]!r}; "
                              f"sort the points by time and drop repeated times.")
-    try:
-        batch = np.broadcast_shapes(x.shape[:-1], t.shape)
-    except ValueError:
-        raise ValueError(f"times of shape {t.shape} does not broadcast against the points of paths, shape "
-                         f"{x.shape[:-1]}; pass times of shape (n,) or (..., n) with the batch axes of paths.") from None
-    if batch != x.shape[:-1]:
-        raise ValueError(f"times of shape {t.shape} has batch axes that paths (shape {x.shape}) lacks; give "
-                         f"paths those axes (e.g. np.broadcast_to) or pass times of shape (n,).")
-    return np.concatenate([np.broadcast_to(t, batch)[..., None], x], axis=-1)
+    check_times_batch(t.shape, x.shape)
+    return np.concatenate([np.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)
 
 
 def basepoint(paths) -> np.ndarray:
