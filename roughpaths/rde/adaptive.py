@@ -144,7 +144,7 @@ class _TreeSteps:
             raise TypeError(f"{type(control).__name__}.init returned {type(self.state).__name__}"
                             f"{' without the key h' if isinstance(self.state, dict) else ''}; it must return a fresh "
                             f"dict holding at least 'h', the first step of each of the {n} lane(s) (contract item 2).")
-        self.dt_min = dt_min = control.dt_min(T)
+        dt_min = control.dt_min(T)
         if isinstance(dt_min, (bool, np.bool_)) or not isinstance(dt_min, (numbers.Real, np.floating, np.integer)) \
                 or not 0 <= dt_min < math.inf:         # the cell count below is ceil(dt_min / cell)
             raise ValueError(f"{type(control).__name__}.dt_min({T!r}) returned {dt_min!r}; the smallest step must be a "
@@ -167,7 +167,7 @@ class _TreeSteps:
         if P == 0:         # no member to step (an empty batch axis): done at once, at the times asked (all: t0, t1)
             self.i[:] = end
             pts = np.array(sorted(self.save_idx | ({0, end} if self.save_all else set())), dtype=np.int64)
-            self.saved = [(np.zeros(pts.size, dtype=np.int64), np.where(pts < end, t0 + pts * cell, t1),
+            self.saved = [(np.zeros(pts.size, dtype=np.int64), self._time(pts),
                            np.empty((pts.size, 0, run.e)))]
         self.y_new, self.err = np.empty_like(run.y), np.zeros(P)
         self.bad, self.tried, self.unmet = (np.zeros(P, dtype=bool) for _ in range(3))
@@ -251,7 +251,7 @@ class _TreeSteps:
 
     def adapt(self, attempts):
         """Fail the members that miss the tolerance at ``dt_min``, let the controller decide, advance the lanes."""
-        run, cell, r, adaptive = self.run, self.cell, self.r, self.control.adaptive
+        run, r, adaptive = self.run, self.r, self.control.adaptive
         failed = _ratios_nb(self.err, self.tried, self.bad, run.healthy, self.lane_of, self.floor, adaptive, r, self.unmet)
         if failed:
             m = np.flatnonzero(self.unmet)          # the tolerance cannot be met at dt_min: fail, never crawl
@@ -288,7 +288,7 @@ class _TreeSteps:
                 np.isin(at, self.save_list)
             lanes, at = lanes[keep], at[keep]
         if lanes.size:
-            self.saved.append((lanes, np.where(at < self.end, self.t0 + at * cell, self.t1),
+            self.saved.append((lanes, self._time(at),
                                run.y[self.lane_members[lanes]]))
             self.n_saved += lanes.size
             run.check_saves(self.n_saved // self.lanes, growing=True)
@@ -305,10 +305,15 @@ class _TreeSteps:
         for k in dead.tolist():
             at = np.array([self.end]) if self.save_all else self.save_list[self.save_list > self.i[k]]
             if at.size:
-                self.saved.append((np.full(at.size, k), np.where(at < self.end, self.t0 + at * self.cell, self.t1),
+                self.saved.append((np.full(at.size, k), self._time(at),
                                    np.full((at.size,) + self.lane_members.shape[1:] + (self.run.e,), np.nan)))
                 self.n_saved += at.size
             self.i[k] = self.end
+
+    def _time(self, at):
+        """The times of the grid indices ``at``: ``t0 + at cell``, and ``t1`` itself at the end (``t0 + end cell``
+        may round off it)."""
+        return np.where(at < self.end, self.t0 + at * self.cell, self.t1)
 
     def _times_of(self, member):
         """The step ends the failure message of ``member`` (flat index) reads: its failed attempt's start and end
