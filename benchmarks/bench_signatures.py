@@ -40,7 +40,8 @@ end, the cells above 1.0 (one thread) and 1.1 (parallel). Cells whose signature 
 ``--sweep-max-sigdim`` floats per path (default 2e6; d = 20 at depth 5, d >= 12 at depth 6) are
 skipped and listed. ``--sweep-d 2,6-9``, ``--sweep-depths 3,4``, ``--sweep-batches 16`` and
 ``--sweep-kinds sig,logsig,sig vjp`` select a subset; ``--sweep-modes 1`` runs the one-thread mode only.
-A timed sample of a small cell is a loop of calls lasting about 2 ms (divided back to one call).
+A timed sample of a small cell is a loop of calls lasting about 2 ms (divided back to one call), timed in at
+least 11 interleaved pairs.
 
 ``--fixed-cost`` prints only the cost of a call on tiny inputs (one path of 8 points in d = 2, 3 at
 depths 2-3, and 32 x 128 in d = 3), where the Python around the kernels is most of the time: ours,
@@ -161,13 +162,24 @@ def machine_rates() -> tuple:
 
 
 def paired(fns, repeats: int, clock) -> list:
-    """Medians of interleaved timings (ours, peer, ours, peer, ...), each after an untimed call."""
+    """Medians of interleaved timings (ours, peer, ours, peer, ...), each after an untimed call.
+
+    A call of 50 ms or more is not preceded by an untimed call (its data do not fit in the caches a
+    previous call could have warmed) and one of a second or more is timed in at most 3 pairs: the
+    heaviest cells of the width sweep otherwise took most of its hour.
+    """
+    first = []
     for fn in fns:
+        t0 = time.perf_counter()
         fn()
+        first.append(time.perf_counter() - t0)
+    heavy = max(first) >= 0.05
+    repeats = min(repeats, 3) if max(first) >= 1.0 else repeats
     times = [[] for _ in fns]
     for _ in range(max(1, repeats)):
         for i, fn in enumerate(fns):
-            fn()
+            if not heavy:
+                fn()
             t0 = clock()
             fn()
             times[i].append(clock() - t0)
@@ -320,8 +332,8 @@ def width_sweep(args) -> None:
         return [(lambda f=f: [f() for _ in range(reps)]) for f in fns], reps
 
     def timed(fns, clock):
-        many, reps = looped(fns)
-        return [t / reps for t in paired(many, args.repeats, clock)]
+        many, reps = looped(fns)        # samples of ~2 ms (reps > 1) get at least 11 pairs: the noisiest cells
+        return [t / reps for t in paired(many, max(args.repeats, 11) if reps > 1 else args.repeats, clock)]
 
     print(f"width sweep: numba threads {threads}, load average {os.getloadavg()[0]:.1f}, median of "
           f"{args.repeats} interleaved pairs; ms; ratio = ours / pysiglib (1t: set_num_threads(1) against "
