@@ -180,7 +180,7 @@ def _signature_compiled(params: dict, dtype):
             if target is None:
                 return None
             try:
-                kernels = xs.kernels(d, depth, direction == "backward")
+                kernels = xs.kernels(n, d, depth, direction == "backward")
             except Exception:                # noqa: BLE001 -- the kernels did not compile: the Python handler
                 return None
             return target, lambda fallback: {xs.ATTRIBUTE: xs.parameters(fallback, d, depth, most, kernels)}

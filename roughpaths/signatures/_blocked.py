@@ -1,7 +1,8 @@
 """One-unit signature kernel with the top level deferred over blocks of segments (private).
 
 Called by :mod:`roughpaths.signatures._engine` for the units that run alone (every ``d >= 8``, d = 6, 7
-beyond depth 3, and lane groups with few units). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
+beyond depth 3, and lane groups with few units), except units of at most 7 segments, which run the plain
+one-unit kernel (:func:`roughpaths.signatures._engine.alone_kernel`: as fast there, and quicker to compile). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
 (reversed word order, the Horner–Chen update with every product rounded, then every sum).
 
 The top level of the Horner update of segment ``k`` is a rank-one update,

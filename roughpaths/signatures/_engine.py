@@ -211,6 +211,29 @@ def _split_units(nunits: int, d: int, depth: int) -> tuple:
     return groups, min(nunits, groups * _lanes.LANES)
 
 
+#: A unit run alone with at most this many segments runs the plain one-unit kernel (:func:`_lanes.scalar_units`),
+#: not the blocked one (:func:`_blocked.block_units`): the same bits (:func:`alone_kernel`).
+_SHORT_UNIT = 7
+
+
+def alone_kernel(n: int, d: int, depth: int):
+    """The kernel of the work units that run alone, for paths of ``n`` points in ``d`` at ``depth`` (a function of
+    the shape only, as every choice of the engine; either kernel gives the same bits).
+
+    Units of at most :data:`_SHORT_UNIT` segments with ``3 <= d <= 10`` run the plain kernel: its compile costs
+    1.3-1.9 s against 3.8-4.5 s for the blocked kernel (cold, empty cache, one process each, d = 3, 5, 8), the
+    larger part of a lone short path's first call, and it runs as fast there: one path of 4 / 8 points, one thread,
+    CPU time, interleaved, d = 3..10 at depths 3..5, 0.61-0.80 / 0.81-1.06 times the blocked kernel's time (1-25 us
+    a call). From 16 points the blocked kernel is faster (1.0-1.9x at 16 points, up to 3.2x at 128). It keeps
+    d = 2 (the plain kernel's rows are a quarter of a packed row: 1.3-2.6x slower at 8 points), (6, 4) (a blocked
+    variant with a compile-time ``d`` and depth: 1.2-1.4x) and d >= 11 (d = 12, 16, 20 at 8 points: 0.85-1.52x).
+    """
+    segments = (n - 1) // _horner_chunks(n, d, depth)
+    if segments <= _SHORT_UNIT and 3 <= d <= 10 and (d, depth) != (6, 4):
+        return _lanes.scalar_units(d)
+    return _blocked.block_units(d, depth)
+
+
 @lru_cache(maxsize=64)
 def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
     """What :func:`_reversed_parts` runs for a ``(nb, n, d)`` batch: a function of the shape only, made once.
@@ -225,7 +248,7 @@ def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
     # ``1.5 d^m`` underestimates d = 2 at depth 5 by 2-3x (loop control), so 64 x 256 such paths (~290 us)
     # stay on one thread; counted (12 a level), they ran on two 0-24 % slower at load 1.3-2.1
     lanes = _lanes.lane_groups(d, depth) if ngroups else None
-    alone = _blocked.block_units(d, depth) if first_alone < nunits else None
+    alone = alone_kernel(n, d, depth) if first_alone < nunits else None
     return (_units(nb, n, nchunks), level_offsets(d, depth), (nunits, dim),
             lanes, _threads.ranges(ngroups, per_unit * _lanes.LANES),
             first_alone, alone, _threads.ranges(nunits - first_alone, per_unit))

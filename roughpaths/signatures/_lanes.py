@@ -25,7 +25,8 @@ d = 2, 3, 5; d = 6, 7 (which run on lanes at depth 3 only) on both.
 *One unit.* :func:`scalar_units` runs units one at a time with :func:`_horner_step_d`, whose loops
 run over the first letters of a level (contiguous, packed ``LANES`` first letters at a time or
 vectorised by LLVM; for d = 6..15 :func:`_wide_step`, the same operations with less loop
-control): the same bits as the lanes. The engine's one-unit kernel is the blocked one
+control): the same bits as the lanes. The engine runs it for units of at most 7 segments that run
+alone (``_engine.alone_kernel``); its other one-unit kernel is the blocked one
 (:mod:`roughpaths.signatures._blocked`, the same bits again), used for every d >= 8, for d = 6, 7
 beyond depth 3 and for d = 4, 5 where ``LANES`` signatures take more than 64 KiB (they no longer
 fit in the L1 cache, and one unit's rows are long enough to fill the vector registers), and for a
@@ -437,10 +438,14 @@ def _scalar_units_kernel(K: int):
     return scalar_units_variant
 
 
-def scalar_units(x, ub, ulo, uhi, m, offsets, lo, hi, part):
-    """Signatures (reversed layout) of units ``lo..hi-1``, one at a time with :func:`_horner_step_d`.
+def scalar_units(d: int):
+    """The plain one-unit kernel for alphabet size ``d`` (compiled on first use, without the GIL):
+    ``kernel(x, ub, ulo, uhi, m, offsets, lo, hi, part)`` writes the signatures (reversed layout) of units
+    ``lo..hi-1`` into ``part``, one unit at a time with :func:`_horner_step_d`.
 
-    The same arithmetic, operation for operation, as :func:`lane_groups` (the same bits); the
-    reference of the blocked one-unit kernel (:mod:`roughpaths.signatures._blocked`) in the tests.
+    The same arithmetic, operation for operation, as :func:`lane_groups` and the blocked one-unit kernel
+    (:mod:`roughpaths.signatures._blocked`): the same bits. The engine runs it for small lone units
+    (:func:`roughpaths.signatures._engine.alone_kernel`), where it is as fast and compiles in a fraction of
+    the blocked kernel's time; the tests use it as the blocked kernel's reference.
     """
-    _scalar_units_kernel(step_key(x.shape[2]))(x, ub, ulo, uhi, m, offsets, lo, hi, part)
+    return _scalar_units_kernel(step_key(d))

@@ -8,7 +8,7 @@ and backward passes) that read the call frame themselves and run the numpy API's
 one-unit kernels on XLA's buffers:
 
 * **What they take**: what the numpy API runs one work unit at a time on one thread, with the one-unit
-  kernels of :mod:`roughpaths.signatures._blocked` and :mod:`roughpaths.signatures._vjp`: depth >= 3,
+  kernels (:func:`roughpaths.signatures._engine.alone_kernel`, :mod:`roughpaths.signatures._vjp`): depth >= 3,
   ``d <= 7``, ``n >= 2`` points, a path short enough to be one work unit, and at most :func:`plan`'s
   ``most`` paths (2 at d <= 3, where the engine runs lanes from 3 paths on), float32 or float64
   buffers. Every other call, and every call whose values the numpy API refuses (a NaN or inf point
@@ -57,8 +57,8 @@ from .._threads import ranges
 from .._xla_native import (ARRAY_ATTR, ATTRS, ATTRS_SIZE, EXECUTE, F64, FRAME_SIZE, HANDLER, METADATA_EXTENSION,
                            METADATA_SIZE, S64, address, buffer, call, error, f32p, f64p, i32, i64, kernel_address,
                            native_call, set_i32, set_i64, u8, voidptr)
-from . import _blocked, _vjp
-from ._engine import _WIDE, _horner_chunks, _split_units
+from . import _vjp
+from ._engine import _WIDE, _horner_chunks, _split_units, alone_kernel
 
 __all__ = ["ATTRIBUTE", "CALLS", "handler", "plan", "kernels", "parameters"]
 
@@ -275,7 +275,7 @@ def _layout(nb, n, d, m):
 # ------------------------------------------------------------------------------ the engine's kernels
 _F8_3D, _F8_2D, _I8_1D = types.float64[:, :, ::1], types.float64[:, ::1], types.int64[::1]
 #: The argument types of the one-unit kernels, as the numpy API calls them (so that both call one compiled
-#: function): :func:`roughpaths.signatures._blocked.block_units` ``(x, ub, ulo, uhi, m, offsets, lo, hi, part)``
+#: function): :func:`roughpaths.signatures._engine.alone_kernel`'s ``(x, ub, ulo, uhi, m, offsets, lo, hi, part)``
 #: and :func:`roughpaths.signatures._vjp.sig_vjp_units` ``(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi,
 #: gd)``.
 BLOCK_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, _I8_1D, types.int64, types.int64, _F8_2D)
@@ -284,7 +284,7 @@ VJP_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, types.int64, _I8_1D, _F
 
 @intrinsic
 def _block_units(typingctx, addr, x, ub, ulo, uhi, m, off, lo, hi, part):
-    """The one-unit signature kernel at ``addr`` (a variant of :func:`roughpaths.signatures._blocked.block_units`)."""
+    """The one-unit signature kernel at ``addr`` (:func:`roughpaths.signatures._engine.alone_kernel`'s)."""
     return native_call(typingctx, BLOCK_ARGS, addr, (x, ub, ulo, uhi, m, off, lo, hi, part))
 
 
@@ -386,13 +386,14 @@ def plan(n: int, d: int, depth: int) -> int:
 _KERNELS: dict = {}
 
 
-def kernels(d: int, depth: int, backward: bool) -> tuple:
-    """``(forward, backward)``: the addresses of the one-unit kernels the numpy API runs for ``d`` and ``depth``
-    (:func:`roughpaths.signatures._blocked.block_units`, and with ``backward``
+def kernels(n: int, d: int, depth: int, backward: bool) -> tuple:
+    """``(forward, backward)``: the addresses of the one-unit kernels the numpy API runs for paths of ``n`` points
+    in ``d`` at ``depth`` (:func:`roughpaths.signatures._engine.alone_kernel`, and with ``backward``
     :func:`roughpaths.signatures._vjp.sig_vjp_units`; else 0), compiled or loaded on first use."""
-    key = (d, depth, backward)
+    forward = alone_kernel(n, d, depth)
+    key = (forward, d, depth, backward)
     if key not in _KERNELS:
-        block = kernel_address(_blocked.block_units(d, depth), BLOCK_ARGS)
+        block = kernel_address(forward, BLOCK_ARGS)
         _KERNELS[key] = (block, kernel_address(_vjp.sig_vjp_units(d), VJP_ARGS) if backward else 0)
     return _KERNELS[key]
 

@@ -324,7 +324,7 @@ def test_kernel_variants_have_their_own_symbols():
     kernel factory must not share a name (two variants compiled in two processes and loaded from numba's cache
     did, and the lookup found the other variant: a write past the signature, then a crash)."""
     from roughpaths.signatures import xla_handlers
-    from roughpaths.signatures import _blocked
+    from roughpaths.signatures import _blocked, _lanes
 
     addresses = {key: xla_handlers.kernel_address(_blocked._block_units_kernel(*key), xla_handlers.BLOCK_ARGS)
                  for key in [(0, 0, False), (6, 4, True), (4, 0, False)]}
@@ -332,4 +332,6 @@ def test_kernel_variants_have_their_own_symbols():
     names = {key: _blocked._block_units_kernel(*key).overloads[xla_handlers.BLOCK_ARGS].fndesc.llvm_func_name
              for key in addresses}
     assert len(set(names.values())) == 3
-    assert xla_handlers.kernels(7, 3, False)[0] == addresses[0, 0, False]
+    assert xla_handlers.kernels(200, 7, 3, False)[0] == addresses[0, 0, False]     # the engine's blocked kernel
+    assert xla_handlers.kernels(8, 7, 3, False)[0] == xla_handlers.kernel_address(     # a short path: the plain one
+        _lanes.scalar_units(7), xla_handlers.BLOCK_ARGS)

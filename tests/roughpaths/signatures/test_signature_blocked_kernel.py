@@ -9,6 +9,7 @@
   every product in the order of the segments;
 * a path gets the same bits in a lane group of the run-time-``d`` lane kernel (d = 6, 7 at depth 3) as
   alone in the blocked kernel, whose rows at such widths end in partial packed rows;
+* a lone path of at most 8 points (the plain one-unit kernel) gets the bits of the blocked kernel and of a lane;
 * the tiled layout permutation equals numpy's gather (``src[:, perm]``) on a level large enough to
   be tiled.
 
@@ -51,7 +52,7 @@ def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     units = _units(3, n, 2)                       # two units a path: 18 and 19 segments
     a = np.empty((6, off[m + 1]))
     b = np.empty_like(a)
-    _lanes.scalar_units(x, *units, m, off, 0, 6, a)
+    _lanes.scalar_units(x.shape[2])(x, *units, m, off, 0, 6, a)
     _blocked.block_units(x.shape[2], m)(x, *units, m, off, 0, 6, b)
     assert a.tobytes() == b.tobytes()
 
@@ -63,6 +64,31 @@ def test_lanes_and_lone_units_give_the_same_bits_at_run_time_widths(rng, d, m):
     whole = signature(x, m)
     for b in (0, 7, 8, 9):
         assert signature(x[b:b + 1], m)[0].tobytes() == whole[b].tobytes()
+
+
+@pytest.mark.parametrize("d,m", [(3, 3), (8, 3)])
+def test_short_lone_paths_take_the_plain_kernel_with_the_bits_of_the_others(rng, d, m):
+    """Lone paths of at most 8 points run the plain one-unit kernel (``_engine.alone_kernel``: it compiles in less
+    than half the blocked kernel's time): the bits of the same path in a lane group (d = 3: 8 of 10 paths on lanes)
+    and of the blocked kernel, and iisignature's values."""
+    from roughpaths.signatures._engine import alone_kernel
+
+    for n in (2, 5, 8):
+        assert alone_kernel(n, d, m) is _lanes.scalar_units(d)
+        x = np.cumsum(rng.standard_normal((10, n, d)) * 0.3, axis=-2)
+        whole = signature(x, m)
+        off = level_offsets(d, m)
+        flipped = n * d < off[m + 1]               # the engine's layout trick (the path negated and reversed)
+        y = np.ascontiguousarray(-x[:, ::-1] if flipped else x)
+        blocked = np.empty((10, off[m + 1]))
+        _blocked.block_units(d, m)(y, *_units(10, n, 1), m, off, 0, 10, blocked)
+        blocked = blocked if flipped else blocked[:, _reversed_to_rowmajor(d, m)]
+        for b in (0, 8, 9):
+            lone = signature(x[b:b + 1], m)[0]
+            assert lone.tobytes() == whole[b].tobytes()
+            assert lone.tobytes() == blocked[b].tobytes()
+        np.testing.assert_allclose(whole, iisignature.sig(x, m), rtol=0, atol=1e-14)
+    assert alone_kernel(9, d, m) is _blocked.block_units(d, m)          # from 8 segments: the blocked kernel
 
 
 @pytest.mark.parametrize("d,m", [(4, 8), (5, 7)])   # 8 x 8 tiles only; tiles and edges (125 x 625)

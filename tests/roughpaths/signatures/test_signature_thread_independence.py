@@ -55,7 +55,7 @@ def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m, key):
     nu = 9 * nchunks
     off = _offsets(d, m)
     one = np.empty((nu, off[m + 1]))
-    kern.scalar_units(x, *units, m, off, 0, nu, one)
+    kern.scalar_units(x.shape[2])(x, *units, m, off, 0, nu, one)
     lanes = np.empty_like(one)
     groups = -(-nu // kern.LANES)
     lane_kernel = kern.lane_groups(d, m) if key is None else kern._lane_groups_kernel(*key)
@@ -70,7 +70,7 @@ def test_lanes_with_empty_units():
     assert np.any(units[1] == units[2])
     off = _offsets(3, 3)
     one = np.empty((12, off[4]))
-    kern.scalar_units(x, *units, 3, off, 0, 12, one)
+    kern.scalar_units(x.shape[2])(x, *units, 3, off, 0, 12, one)
     lanes = np.full_like(one, np.nan)
     kern.lane_groups(x.shape[2], 3)(x, *units, 3, off, 0, 2, lanes)
     assert one.tobytes() == lanes.tobytes()
