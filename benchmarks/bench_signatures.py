@@ -41,7 +41,9 @@ end, the cells above 1.0 (one thread) and 1.1 (parallel). Cells whose signature 
 skipped and listed. ``--sweep-d 2,6-9``, ``--sweep-depths 3,4``, ``--sweep-batches 16`` and
 ``--sweep-kinds sig,logsig,sig vjp`` select a subset; ``--sweep-modes 1`` runs the one-thread mode only.
 A timed sample of a small cell is a loop of calls lasting about 2 ms (divided back to one call), timed in at
-least 11 interleaved pairs.
+least 11 interleaved pairs. ``--sweep-general`` runs it with the kernels general in d only: the run-time
+variant of the lane and the blocked kernels everywhere (no compile-time ``d`` or depth), to show what the
+variants add.
 
 ``--fixed-cost`` prints only the cost of a call on tiny inputs (one path of 8 points in d = 2, 3 at
 depths 2-3, and 32 x 128 in d = 3), where the Python around the kernels is most of the time: ours,
@@ -49,7 +51,7 @@ iisignature and pysiglib on one thread, CPU time, medians of interleaved calls, 
 
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
 [--depths 3,4] [--only-streams] [--sweep [--sweep-d 2-20] [--sweep-depths 2-6] [--sweep-batches 16,64]
-[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6]] [--fixed-cost]`` (the cells, kinds and depths
+[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6] [--sweep-general]] [--fixed-cost]`` (the cells, kinds and depths
 select peer-table cells and skip the rest).
 """
 
@@ -316,6 +318,12 @@ def width_sweep(args) -> None:
 
     from roughpaths import logsignature, signature, signature_vjp
 
+    if args.sweep_general:            # before any call: the engine's plans are cached per shape
+        from roughpaths.signatures import _blocked, _lanes
+
+        _lanes.lane_key = lambda d, m: (0, 0)
+        _blocked.block_key = lambda d, m: (0, 0, False)
+        print("kernels general in d only: the run-time variants of the lane and blocked kernels")
     threads = numba.get_num_threads()
     ds = _int_list(args.sweep_d)
     depths = _int_list(args.sweep_depths)
@@ -410,6 +418,8 @@ def main() -> None:
     parser.add_argument("--sweep-batches", default="16,64", help="sweep batch sizes of 256-point paths")
     parser.add_argument("--sweep-kinds", default="sig,logsig", help="sweep kinds: sig, logsig, sig vjp")
     parser.add_argument("--sweep-modes", default="1,n", help="sweep modes: 1 (one thread), n (all threads)")
+    parser.add_argument("--sweep-general", action="store_true",
+                        help="sweep with the run-time (general in d) kernel variants only")
     parser.add_argument("--sweep-max-sigdim", type=float, default=2e6,
                         help="skip sweep cells with more signature floats per path")
     parser.add_argument("--fixed-cost", action="store_true",

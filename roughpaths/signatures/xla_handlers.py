@@ -15,7 +15,7 @@ one-unit kernels on XLA's buffers:
   or cotangent), goes to the Python handler of the same call (called through its address), so that
   errors keep the numpy API's messages.
 * **The same numbers**: the numpy API's steps in its order: one unit a path, the kernel variant the
-  engine picks for ``(d, depth)`` (the very compiled function: its address), the time reversal of a
+  engine picks for ``(n, d, depth)`` (the very compiled function: its address), the time reversal of a
   path smaller than its signature, the permutations between the row-major and the kernels' reversed
   layout, the increments' cotangent summed into the points as ``(0 + gd[k-1]) - gd[k]``; float64
   throughout, rounded to float32 on the way out where the buffers are float32. The results are
