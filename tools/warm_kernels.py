@@ -102,7 +102,8 @@ def warm_more_variants() -> None:
     86 s of compilation inside the tests, 42 s of it the one-unit reference kernel). The lane kernels of
     d = 2 at depth 5, d = 4 at depth 3 and (5, 3); the one-unit kernels (6, 4), (8, 4) and d = 4 at depth 8;
     the level-2 kernels of d = 4, 5; and :func:`~roughpaths.signatures._lanes.scalar_units`, the per-segment
-    kernel the tests hold the others to (private: the tests call it directly), for d = 2, 3, 5, 6."""
+    kernel the tests hold the others to (private: the tests call it directly; the engine runs it for lone paths
+    of at most 8 points, the JAX tests' one-path calls), for d = 2, 3, 5, 6."""
     import roughpaths as rp
     from roughpaths.algebra.flat import level_offsets
     from roughpaths.signatures import _lanes
@@ -121,7 +122,7 @@ def warm_more_variants() -> None:
         x = _walk(rng, 3, 10, d)
         units = _units(3, 10, 2)
         off = level_offsets(d, 3)
-        _lanes.scalar_units(x, *units, 3, off, 0, 6, np.empty((6, off[4])))
+        _lanes.scalar_units(d)(x, *units, 3, off, 0, 6, np.empty((6, off[4])))
 
 
 def warm_more_drivers() -> None:
