@@ -121,14 +121,19 @@ def _check_depth(depth) -> int:
 _SMALL_REQUEST = 64 * 2 ** 20
 
 
-def _check_fits(batch: int, d: int, depth: int, *, log: bool = False) -> None:
+def _check_fits(batch: int, d: int, depth: int, *, log: bool = False, n: int = 0) -> None:
     """Refuse, before allocating, a request whose working arrays would not fit in memory.
 
     The signature needs about 3 arrays of ``batch * sigdim`` floats (result, chunk partials,
     layout permutation); the log-signature 2 more (log, scratch) plus the sparse Lyndon map, whose
-    top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built).
+    top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built). Paths of
+    ``n`` points cut into ``c > 1`` work units (:func:`_horner_chunks`) add the units' signatures,
+    ``batch * c * sigdim`` floats (twice with ``log``: the gradients' units' cotangents too).
     """
     need = _need_bytes(batch, d, depth, log)
+    chunks = _horner_chunks(n, d, depth) if depth >= 3 and n >= 2 else 1
+    if chunks > 1:
+        need += 8 * _sigdim(d, depth) * max(batch, 1) * chunks * (2 if log else 1)
     if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
         return
     dim = _sigdim(d, depth)

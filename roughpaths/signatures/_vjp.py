@@ -164,6 +164,16 @@ def _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g):
     _lcon(1.0, pre, tmp, d, m, offsets, g)
 
 
+@njit(**_NOGIL)
+def unit_cotangents(part, gtot, nchunks, d, m, offsets, lo, hi, out):
+    """``out[u]``, the cotangent of unit ``u``'s signature (:func:`_unit_cotangent`), for units ``lo..hi-1`` of
+    paths cut into ``nchunks > 1`` units. Unchunked paths need none: a unit's cotangent is its path's, ``gtot``
+    itself, which the backward kernels take as it is (so they never compile this glue: 0.8-1.2 s of a first
+    gradient)."""
+    for u in range(lo, hi):
+        _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, out[u])
+
+
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _mul_rev(x0, xs, a, d, m, offsets, out):
     """``out <- (x0 + xs) ⊗ a`` (``a`` with no scalar), reversed layout, levels 1..m."""
@@ -215,7 +225,7 @@ def _sig_vjp_units_kernel(K: int, V: int):
     """The compiled one-unit backward pass for the step variants ``K`` (:func:`step_key`), ``V`` (:func:`vjp_key`)."""
 
     @njit(**_NOGIL)
-    def sig_vjp_units_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    def sig_vjp_units_variant(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd):
         d = x.shape[2]
         dim = offsets[m + 1]
         g = np.empty(dim)
@@ -228,7 +238,8 @@ def _sig_vjp_units_kernel(K: int, V: int):
         neg = np.empty(d)
         gdelta = np.empty(d)
         for u in range(lo, hi):
-            _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+            for r in range(dim):
+                g[r] = gunit[u, r]
             s = part[u].copy()
             b = ub[u]
             for k in range(uhi[u], ulo[u], -1):        # backward over the unit's segments, last first
@@ -259,8 +270,9 @@ def _sig_vjp_units_kernel(K: int, V: int):
 
 def sig_vjp_units(d: int):
     """The one-unit backward kernel for alphabet size ``d`` (compiled on first use, without the GIL):
-    ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)`` writes the cotangents of the
-    segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d). Each variant's compiled symbols carry its
+    ``kernel(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd)`` writes the cotangents of the segment
+    increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d), given their forward signatures ``part`` and the
+    cotangents ``gunit`` of those (:func:`unit_cotangents`; for unchunked paths the paths'). Each variant's compiled symbols carry its
     key (:func:`roughpaths._variants._named`): :mod:`roughpaths.signatures.xla_handlers` finds the kernel by its name."""
     return _sig_vjp_units_kernel(step_key(d), vjp_key(d))
 
@@ -383,7 +395,7 @@ def _sig_vjp_groups_kernel(V: int):
     """The compiled lane backward pass for the variant ``V`` (:func:`vjp_key`)."""
 
     @njit(**_NOGIL)
-    def sig_vjp_groups_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    def sig_vjp_groups_variant(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd):
         L = LANES
         T = BLOCK
         d = x.shape[2]
@@ -399,7 +411,6 @@ def _sig_vjp_groups_kernel(V: int):
         blk = np.empty(T * d * L)
         neg = np.empty(T * d * L)
         buf = np.empty(2 * d ** max(m - 2, 1) * L)
-        gu = np.empty(dim)
         nsteps = np.zeros(L, dtype=np.int64)
         for grp in range(lo, hi):
             steps = 0
@@ -407,10 +418,9 @@ def _sig_vjp_groups_kernel(V: int):
                 u = grp * L + l
                 if u < nunits:
                     nsteps[l] = uhi[u] - ulo[u]
-                    _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, gu)
                     for r in range(dim):
                         s[r * L + l] = part[u, r]
-                        g[r * L + l] = gu[r]
+                        g[r * L + l] = gunit[u, r]
                 else:
                     nsteps[l] = 0
                     for r in range(dim):
@@ -427,6 +437,6 @@ def _sig_vjp_groups_kernel(V: int):
 
 def sig_vjp_groups(d: int):
     """The lane backward kernel for alphabet size ``d`` (compiled on first use, without the GIL):
-    ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)``, :func:`sig_vjp_units` on lane
+    ``kernel(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd)``, :func:`sig_vjp_units` on lane
     groups ``lo..hi-1`` (units ``g*LANES ..``), the same bits."""
     return _sig_vjp_groups_kernel(vjp_key(d))

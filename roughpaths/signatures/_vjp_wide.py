@@ -28,7 +28,7 @@ from numba import njit
 from .._variants import variants
 from ._lanes import _horner_step_d, _wide_step, step_key
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
-from ._vjp import _dot_wide, _step_vjp_d, _tb_row, _unit_cotangent
+from ._vjp import _dot_wide, _step_vjp_d, _tb_row
 
 _NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
@@ -164,7 +164,7 @@ def _sig_vjp_wide_kernel(K: int):
     """The compiled wide backward pass for the step variant ``K`` (:func:`~._lanes.step_key`)."""
 
     @njit(**_NOGIL)
-    def sig_vjp_wide_variant(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd):
+    def sig_vjp_wide_variant(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd):
         d = x.shape[2]
         dim = offsets[m + 1]
         n = d ** (m - 1)
@@ -175,7 +175,8 @@ def _sig_vjp_wide_kernel(K: int):
         ok = offsets[m]
         g = np.empty(dim)
         for u in range(lo, hi):
-            _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, g)
+            for r in range(dim):
+                g[r] = gunit[u, r]
             s = part[u].copy()
             # backward over the unit's segments, last first, in blocks of KB; one run-time d: a compile-time
             # d = 8 variant measured 20% faster at depth 3, but took 100 s more to compile
@@ -217,6 +218,6 @@ def _sig_vjp_wide_kernel(K: int):
 
 def sig_vjp_wide(d: int):
     """The wide backward kernel (d >= 6, m >= 3; compiled on first use, without the GIL):
-    ``kernel(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi, gd)`` writes the cotangents of the
+    ``kernel(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd)`` writes the cotangents of the
     segment increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d)."""
     return _sig_vjp_wide_kernel(step_key(d))

@@ -101,14 +101,18 @@ def _signature_vjp_rev(x: np.ndarray, depth: int, g_rev: np.ndarray, part: np.nd
     nchunks, (ub, ulo, uhi), off, lanes, alone = _vjp_plan(nb, n, d, depth)
     if part is None:
         part = _reversed_parts(x, depth, nchunks)
+    gunit = g_rev                               # the cotangent of each unit's signature: its path's, unchunked
+    if nchunks > 1:
+        gunit = np.empty(part.shape)
+        _threads.run(lambda lo, hi: _vjp.unit_cotangents(part, g_rev, nchunks, d, depth, off, lo, hi, gunit),
+                     _threads.ranges(part.shape[0], 2.0 * nchunks * part.shape[1]), merge=True)
     gd = np.zeros((nb, n - 1, d))
     if lanes is not None:
         kernel, parts = lanes
-        _threads.run(lambda lo, hi: kernel(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, lo, hi, gd), parts)
+        _threads.run(lambda lo, hi: kernel(x, ub, ulo, uhi, depth, off, part, gunit, lo, hi, gd), parts)
     if alone is not None:
         one, first, parts = alone
-        _threads.run(lambda lo, hi: one(x, ub, ulo, uhi, nchunks, depth, off, part, g_rev, first + lo, first + hi, gd),
-                     parts)
+        _threads.run(lambda lo, hi: one(x, ub, ulo, uhi, depth, off, part, gunit, first + lo, first + hi, gd), parts)
     return _increments_to_points(gd, n)
 
 
@@ -155,7 +159,7 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     g = _check_grad(grad_output, batch, _sigdim(d, depth), "signature")
     flat = _kernel_array(x, (-1, n, d))
-    _check_fits(flat.shape[0], d, depth, log=True)
+    _check_fits(flat.shape[0], d, depth, log=True, n=n)
     return _signature_vjp_flat(flat, depth, g).reshape(x.shape)
 
 
@@ -199,7 +203,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
         g_sig = np.zeros((flat.shape[0], _sigdim(d, depth)))
         g_sig[:, :d] = g
         return _signature_vjp_flat(flat, depth, g_sig).reshape(x.shape)
-    _check_fits(flat.shape[0], d, depth, log=True)
+    _check_fits(flat.shape[0], d, depth, log=True, n=n)
     off = level_offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
     g_log_rev = lyndon_flat_vjp(g, d, depth).take(_rowmajor_to_reversed(d, depth), axis=1)

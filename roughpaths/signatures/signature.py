@@ -63,7 +63,7 @@ def signature(paths, depth: int) -> np.ndarray:
     x = _check_paths(paths, finite=depth == 1)     # depth >= 2: checked through the output
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     flat = _kernel_array(x, (-1, n, d))
-    _check_fits(flat.shape[0], d, depth)
+    _check_fits(flat.shape[0], d, depth, n=n)
     return _finite_or_raise(_signature_flat(flat, depth), x).reshape(batch + (_sigdim(d, depth),))
 
 
@@ -99,7 +99,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
         return signature(x, 1)[..., :_logsigdim(d, depth)]
     batch, n = x.shape[:-2], x.shape[-2]
     flat = _kernel_array(x, (-1, n, d))
-    _check_fits(flat.shape[0], d, depth, log=True)
+    _check_fits(flat.shape[0], d, depth, log=True, n=n)
     if depth == 2:
         # log at level 2 is S_2 - ½ x⊗x; its Lyndon coordinates ([i,j], i < j) are the Lévy areas,
         # which the level-2 kernel accumulates directly

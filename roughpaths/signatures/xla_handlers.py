@@ -276,11 +276,9 @@ def _layout(nb, n, d, m):
 _F8_3D, _F8_2D, _I8_1D = types.float64[:, :, ::1], types.float64[:, ::1], types.int64[::1]
 #: The argument types of the one-unit kernels, as the numpy API calls them (so that both call one compiled
 #: function): :func:`roughpaths.signatures._engine.alone_kernel`'s ``(x, ub, ulo, uhi, m, offsets, lo, hi, part)``
-#: and :func:`roughpaths.signatures._vjp.sig_vjp_units` ``(x, ub, ulo, uhi, nchunks, m, offsets, part, gtot, lo, hi,
-#: gd)``.
+#: and :func:`roughpaths.signatures._vjp.sig_vjp_units` ``(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd)``.
 BLOCK_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, _I8_1D, types.int64, types.int64, _F8_2D)
-VJP_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, types.int64, _I8_1D, _F8_2D, _F8_2D, types.int64, types.int64,
-            _F8_3D)
+VJP_ARGS = (_F8_3D, _I8_1D, _I8_1D, _I8_1D, types.int64, _I8_1D, _F8_2D, _F8_2D, types.int64, types.int64, _F8_3D)
 
 @intrinsic
 def _block_units(typingctx, addr, x, ub, ulo, uhi, m, off, lo, hi, part):
@@ -289,9 +287,9 @@ def _block_units(typingctx, addr, x, ub, ulo, uhi, m, off, lo, hi, part):
 
 
 @intrinsic
-def _vjp_units(typingctx, addr, x, ub, ulo, uhi, nchunks, m, off, part, g_rev, lo, hi, gd):
+def _vjp_units(typingctx, addr, x, ub, ulo, uhi, m, off, part, g_rev, lo, hi, gd):
     """The one-unit VJP kernel at ``addr`` (a variant of :func:`roughpaths.signatures._vjp.sig_vjp_units`)."""
-    return native_call(typingctx, VJP_ARGS, addr, (x, ub, ulo, uhi, nchunks, m, off, part, g_rev, lo, hi, gd))
+    return native_call(typingctx, VJP_ARGS, addr, (x, ub, ulo, uhi, m, off, part, g_rev, lo, hi, gd))
 
 
 @njit(**_JIT)
@@ -341,7 +339,7 @@ def _backward(frame_pointer):
     gd = np.zeros((nb, n - 1, d))
     if not _load_paths(xb, x, False) or not _load_cotangent(gb, g, off, d, m) \
             or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
-            or _vjp_units(vjp, x, ub, ulo, uhi, 1, m, off, part, g, 0, nb, gd):
+            or _vjp_units(vjp, x, ub, ulo, uhi, m, off, part, g, 0, nb, gd):
         return voidptr(call(i64(p), frame))
     _store_points(ob, gd)
     _count(p, 1)

@@ -5,7 +5,7 @@
   instant for huge depths;
 * the cache of Lyndon expansions / projection maps never holds more than its byte budget;
 * a request whose output cannot fit in memory is refused before allocating, naming the size and
-  the fix;
+  the fix (the work units of long paths counted);
 * high-depth log-signatures agree with iisignature (depth 8; depth 10 in the slow suite).
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from roughpaths.algebra import _lyndon
-from roughpaths import logsigdim, logsignature, signature
+from roughpaths import logsigdim, logsignature, signature, signature_vjp, sigdim
 
 
 def _naive_lyndon_count(d, m):
@@ -63,6 +63,20 @@ def test_refuses_a_depth_that_cannot_fit():
     for fn in (lambda: signature(x, 14), lambda: logsignature(x, 14)):
         with pytest.raises(ValueError, match=r"GiB.*lower depth"):
             fn()
+
+
+def test_the_work_units_of_long_paths_are_counted_before_allocating(monkeypatch):
+    """Paths cut into work units (here 4 paths of 4097 points, d = 10 at depth 5: 4 units each) hold the units'
+    signatures, 16 x 111110 floats (14 MB), beside the result; the gradients hold the units' cotangents too.
+    Budgets between the estimate without them and with them: refused at once, naming the size."""
+    x = np.zeros((4, 4097, 10))
+    for budget, fn in ((75e6, lambda: signature(x, 5)),
+                       (95e6, lambda: signature_vjp(x, 5, np.zeros((4, sigdim(10, 5)))))):
+        monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(int(budget)))
+        t = time.perf_counter()
+        with pytest.raises(ValueError, match=r"depth=5 with d=10 and 4 path\(s\).* would take \d+ MiB"):
+            fn()
+        assert time.perf_counter() - t < 2.0                       # refused before the work
 
 
 def test_depth_8_matches_iisignature(rng):

@@ -104,10 +104,14 @@ def test_gradient_lanes_equal_one_unit_at_a_time(nchunks, d, m):
     nu = 9 * nchunks
     off = _offsets(d, m)
     part = _reversed_parts(x, m, nchunks)
+    gunit = g                                     # each unit's cotangent: its path's, or glued across the chunks
+    if nchunks > 1:
+        gunit = np.empty(part.shape)
+        _sig_vjp.unit_cotangents(part, g, nchunks, d, m, off, 0, nu, gunit)
     one = np.zeros((9, 299, d))
-    _sig_vjp.sig_vjp_units(d)(x, *units, nchunks, m, off, part, g, 0, nu, one)
+    _sig_vjp.sig_vjp_units(d)(x, *units, m, off, part, gunit, 0, nu, one)
     lanes = np.full_like(one, np.nan)
     groups = -(-nu // kern.LANES)
     for grp in range(groups):                     # one range per group, in reverse order
-        _sig_vjp.sig_vjp_groups(d)(x, *units, nchunks, m, off, part, g, groups - 1 - grp, groups - grp, lanes)
+        _sig_vjp.sig_vjp_groups(d)(x, *units, m, off, part, gunit, groups - 1 - grp, groups - grp, lanes)
     assert one.tobytes() == lanes.tobytes()
