@@ -8,8 +8,10 @@ Backward through S = S_prev ⊗ exp(D) per segment (last to first):
 * then backward through the Horner step itself (:func:`_step_vjp_d`), which gives both the
   cotangent of D and G_prev = G ◁ exp(D) for about three Horner steps' work.
 
-:func:`_lcon` / :func:`_rcon` (general contractions) serve the chunk cotangents and the log's
-backward pass. Serial kernels over a range ``[lo, hi)`` of work items (GIL released).
+A unit's backward pass starts from the cotangent of its own signature: its path's for a path that is one
+unit, else ``P ▷ (G ◁ Q)`` (P, Q the products of the path's units before and after it), formed for all units
+first by :func:`unit_cotangents`, so that the backward kernels never compile that glue. :func:`_lcon` /
+:func:`_rcon` (general contractions) serve it and the log's backward pass. Serial kernels over a range ``[lo, hi)`` of work items (GIL released).
 :func:`sig_vjp_groups` runs the backward pass of LANES units side by side in packed registers
 (about 4-5x faster than :func:`sig_vjp_units`, one unit at a time, and bitwise the same).
 """
