@@ -409,6 +409,8 @@ class ChaoticDriver(SeededDriver):
         rng = np.random.default_rng(self.seed_sequence)
         self._y0 = fast_map.initial_states(rng, P)
         self.dim = _observe(fast_map, observable, self._y0[:, None, :]).shape[-1]
+        # batch-shaped, as blocks() and select() read the starts of a seeded driver (_flat)
+        self._y0 = self._y0.reshape(self.batch_shape + (fast_map.dim,))
         self.level = 2
         # fast steps per chunk, fixed by the whole batch (select keeps it): pieces never depend on max_steps
         self._chunk = max(1, int(self.block_bytes // max(1, 8 * max(P, 1) * (fast_map.dim + 2 * self.dim))))

@@ -220,3 +220,20 @@ def test_bad_input_is_refused_with_the_fix():
         observable_orbits(cat_map(), _v, 10**7, seed=0, batch_shape=(10**6,))
     with pytest.raises(TypeError, match="seed must be an int"):
         ChaoticDriver(cat_map(), _v, 10, seed=np.random.default_rng(0), dt=0.1, n_steps=2)
+
+
+def test_a_batch_of_several_axes_is_the_flat_batch_reshaped():
+    # the initial points were kept flat (P, k) while blocks() and select() broadcast them to batch_shape + (k,):
+    # any batch of two or more axes failed with a bare numpy broadcast error
+    kw = dict(seed=4, dt=0.1, n_steps=3)
+    flat = ChaoticDriver(cat_map(), _v, 100, batch_shape=(6,), **kw).rough_path()
+    drv = ChaoticDriver(cat_map(), _v, 100, batch_shape=(2, 3), **kw)
+    X = drv.rough_path()
+    assert X.batch_shape == (2, 3)
+    assert drv.initial_state().shape == (2, 3, 2)
+    np.testing.assert_array_equal(X.increments.reshape(6, 3, 2), flat.increments)
+    np.testing.assert_array_equal(X.areas.reshape(6, 3, 2, 2), flat.areas)
+    sub = drv.select([4, 0]).rough_path()
+    np.testing.assert_array_equal(sub.increments, flat.increments[[4, 0]])
+    empty = ChaoticDriver(cat_map(), _v, 100, batch_shape=(0, 3), **kw).rough_path()
+    assert empty.increments.shape == (0, 3, 3, 2)
