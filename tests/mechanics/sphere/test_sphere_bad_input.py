@@ -50,6 +50,19 @@ CASES = [
     (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0, (3, -1): 1.0}, 1.0), ValueError, "real field"),
     (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, np.nan), ValueError, "rotation"),
     (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 3), ValueError, "L must exceed"),
+    # were silent: a NaN or text coefficient, a float L truncated, a NaN time (NaN coefficients), a bool rotation;
+    # or bare numpy errors: a fractional m (IndexError), a huge L or degree (MemoryError)
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): np.nan}, 1.0), ValueError, r"wave\[\(3, 1\)\] must be a finite"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): "0.5"}, 1.0), TypeError, r"wave\[\(3, 1\)\] must be a number"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 0.5): 1.0}, 1.0), ValueError, "wave keys must be"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, True), TypeError, "rotation must be a real number"),
+    (lambda: RossbyHaurwitzWave(10**12, {(10**12, 1): 1.0}, 1.0), ValueError, "memory budget"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 4.7), TypeError, "L must be an integer"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(np.nan, 4), ValueError, "t must be finite"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 10**7), ValueError, "memory budget"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).vorticity(0.1, 0.2, np.inf), ValueError, "t must be finite"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).vorticity([0.1, np.nan], 0.2, 0.0), ValueError,
+     "theta contains 1 non-finite"),
 ]
 
 
