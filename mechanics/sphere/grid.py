@@ -75,6 +75,9 @@ def sphere_grid(n_lat: int, n_lon: int) -> tuple[np.ndarray, np.ndarray, np.ndar
     """
     n_lat = _check_grid_size(n_lat, "n_lat", 1)
     n_lon = _check_grid_size(n_lon, "n_lon", 1)
+    # numpy's nodes are the eigenvalues of the n_lat x n_lat companion matrix (it and eigvalsh's copy)
+    check_bytes(16.0 * n_lat * n_lat + 8.0 * (6 * n_lat + n_lon), f"the grid's Gauss–Legendre nodes (an n_lat x n_lat "
+                f"eigenvalue problem, n_lat = {n_lat}, n_lon = {n_lon})", "use fewer colatitudes (n_lat) or longitudes")
     x, w = np.polynomial.legendre.leggauss(n_lat)
     order = np.argsort(-x)
     return np.arccos(x[order]), 2.0 * np.pi * np.arange(n_lon) / n_lon, w[order]

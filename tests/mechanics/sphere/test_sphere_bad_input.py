@@ -85,3 +85,14 @@ def test_requests_above_the_memory_budget_are_refused_before_allocating(monkeypa
         harmonic_matrix(200, 1, 0)
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**8))
     assert inverse_laplacian(small).shape == (100, 100)
+
+
+def test_a_huge_grid_is_refused_before_the_node_computation_allocates():
+    # the Gauss–Legendre nodes are the eigenvalues of an n_lat x n_lat companion matrix: sphere_grid(10**6, 1)
+    # raised numpy's bare MemoryError (7.28 TiB), and grid_to_coefficients of a tall grid the same
+    with pytest.raises(ValueError, match="n_lat x n_lat .* memory budget.*fewer colatitudes"):
+        sphere_grid(10**6, 1)
+    with pytest.raises(ValueError, match="n_lat x n_lat .* memory budget"):
+        grid_to_coefficients(np.broadcast_to(np.zeros(1), (10**6, 1)), 1)
+    with pytest.raises(ValueError, match="memory budget"):
+        sphere_grid(4, 10**15)
