@@ -67,6 +67,8 @@ import numbers
 
 import numpy as np
 
+from roughpaths.validation import check_work
+
 from ._inputs import as_matrix, check_size
 from .grid import function_to_matrix, grid_to_matrix
 from .laplacian import inverse_laplacian
@@ -166,9 +168,10 @@ def casimirs(W, orders=(2, 3, 4, 5, 6)) -> np.ndarray:
     Computed by repeated products (:math:`O(k_{max}N^3)`).
     """
     arr = as_matrix(W)
-    ks = [int(k) for k in np.atleast_1d(orders)]
-    if not ks or min(ks) < 1 or any(float(k) != float(o) for k, o in zip(ks, np.atleast_1d(orders))):
-        raise ValueError(f"orders must be positive integers (e.g. (2, 3, 4, 5, 6)), got {orders!r}.")
+    ks = _check_orders(orders)
+    n = arr.shape[-1]
+    check_work(float(min(max(ks), 10**300)) * max(1, arr.size // (n * n)) * n * n, f"the powers (iW)^k up to k = {max(ks)} of "
+               f"{arr.size // (n * n)} matrices of size {n} (entries of the products)", "ask for lower orders")
     m = 1j * arr
     out = np.empty(arr.shape[:-2] + (len(ks),))
     power, have = m, 1
@@ -177,6 +180,24 @@ def casimirs(W, orders=(2, 3, 4, 5, 6)) -> np.ndarray:
             power, have = power @ m, have + 1
         out[..., pos] = np.trace(power, axis1=-2, axis2=-1).real
     return out
+
+
+def _check_orders(orders) -> list:
+    """``orders`` as a list of Python ints ``>= 1``: integers, or floats with integer values (bools refused)."""
+    hint = "pass e.g. orders=(2, 3, 4, 5, 6)"
+    if isinstance(orders, (str, bytes)):
+        raise TypeError(f"orders must be positive integers, got the string {orders!r}; {hint}.")
+    arr = np.atleast_1d(np.asarray(orders, dtype=object))
+    if arr.ndim != 1 or arr.size == 0:
+        raise ValueError(f"orders must be positive integers, a non-empty 1-D sequence, got {orders!r}; {hint}.")
+    ks = []
+    for o in arr:
+        if isinstance(o, (bool, np.bool_)) or not isinstance(o, numbers.Real):
+            raise TypeError(f"orders must be positive integers, got {o!r} in {orders!r}; {hint}.")
+        if not isinstance(o, numbers.Integral) and (not np.isfinite(float(o)) or float(o) != int(o)) or int(o) < 1:
+            raise ValueError(f"orders must be positive integers (e.g. (2, 3, 4, 5, 6)), got {orders!r}.")
+        ks.append(int(o))
+    return ks
 
 
 def real_harmonic_matrix(N: int, l: int, m: int) -> np.ndarray:

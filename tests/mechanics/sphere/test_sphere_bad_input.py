@@ -43,6 +43,12 @@ CASES = [
     (lambda: ZeitlinHamiltonian(8).gradient_matrix("W"), TypeError, "W must be"),
     (lambda: casimirs(W8, (0, 2)), ValueError, "orders must be positive integers"),
     (lambda: casimirs(W8, (2.5,)), ValueError, "orders must be positive integers"),
+    # were bare numpy/Python errors (int('ab'), int(nan), a 2-D array) or a bool taken as the order 1
+    (lambda: casimirs(W8, "ab"), TypeError, "orders must be positive integers"),
+    (lambda: casimirs(W8, (np.nan,)), ValueError, "orders must be positive integers"),
+    (lambda: casimirs(W8, [[2, 3]]), ValueError, "orders must be positive integers"),
+    (lambda: casimirs(W8, (True, 2)), TypeError, "orders must be positive integers"),
+    (lambda: casimirs(W8, (10**400,)), ValueError, "work budget.*ask for lower orders"),   # was a loop for ever
     (lambda: energy(np.ones((2, 3))), ValueError, r"\(\.\.\., N, N\)"),
     (lambda: real_harmonic_matrix(8, 0, 0), ValueError, "l = 0 is the identity"),
     (lambda: RossbyHaurwitzWave(0, {(0, 0): 1.0}, 1.0), ValueError, "degree must be"),
