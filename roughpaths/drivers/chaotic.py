@@ -163,8 +163,9 @@ def cat_map(matrix=((2, 1), (1, 1))) -> ChaoticMap:
     A = np.asarray(matrix)
     if A.shape != (2, 2) or A.dtype.kind not in "iu":
         raise ValueError(f"matrix must be a 2x2 integer matrix, got {np.asarray(matrix)!r}.")
+    a_, b_, c_, d_ = (int(x) for x in A.ravel())                    # Python integers: int64 products can wrap
+    det, tr = a_ * d_ - b_ * c_, a_ + d_
     A = A.astype(np.int64)
-    det, tr = int(A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]), int(A[0, 0] + A[1, 1])
     if abs(det) != 1 or abs(tr) <= 2:
         raise ValueError(f"matrix must have det = ±1 and |trace| > 2 (a hyperbolic toral automorphism), got "
                          f"det = {det}, trace = {tr}; e.g. [[2, 1], [1, 1]].")
@@ -337,6 +338,9 @@ def observable_orbits(fast_map, observable, length: int, *, seed, batch_shape=()
                  "use fewer or shorter orbits")
     state = fast_map.initial_states(np.random.default_rng(check_seed(seed)), P)
     d = _observe(fast_map, observable, state[:, None, :]).shape[-1]
+    check_memory(8.0 * P * length * d + (4 << 20) * (2.0 + 2.0 * d / fast_map.dim),
+                 f"the orbits ({P} x {length} fast steps x {d} components) and a chunk of states",
+                 "use fewer or shorter orbits")
     out = np.empty((P, length, d))
     c = max(1, min(length, (4 << 20) // max(1, 8 * P * fast_map.dim)))
     buf = np.empty((P, c, fast_map.dim), dtype=state.dtype)

@@ -237,3 +237,18 @@ def test_a_batch_of_several_axes_is_the_flat_batch_reshaped():
     np.testing.assert_array_equal(sub.increments, flat.increments[[4, 0]])
     empty = ChaoticDriver(cat_map(), _v, 100, batch_shape=(0, 3), **kw).rough_path()
     assert empty.increments.shape == (0, 3, 3, 2)
+
+
+def test_the_orbits_memory_counts_the_observables_dimension(monkeypatch):
+    # the estimate of observable_orbits took d = 8 whatever the observable returned: 10 orbits x 100 steps of a
+    # 1000-component observable (8 MB) passed a 1 MB budget
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
+    wide = lambda y: np.repeat(np.sin(2 * np.pi * y), 500, axis=-1)    # noqa: E731 - d = 1000
+    with pytest.raises(ValueError, match="orbits .* memory budget"):
+        observable_orbits(cat_map(), wide, 100, seed=0, batch_shape=(10,))
+
+
+def test_a_non_unimodular_matrix_is_refused_even_when_int64_wraps():
+    # det [[2^32, 1], [-1, 2^32]] = 2^64 + 1 wrapped to 1 in int64: the matrix passed as det = ±1
+    with pytest.raises(ValueError, match="det = ±1"):
+        cat_map([[2**32, 1], [-1, 2**32]])
