@@ -6,7 +6,8 @@ import pytest
 from mechanics.sphere import (RossbyHaurwitzWave, ZeitlinHamiltonian, casimirs, coefficients_to_grid,
                               coefficients_to_matrix, energy, function_to_matrix, grid_to_coefficients,
                               grid_to_matrix, harmonic_matrix, hbar, inverse_laplacian, laplacian, lm_index,
-                              matrix_to_coefficients, matrix_to_grid, real_harmonic_matrix, sphere_grid)
+                              matrix_to_coefficients, matrix_to_grid, real_harmonic_matrix, salt_noise, sphere_grid,
+                              zeitlin_system)
 
 W8 = 1j * harmonic_matrix(8, 2, 0)
 
@@ -48,6 +49,11 @@ CASES = [
     (lambda: casimirs(W8, (np.nan,)), ValueError, "orders must be positive integers"),
     (lambda: casimirs(W8, [[2, 3]]), ValueError, "orders must be positive integers"),
     (lambda: casimirs(W8, (True, 2)), TypeError, "orders must be positive integers"),
+    # zeitlin_system(noise=...): were numpy's 'zero-size array to reduction operation maximum' (no matrix),
+    # a bare ufunc error (text) and a message naming X instead of noise (object dtype)
+    (lambda: zeitlin_system(8, noise=np.zeros((0, 8, 8))), ValueError, "noise must hold at least one"),
+    (lambda: zeitlin_system(8, noise=[[["a"] * 8] * 8]), TypeError, "noise must be a numeric array"),
+    (lambda: zeitlin_system(8, noise=np.zeros((2, 8, 8), dtype=object)), TypeError, "noise must be a numeric"),
     (lambda: casimirs(W8, (10**400,)), ValueError, "work budget.*ask for lower orders"),   # was a loop for ever
     (lambda: energy(np.ones((2, 3))), ValueError, r"\(\.\.\., N, N\)"),
     (lambda: real_harmonic_matrix(8, 0, 0), ValueError, "l = 0 is the identity"),
