@@ -19,6 +19,9 @@ CASES = [
     (lambda: harmonic_matrix(8, 3, -4), ValueError, r"\|m\| <= l"),
     (lambda: harmonic_matrix(8, 2.0, 0), TypeError, "l must be an integer"),
     (lambda: lm_index(2, 3), ValueError, r"\|m\| <= l"),
+    (lambda: lm_index(1.5, 0), TypeError, "l and m must be integers"),      # was the index 3.75
+    (lambda: lm_index("a", 0), TypeError, "l and m must be integers"),      # was numpy's UFuncTypeError
+    (lambda: lm_index(2, True), TypeError, "l and m must be integers"),
     (lambda: coefficients_to_matrix(np.ones(5)), ValueError, "L\\*\\*2"),
     (lambda: coefficients_to_matrix(np.ones(16), 3), ValueError, "truncation"),
     (lambda: coefficients_to_matrix("abc"), TypeError, "omega"),
