@@ -401,7 +401,7 @@ class ChaoticDriver(SeededDriver):
             raise ValueError("times must be a uniform grid for a ChaoticDriver (every step holds the same number "
                              "of fast steps); pass dt=... and n_steps=....")
         m = self.n * float(h[0])
-        if not (m >= 0.5 and abs(m - round(m)) <= 1e-9 * max(1.0, m)):
+        if not (0.5 <= m < math.inf and abs(m - round(m)) <= 1e-9 * max(1.0, m)):
             raise ValueError(f"n * dt must be a positive integer (fast steps per grid step), got n={n!r}, "
                              f"dt={float(h[0])!r}: n * dt = {m!r}; choose dt = m / n for an integer m.")
         self.fast_steps_per_step = int(round(m))

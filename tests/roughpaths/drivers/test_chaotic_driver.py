@@ -252,3 +252,9 @@ def test_a_non_unimodular_matrix_is_refused_even_when_int64_wraps():
     # det [[2^32, 1], [-1, 2^32]] = 2^64 + 1 wrapped to 1 in int64: the matrix passed as det = ±1
     with pytest.raises(ValueError, match="det = ±1"):
         cat_map([[2**32, 1], [-1, 2**32]])
+
+
+def test_an_overflowing_number_of_fast_steps_is_refused():
+    # n * dt = 1e300 * 1e10 overflows to inf: round(inf) raised Python's bare OverflowError
+    with pytest.raises(ValueError, match=r"n \* dt must be a positive integer.*inf"):
+        ChaoticDriver(cat_map(), _v, 1e300, seed=0, dt=1e10, n_steps=2)
