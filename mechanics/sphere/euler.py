@@ -265,7 +265,10 @@ def salt_noise(N: int, modes=None, *, fields=None, amplitudes=1.0, time_unit: st
     n = check_size(N)
     kappa = _time_scale(n, time_unit)
     amps = _check_amplitudes(amplitudes)
-    modes = [] if modes is None else list(modes)
+    try:
+        modes = [] if modes is None else list(modes)
+    except TypeError:
+        raise TypeError(f"modes must be a sequence of (l, m) pairs, e.g. [(1, 0), (2, 1)], got {modes!r}.") from None
     if fields is not None and (callable(fields) or (isinstance(fields, np.ndarray) and fields.ndim == 2)):
         fields = [fields]
     if fields is not None and not isinstance(fields, np.ndarray):
