@@ -291,7 +291,12 @@ def _check_fast(fast_map, observable):
 
 def _observe(fast_map, observable, states, d=None) -> np.ndarray:
     """``v`` on a chunk of states ``(P, c, k)`` (or ``(P, k)``), checked: shape ``(..., d)``, finite, float64."""
-    v = np.asarray(observable(fast_map.coordinates(states)), dtype=np.float64)
+    v = np.asarray(observable(fast_map.coordinates(states)))
+    if v.dtype.kind not in "biuf":
+        kind = "complex" if v.dtype.kind == "c" else "not numbers"
+        raise TypeError(f"observable must return real numbers, got dtype {v.dtype} ({kind}); return e.g. the real "
+                        f"and imaginary parts as separate components.")
+    v = np.asarray(v, dtype=np.float64)
     want = states.shape[:-1]
     if v.ndim != len(want) + 1 or v.shape[:-1] != want or (d is not None and v.shape[-1] != d):
         raise ValueError(f"observable returned shape {v.shape} for coordinates of shape {states.shape}; it "

@@ -258,3 +258,12 @@ def test_an_overflowing_number_of_fast_steps_is_refused():
     # n * dt = 1e300 * 1e10 overflows to inf: round(inf) raised Python's bare OverflowError
     with pytest.raises(ValueError, match=r"n \* dt must be a positive integer.*inf"):
         ChaoticDriver(cat_map(), _v, 1e300, seed=0, dt=1e10, n_steps=2)
+
+
+def test_an_observable_of_complex_or_text_values_is_refused():
+    # complex values lost their imaginary part with only numpy's ComplexWarning (a silent wrong driver); text
+    # raised numpy's bare 'could not convert string to float'
+    with pytest.raises(TypeError, match="observable must return real numbers.*complex"):
+        observable_orbits(cat_map(), lambda y: np.exp(2j * np.pi * y), 3, seed=1, batch_shape=(2,))
+    with pytest.raises(TypeError, match="observable must return real numbers"):
+        ChaoticDriver(cat_map(), lambda y: np.full(y.shape, "a"), 10, seed=0, dt=0.1, n_steps=2)
