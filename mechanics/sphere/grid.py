@@ -244,4 +244,8 @@ def function_to_matrix(func, N: int, *, oversample: int = 2) -> np.ndarray:
     except ValueError:
         raise ValueError(f"func(theta, phi) must return values broadcastable to the grid shape {shape} (theta "
                          f"as a column, phi as a row), got shape {values.shape}.") from None
+    if values.dtype.kind in "fc" and not np.all(np.isfinite(values)):
+        bad = int(np.count_nonzero(~np.isfinite(values)))
+        raise ValueError(f"func(theta, phi) returned {bad} non-finite value(s) (NaN or inf) on the {shape} grid; "
+                         f"the field must be finite on the whole sphere (theta in (0, pi), phi in [0, 2 pi)).")
     return coefficients_to_matrix(grid_to_coefficients(values, n), n)

@@ -42,6 +42,9 @@ CASES = [
     (lambda: function_to_matrix(3.0, 8), TypeError, "func must be a callable"),
     (lambda: function_to_matrix(lambda t, p: t, 8, oversample=0), ValueError, "oversample"),
     (lambda: function_to_matrix(lambda t, p: np.ones(3), 8), ValueError, "broadcastable to the grid"),
+    # the grid values of func were refused as 'values has non-finite entries', an argument the caller never passed
+    (lambda: function_to_matrix(lambda t, p: np.where(t > 1.0, np.nan, t) + 0 * p, 8), ValueError,
+     r"func\(theta, phi\) returned .* non-finite"),
     (lambda: ZeitlinHamiltonian(8, time_unit="seconds"), ValueError, "time_unit must be"),
     (lambda: ZeitlinHamiltonian(8).value_matrix(np.eye(6)), ValueError, "must be 8 x 8"),
     (lambda: ZeitlinHamiltonian(8).gradient_matrix("W"), TypeError, "W must be"),
