@@ -67,7 +67,9 @@ import numbers
 
 import numpy as np
 
-from ._inputs import as_matrix, check_size
+from roughpaths.validation import check_work
+
+from ._inputs import as_matrix, check_bytes, check_size
 from .grid import function_to_matrix, grid_to_matrix
 from .laplacian import inverse_laplacian
 from .quantisation import harmonic_matrix, hbar
@@ -166,9 +168,10 @@ def casimirs(W, orders=(2, 3, 4, 5, 6)) -> np.ndarray:
     Computed by repeated products (:math:`O(k_{max}N^3)`).
     """
     arr = as_matrix(W)
-    ks = [int(k) for k in np.atleast_1d(orders)]
-    if not ks or min(ks) < 1 or any(float(k) != float(o) for k, o in zip(ks, np.atleast_1d(orders))):
-        raise ValueError(f"orders must be positive integers (e.g. (2, 3, 4, 5, 6)), got {orders!r}.")
+    ks = _check_orders(orders)
+    n = arr.shape[-1]
+    check_work(float(min(max(ks), 10**300)) * max(1, arr.size // (n * n)) * n * n, f"the powers (iW)^k up to k = {max(ks)} of "
+               f"{arr.size // (n * n)} matrices of size {n} (entries of the products)", "ask for lower orders")
     m = 1j * arr
     out = np.empty(arr.shape[:-2] + (len(ks),))
     power, have = m, 1
@@ -177,6 +180,38 @@ def casimirs(W, orders=(2, 3, 4, 5, 6)) -> np.ndarray:
             power, have = power @ m, have + 1
         out[..., pos] = np.trace(power, axis1=-2, axis2=-1).real
     return out
+
+
+def _check_amplitudes(amplitudes) -> np.ndarray:
+    """``amplitudes`` as float64, after refusing bools, text and complex numbers (``np.asarray`` would take a
+    bool as 1.0 and raise its own errors for the others)."""
+    try:
+        items = np.asarray(amplitudes, dtype=object).ravel()
+    except ValueError:
+        items = [amplitudes]
+    for a in items:
+        if isinstance(a, (bool, np.bool_)) or not isinstance(a, numbers.Real):
+            raise TypeError(f"amplitudes must be real numbers (a float, or one per noise field), got {a!r} in "
+                            f"{amplitudes!r}; pass e.g. amplitudes=0.1.")
+    return np.asarray(amplitudes, dtype=np.float64)
+
+
+def _check_orders(orders) -> list:
+    """``orders`` as a list of Python ints ``>= 1``: integers, or floats with integer values (bools refused)."""
+    hint = "pass e.g. orders=(2, 3, 4, 5, 6)"
+    if isinstance(orders, (str, bytes)):
+        raise TypeError(f"orders must be positive integers, got the string {orders!r}; {hint}.")
+    arr = np.atleast_1d(np.asarray(orders, dtype=object))
+    if arr.ndim != 1 or arr.size == 0:
+        raise ValueError(f"orders must be positive integers, a non-empty 1-D sequence, got {orders!r}; {hint}.")
+    ks = []
+    for o in arr:
+        if isinstance(o, (bool, np.bool_)) or not isinstance(o, numbers.Real):
+            raise TypeError(f"orders must be positive integers, got {o!r} in {orders!r}; {hint}.")
+        if not isinstance(o, numbers.Integral) and (not np.isfinite(float(o)) or float(o) != int(o)) or int(o) < 1:
+            raise ValueError(f"orders must be positive integers (e.g. (2, 3, 4, 5, 6)), got {orders!r}.")
+        ks.append(int(o))
+    return ks
 
 
 def real_harmonic_matrix(N: int, l: int, m: int) -> np.ndarray:
@@ -229,14 +264,28 @@ def salt_noise(N: int, modes=None, *, fields=None, amplitudes=1.0, time_unit: st
     """
     n = check_size(N)
     kappa = _time_scale(n, time_unit)
+    amps = _check_amplitudes(amplitudes)
+    try:
+        modes = [] if modes is None else list(modes)
+    except TypeError:
+        raise TypeError(f"modes must be a sequence of (l, m) pairs, e.g. [(1, 0), (2, 1)], got {modes!r}.") from None
+    if fields is not None and (callable(fields) or (isinstance(fields, np.ndarray) and fields.ndim == 2)):
+        fields = [fields]
+    if fields is not None and not isinstance(fields, np.ndarray):
+        try:
+            fields = list(fields)
+        except TypeError:
+            raise TypeError(f"fields must be callables f(theta, phi) or grid values (k, n_lat, n_lon), got "
+                            f"{type(fields).__name__}; pass e.g. fields=[lambda theta, phi: np.cos(theta)].") from None
+    k = len(modes) + (0 if fields is None else len(fields))
+    # the matrices, their stack and the skew-Hermitian part (with its temporary)
+    check_bytes(4 * 16.0 * k * n * n, f"the {k} noise matrices of size {n}", "use fewer modes or fields, or a smaller N")
     mats = []
-    for item in ([] if modes is None else list(modes)):
+    for item in modes:
         if not isinstance(item, (tuple, list)) or len(item) != 2:
             raise ValueError(f"modes must be a sequence of (l, m) pairs, e.g. [(1, 0), (2, 1)], got item {item!r}.")
         mats.append(real_harmonic_matrix(n, item[0], item[1]))
     if fields is not None:
-        if callable(fields) or (isinstance(fields, np.ndarray) and fields.ndim == 2):
-            fields = [fields]
         if isinstance(fields, np.ndarray):
             mats.extend(list(grid_to_matrix(np.asarray(fields, dtype=np.float64), n)))
         else:
@@ -251,7 +300,6 @@ def salt_noise(N: int, modes=None, *, fields=None, amplitudes=1.0, time_unit: st
     out = 0.5 * (out - np.conj(np.swapaxes(out, -1, -2)))  # the real part of each field (skew-Hermitian)
     idx = np.arange(n)
     out[:, idx, idx] -= np.trace(out, axis1=-2, axis2=-1)[:, None] / n
-    amps = np.asarray(amplitudes, dtype=np.float64)
     if amps.ndim == 0:
         amps = np.full(out.shape[0], float(amps))
     if amps.shape != (out.shape[0],) or not np.all(np.isfinite(amps)):

@@ -75,6 +75,9 @@ def sphere_grid(n_lat: int, n_lon: int) -> tuple[np.ndarray, np.ndarray, np.ndar
     """
     n_lat = _check_grid_size(n_lat, "n_lat", 1)
     n_lon = _check_grid_size(n_lon, "n_lon", 1)
+    # numpy's nodes are the eigenvalues of the n_lat x n_lat companion matrix (it and eigvalsh's copy)
+    check_bytes(16.0 * n_lat * n_lat + 8.0 * (6 * n_lat + n_lon), f"the grid's Gauss–Legendre nodes (an n_lat x n_lat "
+                f"eigenvalue problem, n_lat = {n_lat}, n_lon = {n_lon})", "use fewer colatitudes (n_lat) or longitudes")
     x, w = np.polynomial.legendre.leggauss(n_lat)
     order = np.argsort(-x)
     return np.arccos(x[order]), 2.0 * np.pi * np.arange(n_lon) / n_lon, w[order]
@@ -241,4 +244,8 @@ def function_to_matrix(func, N: int, *, oversample: int = 2) -> np.ndarray:
     except ValueError:
         raise ValueError(f"func(theta, phi) must return values broadcastable to the grid shape {shape} (theta "
                          f"as a column, phi as a row), got shape {values.shape}.") from None
+    if values.dtype.kind in "fc" and not np.all(np.isfinite(values)):
+        bad = int(np.count_nonzero(~np.isfinite(values)))
+        raise ValueError(f"func(theta, phi) returned {bad} non-finite value(s) (NaN or inf) on the {shape} grid; "
+                         f"the field must be finite on the whole sphere (theta in (0, pi), phi in [0, 2 pi)).")
     return coefficients_to_matrix(grid_to_coefficients(values, n), n)

@@ -127,6 +127,9 @@ def spin_matrices(N: int) -> np.ndarray:
 def lm_index(l, m):
     """The flat coefficient index ``l*(l+1)+m`` of :math:`(l, m)` (arrays broadcast)."""
     l_arr, m_arr = np.asarray(l), np.asarray(m)
+    if l_arr.dtype.kind not in "iu" or m_arr.dtype.kind not in "iu":
+        raise TypeError(f"l and m must be integers (or integer arrays), got l={l!r}, m={m!r}; pass e.g. "
+                        f"lm_index(2, -1).")
     if np.any(l_arr < 0) or np.any(np.abs(m_arr) > l_arr):
         raise ValueError(f"(l, m) must satisfy l >= 0 and |m| <= l, got l={l!r}, m={m!r}.")
     return l_arr * (l_arr + 1) + m_arr

@@ -48,9 +48,16 @@ import numbers
 
 import numpy as np
 
+from roughpaths.validation import as_float_array, check_real
+
+from ._inputs import check_bytes
 from .quantisation import coefficients_to_matrix, lm_index
 
 __all__ = ["RossbyHaurwitzWave"]
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_))
 
 
 class RossbyHaurwitzWave:
@@ -77,17 +84,27 @@ class RossbyHaurwitzWave:
     def __init__(self, degree: int, wave: dict, rotation: float):
         if isinstance(degree, bool) or not isinstance(degree, numbers.Integral) or degree < 1:
             raise ValueError(f"degree must be an integer l >= 1, got {degree!r}.")
-        if not isinstance(rotation, numbers.Real) or not np.isfinite(rotation):
+        if isinstance(rotation, (bool, np.bool_)) or not isinstance(rotation, numbers.Real):
+            raise TypeError(f"rotation must be a real number (the angular velocity Omega), got {rotation!r}; "
+                            f"pass a float.")
+        if not np.isfinite(rotation):
             raise ValueError(f"rotation must be a finite real angular velocity, got {rotation!r}.")
         if not isinstance(wave, dict) or not wave:
             raise TypeError(f"wave must be a non-empty dict {{(l, m): coefficient}}, got {wave!r}.")
         l = int(degree)
+        check_bytes(17.0 * (2 * l + 1), f"the coefficients of a wave of degree {l}", "use a smaller degree")
         coef = np.zeros(2 * l + 1, dtype=np.complex128)  # index m + l
         given = np.zeros(2 * l + 1, dtype=bool)
         for key, value in wave.items():
-            if not (isinstance(key, tuple) and len(key) == 2 and key[0] == l and abs(key[1]) <= l):
-                raise ValueError(f"wave keys must be (l, m) with l = degree = {l} and |m| <= l, got {key!r}.")
-            coef[key[1] + l] = complex(value)
+            if not (isinstance(key, tuple) and len(key) == 2 and key[0] == l and _is_int(key[1]) and abs(key[1]) <= l):
+                raise ValueError(f"wave keys must be (l, m) with l = degree = {l} and an integer |m| <= l, "
+                                 f"got {key!r}.")
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Number):
+                raise TypeError(f"wave[{key!r}] must be a number (a complex coefficient), got {value!r}; "
+                                f"pass a float or a complex.")
+            if not np.isfinite(complex(value)):
+                raise ValueError(f"wave[{key!r}] must be a finite coefficient, got {value!r}.")
+            coef[int(key[1]) + l] = complex(value)
             given[key[1] + l] = True
         for m in range(0, l + 1):
             a, b = coef[m + l], coef[-m + l]
@@ -108,12 +125,17 @@ class RossbyHaurwitzWave:
 
     def coefficients(self, t: float, L: int) -> np.ndarray:
         r"""The vorticity coefficients at time ``t``, ``omega[l*(l+1)+m]``, shape ``(L**2,)`` (``L > degree``)."""
+        if not _is_int(L):
+            raise TypeError(f"L must be an integer number of degrees (the modes l < L), got {L!r}; "
+                            f"pass e.g. L={self.degree + 1}.")
         L = int(L)
+        t = check_real(t, "t")
         if L <= self.degree:
             raise ValueError(f"L must exceed the degree {self.degree} (the modes l < L are returned), got {L}.")
+        check_bytes(16.0 * L * L, f"the coefficients l < L = {L}", "use a smaller L")
         out = np.zeros(L * L, dtype=np.complex128)
         m = np.arange(-self.degree, self.degree + 1)
-        out[lm_index(self.degree, m)] = self.wave * np.exp(-1j * m * self.speed * float(t))
+        out[lm_index(self.degree, m)] = self.wave * np.exp(-1j * m * self.speed * t)
         out[lm_index(1, 0)] += 2.0 * self.rotation * np.sqrt(4.0 * np.pi / 3.0)
         return out
 
@@ -126,8 +148,9 @@ class RossbyHaurwitzWave:
         (real; ``theta``, ``phi`` broadcast)."""
         from scipy.special import sph_harm_y  # imported here: 0.14 s that `import mechanics` need not pay
 
-        theta, phi = np.broadcast_arrays(np.asarray(theta, dtype=np.float64), np.asarray(phi, dtype=np.float64))
-        shifted = np.mod(phi - self.speed * float(t), 2.0 * np.pi)
+        t = check_real(t, "t")
+        theta, phi = np.broadcast_arrays(as_float_array(theta, "theta"), as_float_array(phi, "phi"))
+        shifted = np.mod(phi - self.speed * t, 2.0 * np.pi)
         out = 2.0 * self.rotation * np.cos(theta) + 0j
         for m in range(-self.degree, self.degree + 1):
             out = out + self.wave[m + self.degree] * sph_harm_y(self.degree, m, theta, shifted)

@@ -26,6 +26,7 @@ import numpy as np
 from ..systems.classical_algebras import su
 from ..systems.hamiltonian import MatrixHamiltonian
 from ..systems.lie_poisson import LiePoissonSystem
+from ._inputs import as_matrix
 from .euler import ZeitlinHamiltonian, salt_noise
 
 __all__ = ["zeitlin_system"]
@@ -84,9 +85,12 @@ def zeitlin_system(N: int, *, noise_modes=((1, 0), (1, 1), (2, 1)), noise=None, 
     if noise is None:
         mats = salt_noise(N, modes=noise_modes, amplitudes=amplitudes, time_unit=time_unit)
     else:
-        mats = np.asarray(noise)
+        mats = as_matrix(noise, "noise", N=N)
         if mats.ndim != 3 or mats.shape[1:] != (N, N):
             raise ValueError(f"noise must have shape (m, {N}, {N}) (one su({N}) matrix per noise), got {mats.shape}.")
+        if mats.shape[0] == 0:
+            raise ValueError(f"noise must hold at least one su({N}) matrix, got shape {mats.shape}; for the model "
+                             f"without noise use ZeitlinHamiltonian(N).vector_field, or pass noise_modes.")
         defect = float(np.max(np.abs(algebra._project(mats) - mats))) if mats.size else 0.0
         if defect > 1e-12 * max(1.0, float(np.max(np.abs(mats)))):
             raise ValueError(f"noise matrices must lie in su({N}) (skew-Hermitian, trace-free); they are off by "

@@ -163,8 +163,9 @@ def cat_map(matrix=((2, 1), (1, 1))) -> ChaoticMap:
     A = np.asarray(matrix)
     if A.shape != (2, 2) or A.dtype.kind not in "iu":
         raise ValueError(f"matrix must be a 2x2 integer matrix, got {np.asarray(matrix)!r}.")
+    a_, b_, c_, d_ = (int(x) for x in A.ravel())                    # Python integers: int64 products can wrap
+    det, tr = a_ * d_ - b_ * c_, a_ + d_
     A = A.astype(np.int64)
-    det, tr = int(A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]), int(A[0, 0] + A[1, 1])
     if abs(det) != 1 or abs(tr) <= 2:
         raise ValueError(f"matrix must have det = ±1 and |trace| > 2 (a hyperbolic toral automorphism), got "
                          f"det = {det}, trace = {tr}; e.g. [[2, 1], [1, 1]].")
@@ -290,7 +291,12 @@ def _check_fast(fast_map, observable):
 
 def _observe(fast_map, observable, states, d=None) -> np.ndarray:
     """``v`` on a chunk of states ``(P, c, k)`` (or ``(P, k)``), checked: shape ``(..., d)``, finite, float64."""
-    v = np.asarray(observable(fast_map.coordinates(states)), dtype=np.float64)
+    v = np.asarray(observable(fast_map.coordinates(states)))
+    if v.dtype.kind not in "biuf":
+        kind = "complex" if v.dtype.kind == "c" else "not numbers"
+        raise TypeError(f"observable must return real numbers, got dtype {v.dtype} ({kind}); return e.g. the real "
+                        f"and imaginary parts as separate components.")
+    v = np.asarray(v, dtype=np.float64)
     want = states.shape[:-1]
     if v.ndim != len(want) + 1 or v.shape[:-1] != want or (d is not None and v.shape[-1] != d):
         raise ValueError(f"observable returned shape {v.shape} for coordinates of shape {states.shape}; it "
@@ -337,6 +343,9 @@ def observable_orbits(fast_map, observable, length: int, *, seed, batch_shape=()
                  "use fewer or shorter orbits")
     state = fast_map.initial_states(np.random.default_rng(check_seed(seed)), P)
     d = _observe(fast_map, observable, state[:, None, :]).shape[-1]
+    check_memory(8.0 * P * length * d + (4 << 20) * (2.0 + 2.0 * d / fast_map.dim),
+                 f"the orbits ({P} x {length} fast steps x {d} components) and a chunk of states",
+                 "use fewer or shorter orbits")
     out = np.empty((P, length, d))
     c = max(1, min(length, (4 << 20) // max(1, 8 * P * fast_map.dim)))
     buf = np.empty((P, c, fast_map.dim), dtype=state.dtype)
@@ -397,7 +406,7 @@ class ChaoticDriver(SeededDriver):
             raise ValueError("times must be a uniform grid for a ChaoticDriver (every step holds the same number "
                              "of fast steps); pass dt=... and n_steps=....")
         m = self.n * float(h[0])
-        if not (m >= 0.5 and abs(m - round(m)) <= 1e-9 * max(1.0, m)):
+        if not (0.5 <= m < math.inf and abs(m - round(m)) <= 1e-9 * max(1.0, m)):
             raise ValueError(f"n * dt must be a positive integer (fast steps per grid step), got n={n!r}, "
                              f"dt={float(h[0])!r}: n * dt = {m!r}; choose dt = m / n for an integer m.")
         self.fast_steps_per_step = int(round(m))
@@ -409,6 +418,8 @@ class ChaoticDriver(SeededDriver):
         rng = np.random.default_rng(self.seed_sequence)
         self._y0 = fast_map.initial_states(rng, P)
         self.dim = _observe(fast_map, observable, self._y0[:, None, :]).shape[-1]
+        # batch-shaped, as blocks() and select() read the starts of a seeded driver (_flat)
+        self._y0 = self._y0.reshape(self.batch_shape + (fast_map.dim,))
         self.level = 2
         # fast steps per chunk, fixed by the whole batch (select keeps it): pieces never depend on max_steps
         self._chunk = max(1, int(self.block_bytes // max(1, 8 * max(P, 1) * (fast_map.dim + 2 * self.dim))))

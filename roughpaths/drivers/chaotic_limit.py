@@ -110,8 +110,8 @@ def chaotic_limit(Sigma, E) -> ChaoticLimit:
     """
     S = as_float_array(Sigma, "Sigma", ndim=2)
     d = S.shape[0]
-    if S.shape != (d, d):
-        raise ValueError(f"Sigma must be a square (d, d) matrix, got shape {S.shape}.")
+    if S.shape != (d, d) or d == 0:
+        raise ValueError(f"Sigma must be a square (d, d) matrix with d >= 1, got shape {S.shape}.")
     Em = as_float_array(E, "E", ndim=2)
     if Em.shape != (d, d):
         raise ValueError(f"E must have the shape of Sigma, ({d}, {d}), got {Em.shape}.")
@@ -253,6 +253,9 @@ def green_kubo(values, max_lag: int) -> GreenKuboEstimate:
     """
     v = as_float_array(values, "values", min_ndim=3)
     L, d = v.shape[-2], v.shape[-1]
+    if d == 0:
+        raise ValueError(f"values must have at least one component (shape (..., L, d) with d >= 1), got shape "
+                         f"{v.shape}.")
     v = v.reshape(-1, L, d)
     P = v.shape[0]
     M = check_positive_int(max_lag, "max_lag")
@@ -278,6 +281,10 @@ def green_kubo(values, max_lag: int) -> GreenKuboEstimate:
     per_orbit = 16.0 * (nfft // 2 + 1) * (d + d * d) + 8.0 * nfft * d * d
     check_memory(per_orbit, "the FFT workspace of one orbit", "use shorter orbits")
     chunk = max(1, int((64 << 20) // per_orbit))
+    # C and the two temporaries of its standard deviation, and the FFT workspace of a chunk of orbits
+    check_memory(3 * 8.0 * P * (M + 1) * d * d + min(P, chunk) * per_orbit,
+                 f"the correlations of {P} orbits ({P} x {M + 1} lags x {d} x {d}) and their FFT workspace",
+                 "use a smaller max_lag, fewer orbits or fewer components")
     C = np.empty((P, M + 1, d, d))
     norm = 1.0 / (L - np.arange(M + 1))
     for p0 in range(0, P, chunk):
@@ -353,6 +360,9 @@ class SineObservable:
     def __call__(self, y) -> np.ndarray:
         """``v(y)``, ``y`` of shape ``(..., 2)`` to ``(..., d)``."""
         y = np.asarray(y, dtype=np.float64)
+        if y.ndim < 1 or y.shape[-1] != 2:
+            raise ValueError(f"y must have shape (..., 2) (points of the 2-torus), got shape {y.shape}; pass "
+                             f"cat_map().coordinates(states), or y[None] for one point.")
         return np.sin(y @ self._freq) @ self._weights
 
     def correlations(self, max_lag: int, matrix=((2, 1), (1, 1))) -> np.ndarray:
@@ -368,7 +378,9 @@ class SineObservable:
             raise ValueError(f"matrix must be a 2x2 integer matrix, got {np.asarray(matrix)!r}.")
         k, c = self.frequencies.astype(object), self.coefficients     # Python integers: exact at every lag
         At = A.astype(object)
-        d = k.shape[0]
+        d, R = c.shape
+        check_memory(8.0 * (M + 1) * d * d + 8.0 * 4 * (d * R) ** 2, f"the correlations ({M + 1} lags x {d} x {d})",
+                     "use a smaller max_lag")
         out = np.zeros((M + 1, d, d))
         moved = k.copy()                                              # (Aᵀ)^m k, as row vectors l ↦ l A
         for m in range(M + 1):

@@ -67,3 +67,23 @@ def test_bad_noise_arguments():
         salt_noise(8, [1, 0])
     with pytest.raises(ValueError, match="time_unit"):
         salt_noise(8, [(1, 0)], time_unit="seconds")
+
+
+def test_amplitudes_of_the_wrong_kind_and_too_many_modes_are_refused(monkeypatch):
+    # were: a bool taken as 1.0, a text raised numpy's bare "could not convert string to float", a complex
+    # float()'s bare TypeError; the matrices of the modes were allocated before any estimate
+    with pytest.raises(TypeError, match="amplitudes must be real"):
+        salt_noise(8, [(1, 0)], amplitudes=True)
+    with pytest.raises(TypeError, match="amplitudes must be real"):
+        salt_noise(8, [(1, 0)], amplitudes="x")
+    with pytest.raises(TypeError, match="amplitudes must be real"):
+        salt_noise(8, [(1, 0)], amplitudes=1j)
+    with pytest.raises(TypeError, match="amplitudes must be real"):
+        salt_noise(8, [(1, 0), (1, 1)], amplitudes=[1.0, True])
+    with pytest.raises(TypeError, match="modes must be a sequence of"):          # was 'int' object is not iterable
+        salt_noise(8, 5)
+    with pytest.raises(TypeError, match="fields must be callables"):             # was 'float' object is not iterable
+        salt_noise(8, fields=3.0)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
+    with pytest.raises(ValueError, match="noise matrices .* memory budget"):
+        salt_noise(64, [(1, 0)] * 20)

@@ -6,7 +6,8 @@ import pytest
 from mechanics.sphere import (RossbyHaurwitzWave, ZeitlinHamiltonian, casimirs, coefficients_to_grid,
                               coefficients_to_matrix, energy, function_to_matrix, grid_to_coefficients,
                               grid_to_matrix, harmonic_matrix, hbar, inverse_laplacian, laplacian, lm_index,
-                              matrix_to_coefficients, matrix_to_grid, real_harmonic_matrix, sphere_grid)
+                              matrix_to_coefficients, matrix_to_grid, real_harmonic_matrix, salt_noise, sphere_grid,
+                              zeitlin_system)
 
 W8 = 1j * harmonic_matrix(8, 2, 0)
 
@@ -18,6 +19,9 @@ CASES = [
     (lambda: harmonic_matrix(8, 3, -4), ValueError, r"\|m\| <= l"),
     (lambda: harmonic_matrix(8, 2.0, 0), TypeError, "l must be an integer"),
     (lambda: lm_index(2, 3), ValueError, r"\|m\| <= l"),
+    (lambda: lm_index(1.5, 0), TypeError, "l and m must be integers"),      # was the index 3.75
+    (lambda: lm_index("a", 0), TypeError, "l and m must be integers"),      # was numpy's UFuncTypeError
+    (lambda: lm_index(2, True), TypeError, "l and m must be integers"),
     (lambda: coefficients_to_matrix(np.ones(5)), ValueError, "L\\*\\*2"),
     (lambda: coefficients_to_matrix(np.ones(16), 3), ValueError, "truncation"),
     (lambda: coefficients_to_matrix("abc"), TypeError, "omega"),
@@ -38,11 +42,25 @@ CASES = [
     (lambda: function_to_matrix(3.0, 8), TypeError, "func must be a callable"),
     (lambda: function_to_matrix(lambda t, p: t, 8, oversample=0), ValueError, "oversample"),
     (lambda: function_to_matrix(lambda t, p: np.ones(3), 8), ValueError, "broadcastable to the grid"),
+    # the grid values of func were refused as 'values has non-finite entries', an argument the caller never passed
+    (lambda: function_to_matrix(lambda t, p: np.where(t > 1.0, np.nan, t) + 0 * p, 8), ValueError,
+     r"func\(theta, phi\) returned .* non-finite"),
     (lambda: ZeitlinHamiltonian(8, time_unit="seconds"), ValueError, "time_unit must be"),
     (lambda: ZeitlinHamiltonian(8).value_matrix(np.eye(6)), ValueError, "must be 8 x 8"),
     (lambda: ZeitlinHamiltonian(8).gradient_matrix("W"), TypeError, "W must be"),
     (lambda: casimirs(W8, (0, 2)), ValueError, "orders must be positive integers"),
     (lambda: casimirs(W8, (2.5,)), ValueError, "orders must be positive integers"),
+    # were bare numpy/Python errors (int('ab'), int(nan), a 2-D array) or a bool taken as the order 1
+    (lambda: casimirs(W8, "ab"), TypeError, "orders must be positive integers"),
+    (lambda: casimirs(W8, (np.nan,)), ValueError, "orders must be positive integers"),
+    (lambda: casimirs(W8, [[2, 3]]), ValueError, "orders must be positive integers"),
+    (lambda: casimirs(W8, (True, 2)), TypeError, "orders must be positive integers"),
+    # zeitlin_system(noise=...): were numpy's 'zero-size array to reduction operation maximum' (no matrix),
+    # a bare ufunc error (text) and a message naming X instead of noise (object dtype)
+    (lambda: zeitlin_system(8, noise=np.zeros((0, 8, 8))), ValueError, "noise must hold at least one"),
+    (lambda: zeitlin_system(8, noise=[[["a"] * 8] * 8]), TypeError, "noise must be a numeric array"),
+    (lambda: zeitlin_system(8, noise=np.zeros((2, 8, 8), dtype=object)), TypeError, "noise must be a numeric"),
+    (lambda: casimirs(W8, (10**400,)), ValueError, "work budget.*ask for lower orders"),   # was a loop for ever
     (lambda: energy(np.ones((2, 3))), ValueError, r"\(\.\.\., N, N\)"),
     (lambda: real_harmonic_matrix(8, 0, 0), ValueError, "l = 0 is the identity"),
     (lambda: RossbyHaurwitzWave(0, {(0, 0): 1.0}, 1.0), ValueError, "degree must be"),
@@ -50,6 +68,19 @@ CASES = [
     (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0, (3, -1): 1.0}, 1.0), ValueError, "real field"),
     (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, np.nan), ValueError, "rotation"),
     (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 3), ValueError, "L must exceed"),
+    # were silent: a NaN or text coefficient, a float L truncated, a NaN time (NaN coefficients), a bool rotation;
+    # or bare numpy errors: a fractional m (IndexError), a huge L or degree (MemoryError)
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): np.nan}, 1.0), ValueError, r"wave\[\(3, 1\)\] must be a finite"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): "0.5"}, 1.0), TypeError, r"wave\[\(3, 1\)\] must be a number"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 0.5): 1.0}, 1.0), ValueError, "wave keys must be"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, True), TypeError, "rotation must be a real number"),
+    (lambda: RossbyHaurwitzWave(10**12, {(10**12, 1): 1.0}, 1.0), ValueError, "memory budget"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 4.7), TypeError, "L must be an integer"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(np.nan, 4), ValueError, "t must be finite"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).coefficients(0.0, 10**7), ValueError, "memory budget"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).vorticity(0.1, 0.2, np.inf), ValueError, "t must be finite"),
+    (lambda: RossbyHaurwitzWave(3, {(3, 1): 1.0}, 1.0).vorticity([0.1, np.nan], 0.2, 0.0), ValueError,
+     "theta contains 1 non-finite"),
 ]
 
 
@@ -72,3 +103,14 @@ def test_requests_above_the_memory_budget_are_refused_before_allocating(monkeypa
         harmonic_matrix(200, 1, 0)
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**8))
     assert inverse_laplacian(small).shape == (100, 100)
+
+
+def test_a_huge_grid_is_refused_before_the_node_computation_allocates():
+    # the Gauss–Legendre nodes are the eigenvalues of an n_lat x n_lat companion matrix: sphere_grid(10**6, 1)
+    # raised numpy's bare MemoryError (7.28 TiB), and grid_to_coefficients of a tall grid the same
+    with pytest.raises(ValueError, match="n_lat x n_lat .* memory budget.*fewer colatitudes"):
+        sphere_grid(10**6, 1)
+    with pytest.raises(ValueError, match="n_lat x n_lat .* memory budget"):
+        grid_to_coefficients(np.broadcast_to(np.zeros(1), (10**6, 1)), 1)
+    with pytest.raises(ValueError, match="memory budget"):
+        sphere_grid(4, 10**15)

@@ -220,3 +220,50 @@ def test_bad_input_is_refused_with_the_fix():
         observable_orbits(cat_map(), _v, 10**7, seed=0, batch_shape=(10**6,))
     with pytest.raises(TypeError, match="seed must be an int"):
         ChaoticDriver(cat_map(), _v, 10, seed=np.random.default_rng(0), dt=0.1, n_steps=2)
+
+
+def test_a_batch_of_several_axes_is_the_flat_batch_reshaped():
+    # the initial points were kept flat (P, k) while blocks() and select() broadcast them to batch_shape + (k,):
+    # any batch of two or more axes failed with a bare numpy broadcast error
+    kw = dict(seed=4, dt=0.1, n_steps=3)
+    flat = ChaoticDriver(cat_map(), _v, 100, batch_shape=(6,), **kw).rough_path()
+    drv = ChaoticDriver(cat_map(), _v, 100, batch_shape=(2, 3), **kw)
+    X = drv.rough_path()
+    assert X.batch_shape == (2, 3)
+    assert drv.initial_state().shape == (2, 3, 2)
+    np.testing.assert_array_equal(X.increments.reshape(6, 3, 2), flat.increments)
+    np.testing.assert_array_equal(X.areas.reshape(6, 3, 2, 2), flat.areas)
+    sub = drv.select([4, 0]).rough_path()
+    np.testing.assert_array_equal(sub.increments, flat.increments[[4, 0]])
+    empty = ChaoticDriver(cat_map(), _v, 100, batch_shape=(0, 3), **kw).rough_path()
+    assert empty.increments.shape == (0, 3, 3, 2)
+
+
+def test_the_orbits_memory_counts_the_observables_dimension(monkeypatch):
+    # the estimate of observable_orbits took d = 8 whatever the observable returned: 10 orbits x 100 steps of a
+    # 1000-component observable (8 MB) passed a 1 MB budget
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
+    wide = lambda y: np.repeat(np.sin(2 * np.pi * y), 500, axis=-1)    # noqa: E731 - d = 1000
+    with pytest.raises(ValueError, match="orbits .* memory budget"):
+        observable_orbits(cat_map(), wide, 100, seed=0, batch_shape=(10,))
+
+
+def test_a_non_unimodular_matrix_is_refused_even_when_int64_wraps():
+    # det [[2^32, 1], [-1, 2^32]] = 2^64 + 1 wrapped to 1 in int64: the matrix passed as det = ±1
+    with pytest.raises(ValueError, match="det = ±1"):
+        cat_map([[2**32, 1], [-1, 2**32]])
+
+
+def test_an_overflowing_number_of_fast_steps_is_refused():
+    # n * dt = 1e300 * 1e10 overflows to inf: round(inf) raised Python's bare OverflowError
+    with pytest.raises(ValueError, match=r"n \* dt must be a positive integer.*inf"):
+        ChaoticDriver(cat_map(), _v, 1e300, seed=0, dt=1e10, n_steps=2)
+
+
+def test_an_observable_of_complex_or_text_values_is_refused():
+    # complex values lost their imaginary part with only numpy's ComplexWarning (a silent wrong driver); text
+    # raised numpy's bare 'could not convert string to float'
+    with pytest.raises(TypeError, match="observable must return real numbers.*complex"):
+        observable_orbits(cat_map(), lambda y: np.exp(2j * np.pi * y), 3, seed=1, batch_shape=(2,))
+    with pytest.raises(TypeError, match="observable must return real numbers"):
+        ChaoticDriver(cat_map(), lambda y: np.full(y.shape, "a"), 10, seed=0, dt=0.1, n_steps=2)

@@ -140,3 +140,25 @@ def test_bad_input_is_refused_with_the_fix():
     with pytest.raises(ValueError, match="coefficients must have shape"):
         SineObservable([[[1, 0]]], [[1.0, 2.0]])
     assert math.isfinite(green_kubo(rng.standard_normal((4, 50, 1)), 2).E[0, 0])
+
+
+def test_empty_dimensions_wrong_coordinates_and_unestimated_sizes_are_refused(monkeypatch):
+    # were bare numpy errors: a (0, 0) Sigma ('zero-size array to reduction operation maximum'), values with no
+    # component ('cannot reshape array of size 0'), coordinates without the last axis of length 2 (matmul)
+    with pytest.raises(ValueError, match="Sigma must be .* d >= 1"):
+        chaotic_limit(np.zeros((0, 0)), np.zeros((0, 0)))
+    with pytest.raises(ValueError, match=r"values must have at least one component"):
+        green_kubo(np.zeros((3, 10, 0)), 2)
+    with pytest.raises(ValueError, match=r"y must have shape \(\.\.\., 2\)"):
+        EXAMPLE(np.zeros((5, 3)))
+    with pytest.raises(ValueError, match=r"y must have shape \(\.\.\., 2\)"):
+        EXAMPLE(0.5)
+    # the correlations C (P, M + 1, d, d) of green_kubo, d times the values, and the (M + 1, d, d) of the exact
+    # correlations were allocated without an estimate
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(5 * 10**6))
+    v = np.random.default_rng(0).standard_normal((2000, 100, 2))     # 3.2 MB; C alone is 6.4 MB
+    with pytest.raises(ValueError, match="correlations .* memory budget"):
+        green_kubo(v, 99)
+    wide = SineObservable(np.ones((200, 1, 2), dtype=np.int64), np.ones((200, 1)))
+    with pytest.raises(ValueError, match="correlations .* memory budget"):
+        wide.correlations(100)
