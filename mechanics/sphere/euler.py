@@ -72,7 +72,7 @@ from roughpaths.validation import check_work
 from ._inputs import as_matrix, check_bytes, check_size
 from .grid import function_to_matrix, grid_to_matrix
 from .laplacian import inverse_laplacian
-from .quantisation import harmonic_matrix, hbar
+from .quantisation import _harmonic_matrices, hbar
 
 __all__ = ["ZeitlinHamiltonian", "energy", "enstrophy", "casimirs", "real_harmonic_matrix", "salt_noise"]
 
@@ -221,21 +221,34 @@ def real_harmonic_matrix(N: int, l: int, m: int) -> np.ndarray:
     :math:`Y^{\mathbb R}_{l,-m} = \sqrt2(-1)^m\operatorname{Im}Y_{lm}` (:math:`m > 0`; orthonormal, and
     :math:`Y^{\mathbb R}_{11}\propto x_1`, :math:`Y^{\mathbb R}_{1,-1}\propto x_2`).
     """
-    n = check_size(N)
-    if isinstance(l, bool) or isinstance(m, bool) or not isinstance(l, numbers.Integral) \
-            or not isinstance(m, numbers.Integral):
-        raise TypeError(f"l and m must be integers, got l={l!r}, m={m!r}.")
-    if not 1 <= l < n or abs(m) > l:
-        raise ValueError(f"(l, m) must satisfy 1 <= l < N = {n} (l = 0 is the identity, not in su(N)) "
-                         f"and |m| <= l, got ({l}, {m}).")
-    if m == 0:
-        return 1j * harmonic_matrix(n, l, 0)
-    am = abs(int(m))
-    plus, minus = harmonic_matrix(n, l, am), harmonic_matrix(n, l, -am)
-    sign = (-1.0) ** am
-    if m > 0:  # sqrt2 (-1)^m Re Y_lm = ((-1)^m Y_lm + Y_{l,-m}) / sqrt2
-        return 1j * (sign * plus + minus) / np.sqrt(2.0)
-    return (sign * plus - minus) / np.sqrt(2.0)  # i * ((-1)^m Y_lm - Y_{l,-m}) / (sqrt2 i)
+    return _real_harmonic_matrices(check_size(N), [(l, m)])[0]
+
+
+def _real_harmonic_matrices(n: int, modes) -> list:
+    """:func:`real_harmonic_matrix` of every ``(l, m)`` of ``modes``, from one pass over the quantised basis."""
+    for l, m in modes:
+        if isinstance(l, bool) or isinstance(m, bool) or not isinstance(l, numbers.Integral) \
+                or not isinstance(m, numbers.Integral):
+            raise TypeError(f"l and m must be integers, got l={l!r}, m={m!r}.")
+        if not 1 <= l < n or abs(m) > l:
+            raise ValueError(f"(l, m) must satisfy 1 <= l < N = {n} (l = 0 is the identity, not in su(N)) "
+                             f"and |m| <= l, got ({l}, {m}).")
+    pairs = []
+    for l, m in modes:
+        pairs += [(int(l), 0)] if m == 0 else [(int(l), abs(int(m))), (int(l), -abs(int(m)))]
+    mats = iter(_harmonic_matrices(n, pairs))
+    out = []
+    for l, m in modes:
+        if m == 0:
+            out.append(1j * next(mats))
+            continue
+        plus, minus = next(mats), next(mats)
+        sign = (-1.0) ** abs(int(m))
+        if m > 0:  # sqrt2 (-1)^m Re Y_lm = ((-1)^m Y_lm + Y_{l,-m}) / sqrt2
+            out.append(1j * (sign * plus + minus) / np.sqrt(2.0))
+        else:
+            out.append((sign * plus - minus) / np.sqrt(2.0))  # i * ((-1)^m Y_lm - Y_{l,-m}) / (sqrt2 i)
+    return out
 
 
 def salt_noise(N: int, modes=None, *, fields=None, amplitudes=1.0, time_unit: str = "physical") -> np.ndarray:
@@ -280,11 +293,10 @@ def salt_noise(N: int, modes=None, *, fields=None, amplitudes=1.0, time_unit: st
     k = len(modes) + (0 if fields is None else len(fields))
     # the matrices, their stack and the skew-Hermitian part (with its temporary)
     check_bytes(4 * 16.0 * k * n * n, f"the {k} noise matrices of size {n}", "use fewer modes or fields, or a smaller N")
-    mats = []
     for item in modes:
         if not isinstance(item, (tuple, list)) or len(item) != 2:
             raise ValueError(f"modes must be a sequence of (l, m) pairs, e.g. [(1, 0), (2, 1)], got item {item!r}.")
-        mats.append(real_harmonic_matrix(n, item[0], item[1]))
+    mats = _real_harmonic_matrices(n, modes)                  # one pass over the basis for all modes
     if fields is not None:
         if isinstance(fields, np.ndarray):
             mats.extend(list(grid_to_matrix(np.asarray(fields, dtype=np.float64), n)))

@@ -237,18 +237,34 @@ def harmonic_matrix(N: int, l: int, m: int) -> np.ndarray:
             raise TypeError(f"{name} must be an integer, got {val!r}.")
     if not 0 <= l < n or abs(m) > l:
         raise ValueError(f"(l, m) must satisfy 0 <= l < N = {n} and |m| <= l, got (l, m) = ({l}, {m}).")
-    am = abs(int(m))
-    vec = None
+    return _harmonic_matrices(n, [(int(l), int(m))])[0]
+
+
+def _harmonic_matrices(n: int, pairs) -> list:
+    """:func:`harmonic_matrix` of every ``(l, m)`` of ``pairs`` (checked by the caller), from one pass over the
+    bands: above N = 256, where every pass builds the basis anew (O(N^3): 2.5 s at N = 512), many matrices cost
+    one pass, not one each (private to this package: SALT noise asks for many)."""
+    want = {}
+    for l, m in pairs:
+        want.setdefault(abs(m), set()).add(l)
+    cols, left = {}, set(want)
     for band, v in band_basis(n):
-        if band == am:
-            vec = v[:, l - am]
-            break
-    out = np.zeros((n, n), dtype=np.complex128)
-    j = np.arange(n - am)
-    if m >= 0:
-        out[j, j + am] = vec
-    else:
-        out[j + am, j] = (-1.0) ** am * vec
+        if band in left:
+            for l in want[band]:
+                cols[l, band] = v[:, l - band].copy()
+            left.discard(band)
+            if not left:
+                break
+    out = []
+    for l, m in pairs:
+        am = abs(m)
+        mat = np.zeros((n, n), dtype=np.complex128)
+        j = np.arange(n - am)
+        if m >= 0:
+            mat[j, j + am] = cols[l, am]
+        else:
+            mat[j + am, j] = (-1.0) ** am * cols[l, am]
+        out.append(mat)
     return out
 
 

@@ -87,3 +87,26 @@ def test_amplitudes_of_the_wrong_kind_and_too_many_modes_are_refused(monkeypatch
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
     with pytest.raises(ValueError, match="noise matrices .* memory budget"):
         salt_noise(64, [(1, 0)] * 20)
+
+
+def test_many_modes_above_the_cached_sizes_cost_one_pass_over_the_basis(monkeypatch):
+    """Above N = 256 the quantised basis is not kept: each pass over it builds it anew (O(N^3): 2.5 s at N = 512).
+    SALT noise of several modes takes one pass for all of them (it took two per mode with m != 0: zeitlin_system at
+    N = 512 12 s, at N = 2048 minutes), with the values of the modes built one at a time."""
+    from mechanics.sphere import quantisation
+
+    passes = []
+    real = quantisation._bands_descending
+
+    def counted(n):
+        passes.append(n)
+        return real(n)
+
+    monkeypatch.setattr(quantisation, "_bands_descending", counted)
+    N = 260
+    modes = [(1, 0), (2, 1), (3, -2)]
+    xi = salt_noise(N, modes, amplitudes=[1.0, 0.5, -2.0])
+    assert passes == [N]
+    one = salt_noise(N, [(3, -2)], amplitudes=-2.0)                       # one more pass, for one mode alone
+    assert len(passes) == 2
+    assert xi[2].tobytes() == one[0].tobytes()
