@@ -80,6 +80,9 @@ _TIME_UNITS = ("physical", "quantum")
 
 
 def _time_scale(N: int, time_unit) -> float:
+    if not isinstance(time_unit, str):            # an array ['physical'] passed `in` elementwise, and was kept
+        raise TypeError(f"time_unit must be the string 'physical' or 'quantum', got {type(time_unit).__name__} "
+                        f"{time_unit!r}.")
     if time_unit not in _TIME_UNITS:
         raise ValueError(f"time_unit must be 'physical' (t, the default: kappa = 1/hbar) or 'quantum' "
                          f"(Zeitlin's tau = t/hbar: kappa = 1), got {time_unit!r}.")

@@ -46,6 +46,8 @@ CASES = [
     (lambda: function_to_matrix(lambda t, p: np.where(t > 1.0, np.nan, t) + 0 * p, 8), ValueError,
      r"func\(theta, phi\) returned .* non-finite"),
     (lambda: ZeitlinHamiltonian(8, time_unit="seconds"), ValueError, "time_unit must be"),
+    (lambda: ZeitlinHamiltonian(8, time_unit=np.array(["physical"])), TypeError, "time_unit must be"),  # was kept
+    (lambda: salt_noise(8, [(1, 0)], time_unit=["quantum"]), TypeError, "time_unit must be"),
     (lambda: ZeitlinHamiltonian(8).value_matrix(np.eye(6)), ValueError, "must be 8 x 8"),
     (lambda: ZeitlinHamiltonian(8).gradient_matrix("W"), TypeError, "W must be"),
     (lambda: casimirs(W8, (0, 2)), ValueError, "orders must be positive integers"),
