@@ -130,10 +130,7 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False, n: int = 0
     ``n`` points cut into ``c > 1`` work units (:func:`_horner_chunks`) add the units' signatures,
     ``batch * c * sigdim`` floats (twice with ``log``: the gradients' units' cotangents too).
     """
-    need = _need_bytes(batch, d, depth, log)
-    chunks = _horner_chunks(n, d, depth) if depth >= 3 and n >= 2 else 1
-    if chunks > 1:
-        need += 8 * _sigdim(d, depth) * max(batch, 1) * chunks * (2 if log else 1)
+    need = _need_bytes(batch, d, depth, log, n)
     if need <= _SMALL_REQUEST:                  # always fits: skip reading /proc/meminfo
         return
     dim = _sigdim(d, depth)
@@ -144,10 +141,13 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False, n: int = 0
 
 
 @lru_cache(maxsize=256)
-def _need_bytes(batch: int, d: int, depth: int, log: bool) -> int:
+def _need_bytes(batch: int, d: int, depth: int, log: bool, n: int) -> int:
     """The estimate of :func:`_check_fits` (cached: it costs about a microsecond, a small signature's tenth)."""
     dim = _sigdim(d, depth)
     need = 8 * dim * max(batch, 1) * (5 if log else 3) + 8 * dim * 64
+    chunks = _horner_chunks(n, d, depth) if depth >= 3 and n >= 2 else 1
+    if chunks > 1:                              # the units' signatures (and with log the gradients' cotangents)
+        need += 8 * dim * max(batch, 1) * chunks * (2 if log else 1)
     if log and depth > 1 and d > 1:
         need += 12 * min(_logsigdim(d, depth) * 2 ** (depth - 1), 4 * dim)
     return need
