@@ -2,8 +2,9 @@
 
 Called by :mod:`roughpaths.signatures._engine` for the units that run alone (every ``d >= 8``, d = 6, 7
 beyond depth 3, and lane groups with few units), except units of at most 7 segments, which run the plain
-one-unit kernel (:func:`roughpaths.signatures._engine.alone_kernel`: as fast there, and quicker to compile). Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes`
-(reversed word order, the Horner–Chen update with every product rounded, then every sum).
+one-unit kernel (:func:`roughpaths.signatures._engine.alone_kernel`: as fast there, and quicker to compile).
+Layout and arithmetic are those of :mod:`roughpaths.signatures._lanes` (reversed word order, the Horner–Chen
+update with every product rounded, then every sum).
 
 The top level of the Horner update of segment ``k`` is a rank-one update,
 ``S_m <- S_m + T^(k)_{m-1} ⊗ D_k``, where ``T^(k)_{m-1}`` depends on levels ``1..m-1`` only (before

@@ -11,7 +11,8 @@ Backward through S = S_prev ⊗ exp(D) per segment (last to first):
 A unit's backward pass starts from the cotangent of its own signature: its path's for a path that is one
 unit, else ``P ▷ (G ◁ Q)`` (P, Q the products of the path's units before and after it), formed for all units
 first by :func:`unit_cotangents`, so that the backward kernels never compile that glue. :func:`_lcon` /
-:func:`_rcon` (general contractions) serve it and the log's backward pass. Serial kernels over a range ``[lo, hi)`` of work items (GIL released).
+:func:`_rcon` (general contractions) serve it and the log's backward pass. Serial kernels over a range
+``[lo, hi)`` of work items (GIL released).
 :func:`sig_vjp_groups` runs the backward pass of LANES units side by side in packed registers
 (about 4-5x faster than :func:`sig_vjp_units`, one unit at a time, and bitwise the same).
 """
@@ -274,8 +275,9 @@ def sig_vjp_units(d: int):
     """The one-unit backward kernel for alphabet size ``d`` (compiled on first use, without the GIL):
     ``kernel(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd)`` writes the cotangents of the segment
     increments of units ``lo..hi-1`` into ``gd`` (B, n-1, d), given their forward signatures ``part`` and the
-    cotangents ``gunit`` of those (:func:`unit_cotangents`; for unchunked paths the paths'). Each variant's compiled symbols carry its
-    key (:func:`roughpaths._variants._named`): :mod:`roughpaths.signatures.xla_handlers` finds the kernel by its name."""
+    cotangents ``gunit`` of those (:func:`unit_cotangents`; for unchunked paths the paths'). Each variant's
+    compiled symbols carry its key (:func:`roughpaths._variants._named`): :mod:`roughpaths.signatures.xla_handlers`
+    finds the kernel by its name."""
     return _sig_vjp_units_kernel(step_key(d), vjp_key(d))
 
 
