@@ -34,6 +34,9 @@ FAMILIES = {
     "signature_vjp depth 4": ("sig", "rp.signature_vjp(x, 4, np.ones((16, rp.sigdim(3, 4))))"),
     # one path: the one-unit kernels (forward and backward), not the lanes
     "signature_vjp, one path": ("sig", "rp.signature_vjp(x[0], 3, np.ones(rp.sigdim(3, 3)))"),
+    # two paths of 2100 points: each cut into work units, whose cotangents a kernel of their own glues first
+    "signature_vjp, long paths": ("sig", "xl = np.cumsum(rng.standard_normal((2, 2100, 3)), axis=1) * 0.01\n"
+                                         "rp.signature_vjp(xl, 3, np.ones((2, rp.sigdim(3, 3))))"),
     "logsignature_vjp depth 4": ("sig", "rp.logsignature_vjp(x, 4, np.ones((16, rp.logsigdim(3, 4))))"),
     "torch step (sig depth 3)": ("sig torch", "t = torch.tensor(x, requires_grad=True)\n"
                                               "rt.signature(t, 3).sum().backward()"),

@@ -172,7 +172,8 @@ def unit_cotangents(part, gtot, nchunks, d, m, offsets, lo, hi, out):
     """``out[u]``, the cotangent of unit ``u``'s signature (:func:`_unit_cotangent`), for units ``lo..hi-1`` of
     paths cut into ``nchunks > 1`` units. Unchunked paths need none: a unit's cotangent is its path's, ``gtot``
     itself, which the backward kernels take as it is (so they never compile this glue: 0.8-1.2 s of a first
-    gradient)."""
+    gradient). Compiled on the first gradient of paths cut into units: 1.7 s cold with the glue it calls
+    (``benchmarks/bench_first_call.py``, "signature_vjp, long paths": 6.2 s in all)."""
     for u in range(lo, hi):
         _unit_cotangent(part, gtot, u, nchunks, d, m, offsets, out[u])
 
