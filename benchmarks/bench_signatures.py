@@ -168,7 +168,9 @@ def paired(fns, repeats: int, clock) -> list:
 
     A call of 50 ms or more is not preceded by an untimed call (its data do not fit in the caches a
     previous call could have warmed) and one of a second or more is timed in at most 3 pairs: the
-    heaviest cells of the width sweep otherwise took most of its hour.
+    heaviest cells of the width sweep otherwise took most of its hour. Each sample starts after a 1 ms pause:
+    our worker threads watch for a next job for about 0.1 ms after one (``roughpaths._threads``), and must not
+    spend the peer's time.
     """
     first = []
     for fn in fns:
@@ -180,6 +182,7 @@ def paired(fns, repeats: int, clock) -> list:
     times = [[] for _ in fns]
     for _ in range(max(1, repeats)):
         for i, fn in enumerate(fns):
+            time.sleep(1e-3)
             if not heavy:
                 fn()
             t0 = clock()

@@ -51,7 +51,9 @@ def warm() -> None:
     seconds each (``benchmarks/bench_first_call.py`` measures them).
     """
     import roughpaths as rp
+    from roughpaths.validation import parallel_ranges
 
+    parallel_ranges(lambda lo, hi: None, 2, 1)      # with two threads or more: the workers' watch loop
     rng = np.random.default_rng(0)
     for d in (3, 2):
         x = _walk(rng, 16, 100, d)

@@ -151,3 +151,44 @@ def test_merged_ranges_are_one_call_on_one_thread_and_every_item_once_on_all():
             assert sorted(calls) == want
     finally:
         numba.set_num_threads(before)
+
+
+def test_watching_sees_another_threads_store():
+    """A worker watching for the next job reads the flag anew every round: with the read hoisted out of its loop
+    (a compiler may hoist a plain load) the watch below would spin for its 10^9 rounds, minutes, instead of
+    returning."""
+    from roughpaths import _threads
+
+    if not _threads.LINGER:
+        pytest.skip("no sched_yield on this platform: workers sleep at once")
+    flag = np.zeros(1, dtype=np.int64)
+    seen = []
+    t = threading.Thread(target=lambda: seen.append(_threads._watch(flag, 0, 10 ** 9)), daemon=True)
+    t.start()
+    flag[0] = 1
+    t.join(timeout=30)
+    assert not t.is_alive() and seen == [True]
+    assert _threads._watch(flag, 1, 3) is False and _threads._watch(flag, 0, 0) is True
+
+
+def test_a_sleeping_worker_is_woken_and_an_awake_one_helps():
+    """Range 0 waits for range 1 to start on another thread: only a worker (asleep after a pause, or still
+    watching right after a job) can start it, else range 0 gives up after 20 s and the caller runs range 1."""
+    import time
+
+    if numba.get_num_threads() < 2:
+        pytest.skip("one thread: no workers")
+    for pause in (0.2, 0.0):                     # long enough to fall asleep; none: still watching
+        started = threading.Event()
+        who = {}
+
+        def fn(lo, hi):
+            who[lo] = threading.get_ident()
+            if lo == 0:
+                started.wait(timeout=20)
+            else:
+                started.set()
+
+        time.sleep(pause)
+        parallel_ranges(fn, 2, 1)
+        assert who[0] != who[1], f"no worker took range 1 after a pause of {pause} s"
