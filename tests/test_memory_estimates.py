@@ -81,6 +81,12 @@ def _lie(c):
     return LieAlgebra(c)
 
 
+def _su(N):
+    from mechanics import su
+
+    return su(N)
+
+
 def _saved():
     X = rp.BrownianDriver(2, seed=0, dt=0.01, n_steps=200, batch_shape=(1000,)).rough_path()
     path = Path(tempfile.mkdtemp()) / "path.npz"
@@ -135,6 +141,7 @@ CASES = [
     Case("load", _saved, lambda path: rp.load(path)),
     # mechanics
     Case("LieAlgebra", lambda: (_so_constants(8),), _lie),
+    Case("su", lambda: (), lambda: _su(96)),
     Case("run_ensemble", lambda: (), lambda: _ensemble(2000)),
 ]
 

@@ -142,3 +142,19 @@ def test_casimirs_refuses_powers_above_the_memory_budget(monkeypatch):
         casimirs(W)
     monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(4 * W.nbytes))
     assert casimirs(W).shape == (100, 5)
+
+
+def test_zeitlin_system_refuses_a_large_N_before_building_su_N(monkeypatch):
+    # su(N) was built first, unchecked (153 MiB and 2 s at N = 512, 10 GiB at N = 4096), and only then were the
+    # noise matrices refused; now su(N) refuses itself before its lists exist
+    import tracemalloc
+
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(2**25))
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError, match=r"basis of su\(N\) at N = 512 .* memory budget .*; use a smaller N\."):
+            zeitlin_system(512)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**20, peak
