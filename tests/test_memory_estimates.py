@@ -81,6 +81,11 @@ def _lie(c):
     return LieAlgebra(c)
 
 
+def _eight_components(y):
+    """A centred observable of the cat map with 8 components (the coordinates, four times)."""
+    return np.concatenate([y] * 4, axis=-1) - 0.5
+
+
 def _su(N):
     from mechanics import su
 
@@ -131,6 +136,9 @@ CASES = [
     Case("BrownianTree.rough_path", lambda: (),
          lambda: rp.BrownianTree(3, seed=0, batch_shape=(300,)).rough_path(np.linspace(0.0, 1.0, 9))),
     Case("fbm", lambda: (), lambda: rp.fbm(256, 0.3, rng=np.random.default_rng(1), batch_shape=(500,))),
+    # the observable's values at the initial points (P x d, d = 8 here) were left out of the estimate
+    Case("ChaoticDriver", lambda: (), lambda: rp.ChaoticDriver(rp.cat_map(), _eight_components, 100, seed=0, dt=0.01,
+                                                               n_steps=2, batch_shape=(20000,))),
     Case("refine", lambda: (rp.BrownianDriver(2, seed=0, dt=0.01, n_steps=16, batch_shape=(100,)).rough_path(),),
          lambda X: rp.refine(X, 4, rng=np.random.default_rng(0))),
     # rde

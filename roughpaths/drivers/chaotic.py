@@ -417,7 +417,9 @@ class ChaoticDriver(SeededDriver):
                    "use fewer orbits, fewer steps or a smaller n")
         rng = np.random.default_rng(self.seed_sequence)
         self._y0 = fast_map.initial_states(rng, P)
-        self.dim = _observe(fast_map, observable, self._y0[:, None, :]).shape[-1]
+        d = _observe(fast_map, observable, self._y0[:1, None, :]).shape[-1]      # at one point: the values' size
+        check_memory(8.0 * P * d, f"the observable's values at the {P} initial points ({P} x {d})", "use fewer orbits")
+        self.dim = _observe(fast_map, observable, self._y0[:, None, :], d).shape[-1]
         # batch-shaped, as blocks() and select() read the starts of a seeded driver (_flat)
         self._y0 = self._y0.reshape(self.batch_shape + (fast_map.dim,))
         self.level = 2
