@@ -92,6 +92,24 @@ def _su(N):
     return su(N)
 
 
+def _complex(shape, seed=0):
+    rng = np.random.default_rng(seed)
+    return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+
+def _sphere():
+    import mechanics.sphere
+
+    return mechanics.sphere
+
+
+def _uncached_basis():
+    """Inputs of nothing; fills the quantised basis' cache (two sizes) with small sizes, so that N = 112 is built."""
+    _sphere().harmonic_matrix(9, 1, 0)
+    _sphere().harmonic_matrix(10, 1, 0)
+    return ()
+
+
 def _saved():
     X = rp.BrownianDriver(2, seed=0, dt=0.01, n_steps=200, batch_shape=(1000,)).rough_path()
     path = Path(tempfile.mkdtemp()) / "path.npz"
@@ -150,6 +168,30 @@ CASES = [
     # mechanics
     Case("LieAlgebra", lambda: (_so_constants(8),), _lie),
     Case("su", lambda: (), lambda: _su(96)),
+    # mechanics.sphere; the quantised basis: built and cached (N <= 256: the bands and the temporaries of the one being
+    # computed, which were left out), and streamed (N > 256: the temporaries were counted as 4 N^2 floats, 7 measured)
+    Case("harmonic_matrix", _uncached_basis, lambda: _sphere().harmonic_matrix(112, 2, 1),
+         lambda: _sphere().harmonic_matrix(11, 2, 1)),
+    Case("harmonic_matrix (streamed basis)", lambda: (), lambda: _sphere().harmonic_matrix(260, 100, 60),
+         lambda: _sphere().harmonic_matrix(260, 259, 259)),
+    Case("coefficients_to_matrix", lambda: (_complex((200, 64 * 64)),),
+         lambda om: _sphere().coefficients_to_matrix(om, 64)),
+    Case("matrix_to_coefficients", lambda: (_complex((200, 64, 64)),), lambda W: _sphere().matrix_to_coefficients(W)),
+    Case("laplacian", lambda: (_complex((200, 64, 64)),), lambda W: _sphere().laplacian(W)),
+    Case("inverse_laplacian", lambda: (_complex((200, 64, 64)),), lambda W: _sphere().inverse_laplacian(W)),
+    Case("sphere_grid", lambda: (), lambda: _sphere().sphere_grid(200, 400)),
+    Case("coefficients_to_grid", lambda: (_complex((5, 32 * 32)),),
+         lambda om: _sphere().coefficients_to_grid(om, 64, 128)),
+    Case("grid_to_coefficients", lambda: (np.random.default_rng(0).normal(size=(5, 64, 128)),),
+         lambda v: _sphere().grid_to_coefficients(v, 32)),
+    Case("function_to_matrix", lambda: (),
+         lambda: _sphere().function_to_matrix(lambda t, p: np.cos(t) * np.sin(p), 96)),
+    Case("salt_noise", lambda: (), lambda: _sphere().salt_noise(64, [(1, 0), (1, 1), (2, 1), (3, -2)])),
+    Case("casimirs", lambda: (_complex((500, 32, 32)),), lambda W: _sphere().casimirs(W)),
+    # a few small arrays besides the coefficients were left out (2-3 kB over)
+    Case("RossbyHaurwitzWave", lambda: (), lambda: _sphere().RossbyHaurwitzWave(5000, {(5000, 3): 1.0 + 1j}, 1.0)),
+    Case("RossbyHaurwitzWave.coefficients", lambda: (_sphere().RossbyHaurwitzWave(3, {(3, 2): 1.0}, 1.0),),
+         lambda wave: wave.coefficients(0.5, 200)),
     Case("run_ensemble", lambda: (), lambda: _ensemble(2000)),
 ]
 

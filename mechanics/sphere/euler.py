@@ -182,8 +182,8 @@ def casimirs(W, orders=(2, 3, 4, 5, 6)) -> np.ndarray:
     check_work(seconds * _UNITS_PER_SECOND, f"orders up to k = {max(ks)}: {k_max - 1.0:.3g} products of {b} "
                f"matrices of size {n} (about {seconds:.3g} s of one core)", f"ask for lower orders (for {n} x {n} "
                f"matrices the C_k with k > {n} follow from those with k <= {n}), or pass fewer matrices at a time")
-    # iW, the current power and the next one; the traces
-    check_bytes(48.0 * arr.size + 8.0 * b * (len(ks) + 2), f"the powers (iW)^k of {b} matrices of size {n}",
+    # iW, the current power and the next one; the traces, and small arrays
+    check_bytes(48.0 * arr.size + 8.0 * b * (len(ks) + 2) + 2.0 ** 14, f"the powers (iW)^k of {b} matrices of size {n}",
                 "pass fewer matrices at a time")
     m = 1j * arr
     out = np.empty(arr.shape[:-2] + (len(ks),))
