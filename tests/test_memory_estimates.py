@@ -157,6 +157,20 @@ CASES = [
     # the observable's values at the initial points (P x d, d = 8 here) were left out of the estimate
     Case("ChaoticDriver", lambda: (), lambda: rp.ChaoticDriver(rp.cat_map(), _eight_components, 100, seed=0, dt=0.01,
                                                                n_steps=2, batch_shape=(20000,))),
+    # the Lorenz-63 sampler's spin-up (the RK4 stages, 7-9 arrays of P x 3) was left out
+    Case("ChaoticDriver (Lorenz-63)", lambda: (),
+         lambda: rp.ChaoticDriver(rp.lorenz63_map(0.05, spinup=1.0), lambda y: y, 20, seed=0, dt=0.05, n_steps=2,
+                                  batch_shape=(5000,))),
+    Case("ChaoticDriver.rough_path", lambda: (rp.ChaoticDriver(rp.cat_map(), lambda y: np.sin(2 * np.pi * y), 100,
+                                                               seed=0, dt=0.1, n_steps=50, batch_shape=(500,)),),
+         lambda drv: drv.rough_path()),
+    Case("observable_orbits", lambda: (),
+         lambda: rp.observable_orbits(rp.cat_map(), lambda y: np.sin(2 * np.pi * y), 2000, seed=0, batch_shape=(100,))),
+    Case("green_kubo", lambda: (np.random.default_rng(0).normal(size=(10, 5000, 3)),), lambda v: rp.green_kubo(v, 200)),
+    # the comparisons' object arrays and the Python integers of (A^T)^m k were left out
+    Case("SineObservable.correlations",
+         lambda: (rp.SineObservable(np.arange(1, 41).reshape(10, 2, 2), np.ones((10, 2))),),
+         lambda obs: obs.correlations(250)),
     Case("refine", lambda: (rp.BrownianDriver(2, seed=0, dt=0.01, n_steps=16, batch_shape=(100,)).rough_path(),),
          lambda X: rp.refine(X, 4, rng=np.random.default_rng(0))),
     # rde

@@ -271,6 +271,8 @@ def lorenz63_map(tau: float = 0.05, *, sigma: float = 10.0, rho: float = 28.0, b
         steps = int(math.ceil(spinup / tau))
         check_work(float(P) * steps * substeps, f"the Lorenz-63 spin-up ({P} points x {steps} samples x {substeps} "
                    f"RK4 steps)", "use a shorter spinup or a larger tau")
+        # the state, the four RK4 stages and their temporaries: 7-9 arrays of P x 3 floats measured, 10 counted
+        check_memory(8.0 * 3 * 10 * P, f"the Lorenz-63 spin-up of {P} points (10 x {P} x 3 floats)", "use fewer orbits")
         u = 8.0 * rng.standard_normal((P, 3)) + np.array([0.0, 0.0, 25.0])
         for _ in range(steps):
             u = step(u)
