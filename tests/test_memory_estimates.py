@@ -81,6 +81,35 @@ def _lie(c):
     return LieAlgebra(c)
 
 
+def _eight_components(y):
+    """A centred observable of the cat map with 8 components (the coordinates, four times)."""
+    return np.concatenate([y] * 4, axis=-1) - 0.5
+
+
+def _su(N):
+    from mechanics import su
+
+    return su(N)
+
+
+def _complex(shape, seed=0):
+    rng = np.random.default_rng(seed)
+    return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+
+def _sphere():
+    import mechanics.sphere
+
+    return mechanics.sphere
+
+
+def _uncached_basis():
+    """Inputs of nothing; fills the quantised basis' cache (two sizes) with small sizes, so that N = 112 is built."""
+    _sphere().harmonic_matrix(9, 1, 0)
+    _sphere().harmonic_matrix(10, 1, 0)
+    return ()
+
+
 def _saved():
     X = rp.BrownianDriver(2, seed=0, dt=0.01, n_steps=200, batch_shape=(1000,)).rough_path()
     path = Path(tempfile.mkdtemp()) / "path.npz"
@@ -125,6 +154,23 @@ CASES = [
     Case("BrownianTree.rough_path", lambda: (),
          lambda: rp.BrownianTree(3, seed=0, batch_shape=(300,)).rough_path(np.linspace(0.0, 1.0, 9))),
     Case("fbm", lambda: (), lambda: rp.fbm(256, 0.3, rng=np.random.default_rng(1), batch_shape=(500,))),
+    # the observable's values at the initial points (P x d, d = 8 here) were left out of the estimate
+    Case("ChaoticDriver", lambda: (), lambda: rp.ChaoticDriver(rp.cat_map(), _eight_components, 100, seed=0, dt=0.01,
+                                                               n_steps=2, batch_shape=(20000,))),
+    # the Lorenz-63 sampler's spin-up (the RK4 stages, 7-9 arrays of P x 3) was left out
+    Case("ChaoticDriver (Lorenz-63)", lambda: (),
+         lambda: rp.ChaoticDriver(rp.lorenz63_map(0.05, spinup=1.0), lambda y: y, 20, seed=0, dt=0.05, n_steps=2,
+                                  batch_shape=(5000,))),
+    Case("ChaoticDriver.rough_path", lambda: (rp.ChaoticDriver(rp.cat_map(), lambda y: np.sin(2 * np.pi * y), 100,
+                                                               seed=0, dt=0.1, n_steps=50, batch_shape=(500,)),),
+         lambda drv: drv.rough_path()),
+    Case("observable_orbits", lambda: (),
+         lambda: rp.observable_orbits(rp.cat_map(), lambda y: np.sin(2 * np.pi * y), 2000, seed=0, batch_shape=(100,))),
+    Case("green_kubo", lambda: (np.random.default_rng(0).normal(size=(10, 5000, 3)),), lambda v: rp.green_kubo(v, 200)),
+    # the comparisons' object arrays and the Python integers of (A^T)^m k were left out
+    Case("SineObservable.correlations",
+         lambda: (rp.SineObservable(np.arange(1, 41).reshape(10, 2, 2), np.ones((10, 2))),),
+         lambda obs: obs.correlations(250)),
     Case("refine", lambda: (rp.BrownianDriver(2, seed=0, dt=0.01, n_steps=16, batch_shape=(100,)).rough_path(),),
          lambda X: rp.refine(X, 4, rng=np.random.default_rng(0))),
     # rde
@@ -135,6 +181,31 @@ CASES = [
     Case("load", _saved, lambda path: rp.load(path)),
     # mechanics
     Case("LieAlgebra", lambda: (_so_constants(8),), _lie),
+    Case("su", lambda: (), lambda: _su(96)),
+    # mechanics.sphere; the quantised basis: built and cached (N <= 256: the bands and the temporaries of the one being
+    # computed, which were left out), and streamed (N > 256: the temporaries were counted as 4 N^2 floats, 7 measured)
+    Case("harmonic_matrix", _uncached_basis, lambda: _sphere().harmonic_matrix(112, 2, 1),
+         lambda: _sphere().harmonic_matrix(11, 2, 1)),
+    Case("harmonic_matrix (streamed basis)", lambda: (), lambda: _sphere().harmonic_matrix(260, 100, 60),
+         lambda: _sphere().harmonic_matrix(260, 259, 259)),
+    Case("coefficients_to_matrix", lambda: (_complex((200, 64 * 64)),),
+         lambda om: _sphere().coefficients_to_matrix(om, 64)),
+    Case("matrix_to_coefficients", lambda: (_complex((200, 64, 64)),), lambda W: _sphere().matrix_to_coefficients(W)),
+    Case("laplacian", lambda: (_complex((200, 64, 64)),), lambda W: _sphere().laplacian(W)),
+    Case("inverse_laplacian", lambda: (_complex((200, 64, 64)),), lambda W: _sphere().inverse_laplacian(W)),
+    Case("sphere_grid", lambda: (), lambda: _sphere().sphere_grid(200, 400)),
+    Case("coefficients_to_grid", lambda: (_complex((5, 32 * 32)),),
+         lambda om: _sphere().coefficients_to_grid(om, 64, 128)),
+    Case("grid_to_coefficients", lambda: (np.random.default_rng(0).normal(size=(5, 64, 128)),),
+         lambda v: _sphere().grid_to_coefficients(v, 32)),
+    Case("function_to_matrix", lambda: (),
+         lambda: _sphere().function_to_matrix(lambda t, p: np.cos(t) * np.sin(p), 96)),
+    Case("salt_noise", lambda: (), lambda: _sphere().salt_noise(64, [(1, 0), (1, 1), (2, 1), (3, -2)])),
+    Case("casimirs", lambda: (_complex((500, 32, 32)),), lambda W: _sphere().casimirs(W)),
+    # a few small arrays besides the coefficients were left out (2-3 kB over)
+    Case("RossbyHaurwitzWave", lambda: (), lambda: _sphere().RossbyHaurwitzWave(5000, {(5000, 3): 1.0 + 1j}, 1.0)),
+    Case("RossbyHaurwitzWave.coefficients", lambda: (_sphere().RossbyHaurwitzWave(3, {(3, 2): 1.0}, 1.0),),
+         lambda wave: wave.coefficients(0.5, 200)),
     Case("run_ensemble", lambda: (), lambda: _ensemble(2000)),
 ]
 

@@ -188,8 +188,11 @@ def _cached_basis(N: int) -> tuple:
 
 def band_basis(N: int):
     """Iterate ``(m, V_m)`` over the diagonals (descending m; cached for ``N <= 256``, else streamed)."""
-    check_bytes(8.0 * (N ** 3 / 3.0 if N <= _CACHE_MAX_N else 4.0 * N * N), f"the quantised basis at N = {N}",
-                "use a smaller N")
+    # the bands kept when cached (N(N+1)(2N+1)/6 floats) and, while a band is computed, it, the one before, the
+    # eigen-solver's workspace and the sign rule's temporaries: 9 N^2 floats and small arrays (tracemalloc, N = 32 to
+    # 200, cached or streamed, with harmonic_matrix's N x N result: 43-75 N^2 bytes besides the bands kept)
+    kept = N * (N + 1.0) * (2.0 * N + 1.0) / 6.0 if N <= _CACHE_MAX_N else 0.0
+    check_bytes(8.0 * (kept + 9.0 * N * N) + 2.0 ** 15, f"the quantised basis at N = {N}", "use a smaller N")
     if N <= _CACHE_MAX_N:
         bands = _cached_basis(N)
         return ((m, bands[m]) for m in range(N - 1, -1, -1))

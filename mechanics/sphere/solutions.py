@@ -92,7 +92,7 @@ class RossbyHaurwitzWave:
         if not isinstance(wave, dict) or not wave:
             raise TypeError(f"wave must be a non-empty dict {{(l, m): coefficient}}, got {wave!r}.")
         l = int(degree)
-        check_bytes(17.0 * (2 * l + 1), f"the coefficients of a wave of degree {l}", "use a smaller degree")
+        check_bytes(17.0 * (2 * l + 1) + 8192.0, f"the coefficients of a wave of degree {l}", "use a smaller degree")
         coef = np.zeros(2 * l + 1, dtype=np.complex128)  # index m + l
         given = np.zeros(2 * l + 1, dtype=bool)
         for key, value in wave.items():
@@ -132,7 +132,9 @@ class RossbyHaurwitzWave:
         t = check_real(t, "t")
         if L <= self.degree:
             raise ValueError(f"L must exceed the degree {self.degree} (the modes l < L are returned), got {L}.")
-        check_bytes(16.0 * L * L, f"the coefficients l < L = {L}", "use a smaller L")
+        # the result and, for the wave's 2 degree + 1 modes, a few arrays of that size
+        check_bytes(16.0 * L * L + 64.0 * (2 * self.degree + 1) + 8192.0, f"the coefficients l < L = {L}",
+                    "use a smaller L")
         out = np.zeros(L * L, dtype=np.complex128)
         m = np.arange(-self.degree, self.degree + 1)
         out[lm_index(self.degree, m)] = self.wave * np.exp(-1j * m * self.speed * t)

@@ -12,6 +12,8 @@ import numbers
 
 import numpy as np
 
+from roughpaths.validation import check_memory
+
 from .matrix_algebra import MatrixLieAlgebra, _built
 
 __all__ = ["so", "su", "u", "sp", "sl"]
@@ -40,6 +42,19 @@ def _check_size(value, name, minimum):
     return int(value)
 
 
+#: Bytes per non-zero entry of a built-in basis at the peak of its construction: the three Python lists of
+#: :class:`_Entries` (an int row, an int index and a float or complex value: about 110 bytes), their arrays and the
+#: sparse matrices of :class:`MatrixLieAlgebra` (measured with tracemalloc, N = 64 to 700: 192-214 bytes for the real
+#: algebras, 245-248 for the complex ones; su(4096) would take 10 GiB and three minutes).
+_BYTES_PER_ENTRY = 260.0
+
+
+def _check_basis_memory(name: str, arg: str, value: int, nnz: int) -> None:
+    """Refuse, before the lists are built, a basis of ``nnz`` non-zero entries above the memory budget."""
+    check_memory(_BYTES_PER_ENTRY * nnz, f"the basis of {name} at {arg} = {value} ({nnz:.3g} non-zero entries, built "
+                 f"as Python lists and then sparse matrices)", f"use a smaller {arg}")
+
+
 def _skew_pairs(e, N, scale=1.0, sign=1.0, offset=(0, 0)):
     """``E_ab - E_ba`` (a < b) on the block at ``offset``, times ``scale``."""
     r, c = offset
@@ -65,10 +80,16 @@ def so(n: int) -> MatrixLieAlgebra:
     6
     """
     n = _check_size(n, "n", 2)
+    _check_basis_memory("so(n)", "n", n, n * (n - 1))
     e = _Entries(n)
     _skew_pairs(e, n)
     return _built(MatrixLieAlgebra._from_entries(f"so({n})", n, e.rows, e.idx, e.vals, np.float64, e.signs, True),
                   "skew")
+
+
+def _su_nnz(N: int) -> int:
+    """Non-zero entries of the basis of su(N): two per off-diagonal pair and kind, k + 1 per diagonal D_k."""
+    return 2 * N * (N - 1) + (N - 1) * (N + 2) // 2
 
 
 def _su_entries(N):
@@ -93,6 +114,7 @@ def su(N: int) -> MatrixLieAlgebra:
     (3, 15)
     """
     N = _check_size(N, "N", 2)
+    _check_basis_memory("su(N)", "N", N, _su_nnz(N))
     e = _su_entries(N)
     return _built(MatrixLieAlgebra._from_entries(f"su({N})", N, e.rows, e.idx, e.vals, np.complex128, e.signs,
                                                  True), "skew_traceless")
@@ -106,6 +128,7 @@ def u(N: int) -> MatrixLieAlgebra:
     9
     """
     N = _check_size(N, "N", 1)
+    _check_basis_memory("u(N)", "N", N, _su_nnz(N) + N)
     e = _su_entries(N)
     f = np.sqrt(2.0 / N)
     e.add([(a, a, 1j * f) for a in range(N)], 1.0)
@@ -123,6 +146,7 @@ def sl(n: int) -> MatrixLieAlgebra:
     8
     """
     n = _check_size(n, "n", 2)
+    _check_basis_memory("sl(n, R)", "n", n, _su_nnz(n))
     e = _Entries(n)
     _skew_pairs(e, n)
     for a in range(n):
@@ -148,6 +172,7 @@ def sp(n: int) -> MatrixLieAlgebra:
     (10, 4)
     """
     n = _check_size(n, "n", 1)
+    _check_basis_memory("sp(2n, R)", "n", n, 8 * n * (n - 1) + 6 * n)
     N = 2 * n
     e = _Entries(N)
     h = 1.0 / np.sqrt(2.0)

@@ -271,6 +271,8 @@ def lorenz63_map(tau: float = 0.05, *, sigma: float = 10.0, rho: float = 28.0, b
         steps = int(math.ceil(spinup / tau))
         check_work(float(P) * steps * substeps, f"the Lorenz-63 spin-up ({P} points x {steps} samples x {substeps} "
                    f"RK4 steps)", "use a shorter spinup or a larger tau")
+        # the state, the four RK4 stages and their temporaries: 7-9 arrays of P x 3 floats measured, 10 counted
+        check_memory(8.0 * 3 * 10 * P, f"the Lorenz-63 spin-up of {P} points (10 x {P} x 3 floats)", "use fewer orbits")
         u = 8.0 * rng.standard_normal((P, 3)) + np.array([0.0, 0.0, 25.0])
         for _ in range(steps):
             u = step(u)
@@ -417,7 +419,9 @@ class ChaoticDriver(SeededDriver):
                    "use fewer orbits, fewer steps or a smaller n")
         rng = np.random.default_rng(self.seed_sequence)
         self._y0 = fast_map.initial_states(rng, P)
-        self.dim = _observe(fast_map, observable, self._y0[:, None, :]).shape[-1]
+        d = _observe(fast_map, observable, self._y0[:1, None, :]).shape[-1]      # at one point: the values' size
+        check_memory(8.0 * P * d, f"the observable's values at the {P} initial points ({P} x {d})", "use fewer orbits")
+        self.dim = _observe(fast_map, observable, self._y0[:, None, :], d).shape[-1]
         # batch-shaped, as blocks() and select() read the starts of a seeded driver (_flat)
         self._y0 = self._y0.reshape(self.batch_shape + (fast_map.dim,))
         self.level = 2

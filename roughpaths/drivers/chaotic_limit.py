@@ -51,6 +51,7 @@ sum. Odd observables have vanishing odd moments (``y ↦ −y`` commutes with ``
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -379,8 +380,11 @@ class SineObservable:
         k, c = self.frequencies.astype(object), self.coefficients     # Python integers: exact at every lag
         At = A.astype(object)
         d, R = c.shape
-        check_memory(8.0 * (M + 1) * d * d + 8.0 * 4 * (d * R) ** 2, f"the correlations ({M + 1} lags x {d} x {d})",
-                     "use a smaller max_lag")
+        # the result; the comparisons of k with (Aᵀ)^m k ((dR)² objects, bools and floats: 48 bytes a pair); the Python
+        # integers of (Aᵀ)^m k, of its product and negation (8 dR of them, m log₂ρ(A) + 64 bits each)
+        bits = (M + 1) * math.log2(max(1.0, float(np.max(np.abs(np.linalg.eigvals(A.astype(float))))))) + 64.0
+        check_memory(8.0 * (M + 1) * d * d + 48.0 * (d * R) ** 2 + 8.0 * d * R * (32.0 + bits / 7.5),
+                     f"the correlations ({M + 1} lags x {d} x {d})", "use a smaller max_lag")
         out = np.zeros((M + 1, d, d))
         moved = k.copy()                                              # (Aᵀ)^m k, as row vectors l ↦ l A
         for m in range(M + 1):

@@ -116,3 +116,45 @@ def test_a_huge_grid_is_refused_before_the_node_computation_allocates():
         grid_to_coefficients(np.broadcast_to(np.zeros(1), (10**6, 1)), 1)
     with pytest.raises(ValueError, match="memory budget"):
         sphere_grid(4, 10**15)
+
+
+@pytest.mark.parametrize("n, order, budget", [
+    (2, 10**4, 1e5),       # 10**4 steps of 2 us each (the call of a product): was counted as 4 entries a step, 4e4
+    (1024, 3, 4.5e6),      # 2 products of N^3 multiply-adds (0.3 s each): was counted as N^2 entries each, 3.1e6
+])
+def test_casimirs_work_estimate_counts_what_the_products_cost(monkeypatch, n, order, budget):
+    # the old count (max order x matrices x N^2) was below these budgets: the calls ran instead
+    W = 1j * np.random.default_rng(0).normal(size=(n, n)) / n
+    monkeypatch.setenv("ROUGHPATHS_MAX_WORK", str(budget))
+    with pytest.raises(ValueError, match=rf"orders up to k = {order}: .* s of one core.* work budget .* ask for lower "
+                                         rf"orders \(for {n} x {n} matrices the C_k with k > {n} follow"):
+        casimirs(W, (2, order))
+    monkeypatch.setenv("ROUGHPATHS_MAX_WORK", str(budget * 100))
+    assert casimirs(W, (2, order)).shape == (2,)
+
+
+def test_casimirs_refuses_powers_above_the_memory_budget(monkeypatch):
+    # iW, the current power and the next: three stacks of the input's size; they were allocated unchecked
+    W = np.zeros((100, 32, 32), dtype=complex)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(3 * W.nbytes - 1))
+    with pytest.raises(ValueError, match="powers .* of 100 matrices of size 32 would take .* memory budget.*fewer "
+                                         "matrices"):
+        casimirs(W)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(4 * W.nbytes))
+    assert casimirs(W).shape == (100, 5)
+
+
+def test_zeitlin_system_refuses_a_large_N_before_building_su_N(monkeypatch):
+    # su(N) was built first, unchecked (153 MiB and 2 s at N = 512, 10 GiB at N = 4096), and only then were the
+    # noise matrices refused; now su(N) refuses itself before its lists exist
+    import tracemalloc
+
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(2**25))
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError, match=r"basis of su\(N\) at N = 512 .* memory budget .*; use a smaller N\."):
+            zeitlin_system(512)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**20, peak

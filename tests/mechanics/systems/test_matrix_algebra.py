@@ -166,3 +166,20 @@ def test_large_algebras_form_nothing_of_size_n_squared():
     assert peak < 20e6, peak
     with pytest.raises(ValueError, match=r"structure constants of su\(64\).*512 GiB.*matrix operations"):
         g.structure_constants
+
+
+@pytest.mark.parametrize("make, size, arg", [(su, 512, "N"), (u, 512, "N"), (so, 1024, "n"), (sl, 512, "n"),
+                                             (sp, 256, "n")], ids=["su", "u", "so", "sl", "sp"])
+def test_a_basis_above_the_memory_budget_is_refused_before_it_is_built(monkeypatch, make, size, arg):
+    """The sparse bases are built as Python lists first (about 250 bytes a non-zero entry at the peak, 2.5 N^2
+    entries for su(N)): su(512) took 153 MiB and 2 s, su(4096) would take 10 GiB and minutes, with no check."""
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(2**25))
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError, match=rf"basis of .* at {arg} = {size} \(.* non-zero entries.*\) would take "
+                                             rf".* memory budget .*; use a smaller {arg}\."):
+            make(size)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**20, peak

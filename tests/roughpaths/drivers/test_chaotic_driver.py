@@ -248,6 +248,24 @@ def test_the_orbits_memory_counts_the_observables_dimension(monkeypatch):
         observable_orbits(cat_map(), wide, 100, seed=0, batch_shape=(10,))
 
 
+def test_the_drivers_memory_counts_the_observables_values_at_the_initial_points(monkeypatch):
+    # the first evaluation of the observable at the P initial points (a P x d array) was not estimated: 1000
+    # orbits of a 1000-component observable (8 MB of values) passed a 1 MB budget (the initial points, 80 kB)
+    import tracemalloc
+
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(10**6))
+    wide = lambda y: np.repeat(np.sin(2 * np.pi * y), 500, axis=-1)    # noqa: E731 - d = 1000
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError, match=r"observable's values at the 1000 initial points \(1000 x 1000\) would "
+                                             r"take 7.63 MiB, more than the memory budget .*; use fewer orbits"):
+            ChaoticDriver(cat_map(), wide, 10, seed=0, dt=0.1, n_steps=2, batch_shape=(1000,))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 10**6, peak                                        # refused before the values exist
+
+
 def test_a_non_unimodular_matrix_is_refused_even_when_int64_wraps():
     # det [[2^32, 1], [-1, 2^32]] = 2^64 + 1 wrapped to 1 in int64: the matrix passed as det = ±1
     with pytest.raises(ValueError, match="det = ±1"):
