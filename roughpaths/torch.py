@@ -25,8 +25,10 @@ Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`
   kernels are float64 only): a float32 input is widened, the result (and the gradient) rounded back
   to float32, so float32 in gives float32 out, about as accurate as float32 can hold. Other dtypes
   (integers, float16, bfloat16, complex) are refused with a ``TypeError`` naming the fix.
-* **Gradients.** First derivatives only: the backward pass is not itself differentiable (a second
-  ``backward`` through it raises torch's error for ``once_differentiable`` functions), and
+* **Gradients.** First derivatives only: the backward pass is not itself differentiable. A gradient
+  taken with ``create_graph=True`` (a gradient penalty, a Hessian) is marked so that differentiating it
+  raises a ``RuntimeError`` saying so, whatever the cotangent that reached the function (a constant one
+  too, as from ``.sum()``: no silent zero second derivative), and
   ``torch.func`` transforms (``vmap``, ``jacrev``) are not supported; batch with leading axes instead,
   which runs as one call of the compiled kernels.
 * **Cost.** The forward converts the tensors to numpy once, without a copy (float64) or with one
@@ -62,7 +64,7 @@ from __future__ import annotations
 
 import numpy as np
 import torch
-from torch.autograd.function import once_differentiable
+from torch._C import _functions as _autograd_functions
 
 import roughpaths as _rp
 from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
@@ -142,6 +144,14 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     return _function(forward, vjp, names=names, core=core, label=label, grad_readonly=True)
 
 
+def _second_derivative_message(label: str) -> str:
+    return (f"roughpaths.torch gives first derivatives only: a gradient through <{label}Backward> was taken with "
+            f"create_graph=True (a gradient penalty, a Hessian), but its backward pass runs in numpy and is not "
+            f"differentiable, so that gradient cannot be differentiated again. Take the gradient without "
+            f"create_graph=True, or compute the second-order term another way (e.g. finite differences of the "
+            f"gradient).")
+
+
 def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_readonly: bool):
     """:func:`differentiable`; ``grad_readonly=False`` for a ``vjp`` known not to write to its ``grad_output``
     (the library's own: a read-only cotangent would be copied by the numpy API's input check, ~1-2 us)."""
@@ -168,12 +178,25 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype) if need else None
                                for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
 
-    backward_once = once_differentiable(_compute_backward)
-
     def _backward(ctx, grad):
-        if torch.is_grad_enabled():               # create_graph=True: a second derivative raises torch's error
-            return backward_once(ctx, grad)
-        return _compute_backward(ctx, grad)       # the usual case, without once_differentiable's no_grad block
+        if not torch.is_grad_enabled():
+            return _compute_backward(ctx, grad)   # the usual case
+        # create_graph=True: the gradients are constants to autograd (the VJP runs in numpy), but they depend on
+        # the inputs. torch's once_differentiable marks them only when the cotangent requires grad, so the
+        # gradient of sig.sum() (a constant cotangent) came out as a plain tensor and a penalty built from it
+        # was silently differentiated as a constant. Every gradient is marked: differentiating it raises.
+        with torch.no_grad():
+            grads = _compute_backward(ctx, grad)
+        marked = [k for k, g in enumerate(grads) if g is not None]
+        if not marked:
+            return grads
+        err = _autograd_functions.DelayedError(_second_derivative_message(label), len(marked))
+        out = err(*[grads[k].detach().requires_grad_() for k in marked])
+        out = (out,) if isinstance(out, torch.Tensor) else tuple(out)
+        grads = list(grads)
+        for k, g in zip(marked, out):
+            grads[k] = g
+        return tuple(grads)
 
     fn = type(label, (torch.autograd.Function,),
               {"forward": staticmethod(_forward), "backward": staticmethod(_backward)})

@@ -75,8 +75,28 @@ def test_no_grad_and_second_derivative():
     with torch.no_grad():
         assert not rpt.signature(x, 2).requires_grad
     (g,) = torch.autograd.grad(rpt.signature(x, 2).sum(), x, create_graph=True)
-    with pytest.raises(RuntimeError, match="once_differentiable|does not require grad"):
+    with pytest.raises(RuntimeError, match="first derivatives only.*create_graph=True"):
         g.sum().backward()
+
+
+@pytest.mark.parametrize("call", [lambda x: rpt.signature(x, 3), lambda x: rpt.logsignature(x, 3),
+                                  lambda x: rpt.signature_kernel(x, 0.5 * x),
+                                  lambda x: rpt.signature_kernel_gram(x[None], x[None])])
+def test_a_gradient_penalty_is_refused_not_silently_constant(call):
+    # a gradient penalty (WGAN-GP, input-gradient regularisation) differentiates the gradient again; with a
+    # constant cotangent (a fixed linear read-out) the gradient came back as a plain tensor, and the penalty's
+    # dependence on x was silently dropped: loss.backward() ran and gave the gradient of the first term only
+    x = torch.from_numpy(_paths((5, 2), seed=3) * 0.3).requires_grad_()
+    out = call(x)
+    w = torch.from_numpy(np.random.default_rng(4).standard_normal(tuple(out.shape)))   # fixed read-out
+    loss = (out * w).sum()
+    (g,) = torch.autograd.grad(loss, x, create_graph=True)
+    assert g.requires_grad
+    with pytest.raises(RuntimeError, match="first derivatives only"):
+        (loss + (g ** 2).sum()).backward()
+    x.grad = None
+    (g,) = torch.autograd.grad((call(x) * w).sum(), x)          # without create_graph: a plain gradient
+    assert not g.requires_grad and torch.isfinite(g).all()
 
 
 @pytest.mark.parametrize("make, exc, words", [
