@@ -92,14 +92,23 @@ def _padded(idx: np.ndarray) -> np.ndarray:
     return np.concatenate([idx, np.full(pad, idx[-1], dtype=np.int64)]) if pad else idx
 
 
-def _check_size(npairs: int, n: int, m: int, order: int, d: int, grad: bool) -> None:
+#: Bytes a pair holds in the public calls besides the PDE rows: its two flat indices and their padded copies
+#: (``_flat_index(...).ravel()``, :func:`_padded`), 32, and its kernel, 8; the gradients add its cotangent's flat
+#: copy, 8 (their per-pair point cotangents are counted apart).
+_PAIR_BYTES, _PAIR_BYTES_GRAD = 40.0, 48.0
+
+
+def _check_size(npairs: int, n: int, m: int, order: int, d: int, grad: bool, *, pairs: bool = False) -> None:
+    """Refuse a call whose work or memory is above the budget; ``pairs``: count the per-pair index arrays and
+    results too (the public calls check before they build them; the MMD test counts them in its own estimate)."""
     check_work(_work(npairs, n, m, order), f"signature kernel of {npairs} pair(s) of {n} and {m} points at "
                f"dyadic_order={order}", "lower dyadic_order, subsample the paths, or split the batch")
     S = 2 ** order
     per_group = 8.0 * _goursat.LANES * ((m - 1) * S + 1) * (2 + (n + S if grad else 0))
-    check_memory(per_group * 64 + (8.0 * npairs * (n + m) * d if grad else 0.0),
-                 f"signature kernel at dyadic_order={order} of paths of {n} and {m} points",
-                 "lower dyadic_order or split the batch")
+    per_pair = (_PAIR_BYTES_GRAD if grad else _PAIR_BYTES) if pairs else 0.0
+    check_memory(per_group * 64 + (8.0 * npairs * (n + m) * d if grad else 0.0) + per_pair * npairs,
+                 f"signature kernel{' gradient' if grad else ''} of {npairs} pair(s) at dyadic_order={order} of "
+                 f"paths of {n} and {m} points", "lower dyadic_order or split the batch (fewer pairs per call)")
 
 
 def _feature_length(Z: np.ndarray, rbf: bool) -> float:
@@ -161,13 +170,16 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return v
 
 
-def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, rbf: bool, order: int) -> np.ndarray:
-    """Kernels of the pairs ``(X[ia[k]], Y[ib[k]])`` of validated, scaled ``(A, n, d)``, ``(B, m, d)`` arrays."""
+def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, rbf: bool, order: int, *,
+                  checked: bool = False) -> np.ndarray:
+    """Kernels of the pairs ``(X[ia[k]], Y[ib[k]])`` of validated, scaled ``(A, n, d)``, ``(B, m, d)`` arrays
+    (``checked``: the caller checked the sizes already)."""
     npairs, n, m = ia.shape[0], X.shape[1], Y.shape[1]
     out = np.ones(npairs)
     if npairs == 0 or n < 2 or m < 2:
         return out
-    _check_size(npairs, n, m, order, X.shape[2], False)
+    if not checked:
+        _check_size(npairs, n, m, order, X.shape[2], False)
     ia, ib = _padded(ia), _padded(ib)
     ngroups = ia.shape[0] // _goursat.LANES
     per_group = _work(_goursat.LANES, n, m, order) * 4
@@ -179,12 +191,11 @@ def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, 
 
 
 def _pairs_vjp(X, Y, ia, ib, rbf: bool, order: int, gout: np.ndarray) -> tuple:
-    """Per-pair cotangents ``(P, n, d)``, ``(P, m, d)`` of the (scaled) points."""
+    """Per-pair cotangents ``(P, n, d)``, ``(P, m, d)`` of the (scaled) points (the caller checked the sizes)."""
     npairs, n, d, m = ia.shape[0], X.shape[1], X.shape[2], Y.shape[1]
     gx, gy = np.zeros((npairs, n, d)), np.zeros((npairs, m, d))
     if npairs == 0 or n < 2 or m < 2:
         return gx, gy
-    _check_size(npairs, n, m, order, d, True)
     ia, ib = _padded(ia), _padded(ib)
     X, Y, gout = _readonly(X), _readonly(Y), _readonly(np.ascontiguousarray(gout, dtype=np.float64))
     ngroups = ia.shape[0] // _goursat.LANES
@@ -269,9 +280,10 @@ def signature_kernel(x, y, *, dyadic_order: int = 0, static_kernel=None):
     """
     x, y, order, rbf, factor = _setup(x, y, dyadic_order, static_kernel, ("x", "y"), 2)
     batch = _batch(x.shape[:-2], y.shape[:-2], ("x", "y"))
+    _check_size(int(np.prod(batch, dtype=np.int64)), x.shape[-2], y.shape[-2], order, x.shape[-1], False, pairs=True)
     ia = _flat_index(x.shape[:-2], batch, 1).ravel()
     ib = _flat_index(y.shape[:-2], batch, 1).ravel()
-    out = _pairs_kernel(_scaled(x, 2, factor), _scaled(y, 2, factor), ia, ib, rbf, order)
+    out = _pairs_kernel(_scaled(x, 2, factor), _scaled(y, 2, factor), ia, ib, rbf, order, checked=True)
     return out.reshape(batch)[()]
 
 
@@ -302,9 +314,11 @@ def signature_kernel_gram(X, Y, *, dyadic_order: int = 0, static_kernel=None) ->
     X, Y, order, rbf, factor = _setup(X, Y, dyadic_order, static_kernel, ("X", "Y"), 3)
     batch = _batch(X.shape[:-3], Y.shape[:-3], ("X", "Y"))
     a, b = X.shape[-3], Y.shape[-3]
+    _check_size(int(np.prod(batch + (a, b), dtype=np.int64)), X.shape[-2], Y.shape[-2], order, X.shape[-1], False,
+                pairs=True)
     ia = np.broadcast_to(_flat_index(X.shape[:-3], batch, a)[..., :, None], batch + (a, b)).ravel()
     ib = np.broadcast_to(_flat_index(Y.shape[:-3], batch, b)[..., None, :], batch + (a, b)).ravel()
-    out = _pairs_kernel(_scaled(X, 2, factor), _scaled(Y, 2, factor), ia, ib, rbf, order)
+    out = _pairs_kernel(_scaled(X, 2, factor), _scaled(Y, 2, factor), ia, ib, rbf, order, checked=True)
     return out.reshape(batch + (a, b))
 
 
@@ -346,6 +360,7 @@ def signature_kernel_vjp(x, y, grad_output, *, dyadic_order: int = 0, static_ker
     x, y, order, rbf, factor = _setup(x, y, dyadic_order, static_kernel, ("x", "y"), 2)
     batch = _batch(x.shape[:-2], y.shape[:-2], ("x", "y"))
     g = _check_grad(grad_output, batch, "signature_kernel(x, y)")
+    _check_size(g.size, x.shape[-2], y.shape[-2], order, x.shape[-1], True, pairs=True)
     ia = _flat_index(x.shape[:-2], batch, 1).ravel()
     ib = _flat_index(y.shape[:-2], batch, 1).ravel()
     gx, gy = _pairs_vjp(_scaled(x, 2, factor), _scaled(y, 2, factor), ia, ib, rbf, order, g.ravel())
@@ -381,6 +396,7 @@ def signature_kernel_gram_vjp(X, Y, grad_output, *, dyadic_order: int = 0, stati
     batch = _batch(X.shape[:-3], Y.shape[:-3], ("X", "Y"))
     a, b = X.shape[-3], Y.shape[-3]
     g = _check_grad(grad_output, batch + (a, b), "signature_kernel_gram(X, Y)")
+    _check_size(g.size, X.shape[-2], Y.shape[-2], order, X.shape[-1], True, pairs=True)
     ia = np.broadcast_to(_flat_index(X.shape[:-3], batch, a)[..., :, None], batch + (a, b)).ravel()
     ib = np.broadcast_to(_flat_index(Y.shape[:-3], batch, b)[..., None, :], batch + (a, b)).ravel()
     gx, gy = _pairs_vjp(_scaled(X, 2, factor), _scaled(Y, 2, factor), ia, ib, rbf, order, g.ravel())
