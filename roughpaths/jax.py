@@ -21,7 +21,9 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
 * **Devices.** The numpy API runs on the host; on an accelerator the call is a ``pure_callback``
   and JAX copies the arrays to the host and back (correct, but the copy costs what it costs).
 * **Errors.** An error of the numpy API (a non-finite point, say) is raised by JAX where the result
-  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
+  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's. What depends on the shapes
+  alone (the depth, the memory a signature would take) is checked when the call is made or traced,
+  with the numpy API's ``ValueError``: XLA allocates the result before the host call runs.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
 * **Cost.** A jitted forward plus backward (``value_and_grad``, two custom calls), CPU time on a loaded
@@ -65,6 +67,7 @@ from __future__ import annotations
 import ctypes
 import math
 import os
+from functools import partial
 
 import numpy as np
 import jax
@@ -73,6 +76,7 @@ import jax.numpy as jnp
 import roughpaths as _rp
 from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
 from roughpaths._xla_ffi import host_handler
+from roughpaths.signatures._engine import _check_depth, _check_fits
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -295,14 +299,21 @@ def _paths_core(cores, name="paths"):
     return d
 
 
+def _signature_shape(batch: tuple, cores: list, depth, *, log: bool) -> tuple:
+    """The result's shape, after the numpy API's depth and memory checks: XLA allocates the result buffer before
+    the host call runs, so a request the numpy API would refuse must be refused here, before it is traced."""
+    d = _paths_core(cores)
+    depth = _check_depth(depth)
+    _check_fits(math.prod(batch), d, depth, log=log, n=cores[0][0])
+    return batch + ((_rp.logsigdim if log else _rp.sigdim)(d, depth),)
+
+
 _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
                              lambda x, g, depth: _rp.signature_vjp(x, depth, g),
-                             lambda batch, cores, depth: batch + (_rp.sigdim(_paths_core(cores), depth),),
-                             ("paths",), (2,), _signature_compiled)
+                             partial(_signature_shape, log=False), ("paths",), (2,), _signature_compiled)
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
-                               lambda batch, cores, depth: batch + (_rp.logsigdim(_paths_core(cores), depth),),
-                               names=("paths",), core=(2,))
+                               partial(_signature_shape, log=True), names=("paths",), core=(2,))
 _kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
                          lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
                          lambda batch, cores, **kw: batch,

@@ -114,6 +114,23 @@ def test_bad_input_is_refused(bad, exc, words):
         assert w in str(info.value)
 
 
+@pytest.mark.parametrize("name", ["signature", "logsignature"])
+def test_a_request_beyond_the_memory_budget_is_refused_before_xla_allocates_its_result(monkeypatch, name):
+    # XLA allocates the result buffer before the host call (where the numpy API checks the memory) runs: depth 12 in
+    # d = 4 (2.2e7 floats a path) was traced, its result allocated, and refused only then, as a JaxRuntimeError (at
+    # depth 30, 1.5e16 bytes, XLA's own RESOURCE_EXHAUSTED, naming neither depth nor a fix)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(256 * 2 ** 20))
+    x = jnp.zeros((1, 3, 4))
+    fn = getattr(rpj, name)
+    for call in (lambda: fn(x, 12), lambda: jax.jit(lambda p: fn(p, 12)).lower(x)):
+        with pytest.raises(ValueError, match=r"depth=12 with d=4 .* would take .*lower depth") as info:
+            call()
+        assert not isinstance(info.value, jax.errors.JaxRuntimeError)
+    with pytest.raises(ValueError, match=r"depth=30 with d=3 .* would take .* TiB"):
+        fn(jnp.zeros((2, 5, 3)), 30)
+    assert fn(x, 3).shape == (1, (rp.sigdim if name == "signature" else rp.logsigdim)(4, 3))
+
+
 def test_the_call_is_an_xla_custom_call():
     hlo = jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text()
     assert "roughpaths_host_" in hlo and "callback" not in hlo.lower(), hlo
