@@ -324,6 +324,20 @@ def test_compiled_handlers_leave_errors_to_the_numpy_api(x64, where):
         jax.block_until_ready(_step(3)(x, np.ones(rp.sigdim(3, 3))))
 
 
+def test_compiled_handlers_leave_an_overflow_to_the_numpy_api(x64):
+    """Finite paths whose signature (or gradient) leaves float64 are refused by the numpy API; the compiled
+    handlers stored the overflowed values (inf) instead of handing the call on."""
+    x = _paths((8, 3), seed=24) * 1e110                             # level 3 ~ 1e330
+    before = _calls()
+    with pytest.raises(Exception, match="depth-3 signature of paths .* overflows float64"):
+        jax.block_until_ready(jax.jit(lambda p: rpj.signature(p, 3))(x))
+    x = _paths((8, 3), seed=24) * 1e60                              # level 3 fits, the gradient ~ 1e120 * 1e200
+    G = np.full(rp.sigdim(3, 3), 1e200)
+    with pytest.raises(Exception, match="gradient of the depth-3 signature overflows float64"):
+        jax.block_until_ready(_step(3)(x, G))
+    assert _calls()[1] == before[1]
+
+
 def test_a_compiled_handler_without_its_parameters_returns_an_error():
     """A call of a compiled handler without (or with another) attribute is refused with an XLA error, not a crash:
     without the parameters there is no Python handler to hand it to."""

@@ -168,3 +168,11 @@ def test_backward_leaves_the_cotangent_unchanged(name, depth):
     before = g.clone()
     out.backward(g)
     assert torch.equal(g, before)
+
+
+def test_an_overflowing_signature_is_refused_not_returned_as_inf_or_nan():
+    x = torch.from_numpy(_paths((3, 6, 2), seed=5) * 1e110).requires_grad_()
+    with pytest.raises(ValueError, match="overflows float64.*Rescale the paths"):
+        rpt.signature(x, 3)
+    with pytest.raises(ValueError, match="overflows float64.*Rescale the paths"):
+        rpt.logsignature(x, 3)
