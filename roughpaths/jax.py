@@ -21,9 +21,10 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
 * **Devices.** The numpy API runs on the host; on an accelerator the call is a ``pure_callback``
   and JAX copies the arrays to the host and back (correct, but the copy costs what it costs).
 * **Errors.** An error of the numpy API (a non-finite point, say) is raised by JAX where the result
-  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's. What depends on the shapes
-  alone (the depth, the memory a signature would take) is checked when the call is made or traced,
-  with the numpy API's ``ValueError``: XLA allocates the result before the host call runs.
+  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's. What the shapes and the
+  options decide (the batch axes, the depth and the memory a signature would take, the kernels' ``d``,
+  ``dyadic_order`` and ``static_kernel``) is checked when the call is made or traced, with the numpy API's
+  ``ValueError`` or ``TypeError``: XLA allocates the result before the host call runs.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
 * **Cost.** A jitted forward plus backward (``value_and_grad``, two custom calls), CPU time on a loaded
@@ -74,9 +75,10 @@ import jax
 import jax.numpy as jnp
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
+from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
 from roughpaths._xla_ffi import host_handler
 from roughpaths.signatures._engine import _check_depth, _check_fits
+from roughpaths.signatures.kernel import _check_options, _check_pair_shapes
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -273,12 +275,9 @@ def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled
 
     def apply(*xs, **params):
         xs = [_as_jax(x, n) for x, n in zip(xs, names)]
-        for x, n, c in zip(xs, names, core):
-            if x.ndim < c:
-                raise ValueError(f"{n} must have at least {c} axes, got shape {x.shape}.")
+        batch = batch_shape([x.shape for x in xs], core, names)      # the ranks and the batch axes, named
         dtype = jnp.result_type(*xs)
         xs = [x.astype(dtype) for x in xs]
-        batch = np.broadcast_shapes(*(x.shape[:x.ndim - c] for x, c in zip(xs, core)))
         out_shape(batch, [x.shape[x.ndim - c:] for x, c in zip(xs, core)], **params)   # checks, before tracing
         key = (tuple(sorted(params.items())), np.dtype(dtype).name)
         try:
@@ -314,14 +313,21 @@ _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
                                partial(_signature_shape, log=True), names=("paths",), core=(2,))
+def _kernel_shape(batch: tuple, cores: list, *, names: tuple, dyadic_order, static_kernel) -> tuple:
+    """The kernels' shape, after the numpy API's checks of what is known before tracing (the options, a point and
+    a coordinate in each path, the same ``d``): refused with its ``ValueError`` or ``TypeError`` there, not at run
+    time as a ``JaxRuntimeError``."""
+    _check_options(dyadic_order, static_kernel)
+    _check_pair_shapes(cores[0], cores[1], names, len(cores[0]))
+    return batch if len(cores[0]) == 2 else batch + (cores[0][0], cores[1][0])
+
+
 _kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
                          lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
-                         lambda batch, cores, **kw: batch,
-                         names=("x", "y"), core=(2, 2))
+                         partial(_kernel_shape, names=("x", "y")), names=("x", "y"), core=(2, 2))
 _gram = differentiable(lambda x, y, **kw: _rp.signature_kernel_gram(x, y, **kw),
                        lambda x, y, g, **kw: _rp.signature_kernel_gram_vjp(x, y, g, **kw),
-                       lambda batch, cores, **kw: batch + (cores[0][0], cores[1][0]),
-                       names=("X", "Y"), core=(3, 3))
+                       partial(_kernel_shape, names=("X", "Y")), names=("X", "Y"), core=(3, 3))
 
 
 def signature(paths, depth: int):

@@ -67,7 +67,7 @@ import torch
 from torch._C import _functions as _autograd_functions
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
+from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -204,10 +204,12 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
     def apply(*tensors, **params):
         for t, n in zip(tensors, names):
             _check_tensor(t, n)          # refuse a wrong device or dtype before autograd sees it
-        if len(tensors) > 1 and len({t.dtype for t in tensors}) > 1:
-            dtypes = {t.dtype for t in tensors}
-            raise TypeError(f"{' and '.join(names)} have different dtypes {sorted(map(str, dtypes))}; "
-                            f"convert them to one (e.g. .double()).")
+        if len(tensors) > 1:
+            if len({t.dtype for t in tensors}) > 1:
+                dtypes = {t.dtype for t in tensors}
+                raise TypeError(f"{' and '.join(names)} have different dtypes {sorted(map(str, dtypes))}; "
+                                f"convert them to one (e.g. .double()).")
+            batch_shape([tuple(t.shape) for t in tensors], core, names)   # refused naming them, before autograd
         return fn.apply(params, *tensors)
 
     return apply

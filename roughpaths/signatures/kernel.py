@@ -56,20 +56,23 @@ def _check_order(dyadic_order) -> int:
 
 def _check_pair(x, y, names: tuple, axes: int) -> tuple:
     """Validated float64 ``x``, ``y`` with at least ``axes`` axes and the same last axis ``d``."""
-    out = []
-    for arr, name in zip((x, y), names):
-        shape_doc = "(..., n, d)" if axes == 2 else "(..., a, n, d)"
-        a = as_float_array(arr, name, min_ndim=axes)
-        if a.shape[-2] < 1 or a.shape[-1] < 1:
-            raise ValueError(f"{name} must have shape {shape_doc} with at least one point and one coordinate, "
-                             f"got shape {a.shape}.")
-        out.append(a)
-    x, y = out
-    if x.shape[-1] != y.shape[-1]:
-        raise ValueError(f"{names[0]} has d={x.shape[-1]} coordinates (last axis) but {names[1]} has "
-                         f"d={y.shape[-1]}: both paths must live in the same R^d; select or pad the channels "
-                         f"so that {names[0]}.shape[-1] == {names[1]}.shape[-1].")
+    x, y = (as_float_array(arr, name, min_ndim=axes) for arr, name in zip((x, y), names))
+    _check_pair_shapes(x.shape, y.shape, names, axes)
     return x, y
+
+
+def _check_pair_shapes(xs: tuple, ys: tuple, names: tuple, axes: int) -> None:
+    """Refuse paths of shapes ``xs``, ``ys`` (at least ``axes`` axes) without a point or a coordinate, or whose
+    ``d`` differ (also the JAX front end's check, made on the shapes before tracing)."""
+    shape_doc = "(..., n, d)" if axes == 2 else "(..., a, n, d)"
+    for shape, name in zip((xs, ys), names):
+        if shape[-2] < 1 or shape[-1] < 1:
+            raise ValueError(f"{name} must have shape {shape_doc} with at least one point and one coordinate, "
+                             f"got shape {tuple(shape)}.")
+    if xs[-1] != ys[-1]:
+        raise ValueError(f"{names[0]} has d={xs[-1]} coordinates (last axis) but {names[1]} has "
+                         f"d={ys[-1]}: both paths must live in the same R^d; select or pad the channels "
+                         f"so that {names[0]}.shape[-1] == {names[1]}.shape[-1].")
 
 
 def _batch(bx: tuple, by: tuple, names: tuple) -> tuple:
@@ -222,7 +225,9 @@ def _flat_index(shape: tuple, batch: tuple, inner: int) -> np.ndarray:
     return np.broadcast_to(base, batch + (inner,))
 
 
-def _setup(x, y, dyadic_order, static_kernel, names, axes):
+def _check_options(dyadic_order, static_kernel) -> tuple:
+    """``(order, rbf, factor)`` of valid ``dyadic_order`` and ``static_kernel``, or a clear error (also the JAX
+    front end's check, before tracing)."""
     order = _check_order(dyadic_order)
     if order > _MAX_ORDER:
         raise ValueError(f"dyadic_order={order} refines each step 2**{order} times; use dyadic_order <= "
@@ -232,6 +237,11 @@ def _setup(x, y, dyadic_order, static_kernel, names, axes):
         raise ValueError(f"static_kernel={static_kernel!r}: the paths are divided by sigma, and 1/sigma overflows "
                          f"float64; pass a sigma of at least 1e-300 (in the units of the paths' values), or "
                          f"rescale the paths.")
+    return order, rbf, factor
+
+
+def _setup(x, y, dyadic_order, static_kernel, names, axes):
+    order, rbf, factor = _check_options(dyadic_order, static_kernel)
     x, y = _check_pair(x, y, names, axes)
     for arr, name in zip((x, y), names):
         if factor != 1.0 and arr.size:

@@ -366,3 +366,24 @@ def test_kernel_variants_have_their_own_symbols():
     assert xla_handlers.kernels(200, 7, 3, False)[0] == addresses[0, 0, False]     # the engine's blocked kernel
     assert xla_handlers.kernels(8, 7, 3, False)[0] == xla_handlers.kernel_address(     # a short path: the plain one
         _lanes.scalar_units(7), xla_handlers.BLOCK_ARGS)
+
+
+@pytest.mark.parametrize("call, exc, words", [
+    (lambda x, y: rpj.signature_kernel(x, y[:2]), ValueError, ["batch axes of x (3,), y (2,)", "broadcast"]),
+    (lambda x, y: rpj.signature_kernel_gram(x[None], y[None, :2, :, :1]), ValueError, ["d=2", "d=1"]),
+    (lambda x, y: rpj.signature_kernel(x, y[..., :1]), ValueError, ["x has d=2", "y has d=1"]),
+    (lambda x, y: rpj.signature_kernel(x, y, dyadic_order=-1), ValueError, ["dyadic_order must be >= 0"]),
+    (lambda x, y: rpj.signature_kernel(x, y, static_kernel="rbf"), TypeError, ["static_kernel must be", "RBFKernel"]),
+    (lambda x, y: rpj.signature_kernel(x[0, 0], y), ValueError, ["x must have at least 2 axes", "x[None]"]),
+])
+def test_kernel_arguments_are_refused_when_called_not_at_run_time(call, exc, words):
+    # what the shapes and the options decide is refused with the numpy API's error when the function is called
+    # (or traced): a batch mismatch gave numpy's anonymous "shape mismatch", a d mismatch or a bad option a
+    # JaxRuntimeError at run time
+    x, y = jnp.asarray(_paths((3, 5, 2), seed=1)), jnp.asarray(_paths((3, 4, 2), seed=2))
+    for run in (lambda: call(x, y), lambda: jax.jit(call).lower(x, y)):
+        with pytest.raises(exc) as info:
+            run()
+        assert not isinstance(info.value, jax.errors.JaxRuntimeError)
+        for w in words:
+            assert w in str(info.value), str(info.value)

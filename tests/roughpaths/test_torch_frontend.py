@@ -176,3 +176,11 @@ def test_an_overflowing_signature_is_refused_not_returned_as_inf_or_nan():
         rpt.signature(x, 3)
     with pytest.raises(ValueError, match="overflows float64.*Rescale the paths"):
         rpt.logsignature(x, 3)
+
+
+def test_kernel_batch_axes_that_do_not_broadcast_are_named():
+    x = torch.from_numpy(_paths((3, 5, 2), seed=1))
+    with pytest.raises(ValueError, match=r"batch axes of x \(3,\), y \(2,\) do not broadcast"):
+        rpt.signature_kernel(x, x[:2])
+    with pytest.raises(ValueError, match=r"batch axes of X \(3,\), Y \(2,\) do not broadcast"):
+        rpt.signature_kernel_gram(x[:, None], x[:2, None])
