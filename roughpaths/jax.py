@@ -426,11 +426,23 @@ def time_augment(paths, times=None):
         # into a product with its reciprocal and gave other times than numpy and torch (n = 7: t_2 differed)
         t = jnp.asarray((np.arange(n) / max(n - 1, 1)).astype(x.dtype))
     else:
-        t = _as_jax(times, "times").astype(x.dtype)
+        t = _times_array(times).astype(x.dtype)
     if t.ndim < 1 or t.shape[-1] != n:
         raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {t.shape}.")
     check_times_batch(tuple(t.shape), tuple(x.shape))
     return jnp.concatenate([jnp.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)
+
+
+def _times_array(times):
+    """``time_augment``'s ``times`` as a JAX array (or tracer) of real numbers: integers too, as the numpy and torch
+    functions take them (they are cast to the paths' dtype)."""
+    if isinstance(times, (str, bytes)) or times is None:
+        raise TypeError(f"times must be an array of real numbers, got {type(times).__name__}; pass a jax or numpy "
+                        f"array of the points' times.")
+    t = jnp.asarray(times)
+    if t.dtype.kind not in "biuf":
+        raise TypeError(f"times has dtype {t.dtype}; pass real times (floats or integers).")
+    return t
 
 
 def basepoint(paths):

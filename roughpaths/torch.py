@@ -67,6 +67,7 @@ import torch
 from torch._C import _functions as _autograd_functions
 
 import roughpaths as _rp
+from roughpaths.validation import as_float_array
 from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
@@ -326,13 +327,32 @@ def time_augment(paths: torch.Tensor, times=None) -> torch.Tensor:
     if times is None:
         t = torch.arange(n, dtype=x.dtype, device=x.device) / max(n - 1, 1)
     else:
-        t = torch.as_tensor(times, dtype=x.dtype, device=x.device)
+        t = _times_tensor(times, x)
         if t.ndim < 1 or t.shape[-1] != n:
             raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {tuple(t.shape)}.")
         if n > 1 and not bool(torch.all(t[..., 1:] > t[..., :-1])):
-            raise ValueError("times must be strictly increasing along its last axis; sort the points by time.")
+            where = tuple(int(i) for i in torch.nonzero(~(t[..., 1:] > t[..., :-1]))[0])
+            raise ValueError(f"times must be strictly increasing along its last axis, but at index {where} it goes from "
+                             f"{float(t[where])!r} to {float(t[where[:-1] + (where[-1] + 1,)])!r} (in {x.dtype}); sort "
+                             f"the points by time and drop repeated times.")
         check_times_batch(tuple(t.shape), tuple(x.shape))
     return torch.cat([t.expand(x.shape[:-1]).unsqueeze(-1), x], dim=-1)
+
+
+def _times_tensor(times, x: torch.Tensor) -> torch.Tensor:
+    """``time_augment``'s ``times`` as a finite tensor of the paths' dtype and device (a tensor keeps its graph), with
+    the numpy function's checks: real numbers (integers too), no NaN or inf."""
+    if isinstance(times, torch.Tensor):
+        if times.is_complex():
+            raise TypeError(f"times must be real, got a complex tensor of dtype {times.dtype}; pass times.real if the "
+                            f"imaginary part is zero.")
+        t = times.to(dtype=x.dtype, device=x.device)
+        if not bool(torch.isfinite(t).all()):
+            first = tuple(int(i) for i in torch.nonzero(~torch.isfinite(t))[0])
+            raise ValueError(f"times contains {int((~torch.isfinite(t)).sum())} non-finite value(s) (NaN or inf, "
+                             f"in {x.dtype}), the first at index {first}; remove or interpolate them before calling.")
+        return t
+    return torch.as_tensor(as_float_array(times, "times"), dtype=x.dtype, device=x.device)
 
 
 def basepoint(paths: torch.Tensor) -> torch.Tensor:
