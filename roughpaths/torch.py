@@ -29,8 +29,8 @@ Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`
   taken with ``create_graph=True`` (a gradient penalty, a Hessian) is marked so that differentiating it
   raises a ``RuntimeError`` saying so, whatever the cotangent that reached the function (a constant one
   too, as from ``.sum()``: no silent zero second derivative), and
-  ``torch.func`` transforms (``vmap``, ``jacrev``) are not supported; batch with leading axes instead,
-  which runs as one call of the compiled kernels.
+  ``torch.func`` transforms (``vmap``, ``grad``, ``jacrev``) are not supported (refused with a ``TypeError``
+  naming the fix); batch with leading axes instead, which runs as one call of the compiled kernels.
 * **Cost.** The forward converts the tensors to numpy once, without a copy (float64) or with one
   cast (float32, whose float64 copy is kept for the backward), and the result back without a copy;
   the backward reuses those arrays, and the library's own VJPs get torch's cotangent without a copy
@@ -90,6 +90,14 @@ def _check_tensor(t, name: str) -> None:
                              f"data: pass a CPU tensor (torch.empty_like({name}, device='cpu') filled with the values).")
         raise ValueError(f"{name} is on device {t.device}; roughpaths.torch runs its compiled kernels on the CPU: "
                          f"pass {name}.cpu() (and move the result back with .to({name}.device)).")
+
+
+def _is_functorch_wrapped(t: torch.Tensor) -> bool:
+    """Whether ``t`` is a tensor of a ``torch.func`` transform (its wrappers have no data numpy could read)."""
+    try:
+        return bool(torch._C._functorch.is_functorch_wrapped_tensor(t))
+    except AttributeError:                       # (a torch without that query: torch's own error follows)
+        return False
 
 
 def _numpy64(t: torch.Tensor) -> np.ndarray:
@@ -205,6 +213,11 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
     def apply(*tensors, **params):
         for t, n in zip(tensors, names):
             _check_tensor(t, n)          # refuse a wrong device or dtype before autograd sees it
+            if _is_functorch_wrapped(t):
+                raise TypeError(f"{n} is a tensor inside a torch.func transform (vmap, grad, jacrev, ...); the "
+                                f"roughpaths.torch functions run their kernels in numpy and support torch.autograd "
+                                f"only. Batch with leading axes instead of vmap (one call of the compiled kernels) "
+                                f"and take gradients with loss.backward() or torch.autograd.grad.")
         if len(tensors) > 1:
             if len({t.dtype for t in tensors}) > 1:
                 dtypes = {t.dtype for t in tensors}

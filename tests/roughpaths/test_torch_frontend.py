@@ -184,3 +184,15 @@ def test_kernel_batch_axes_that_do_not_broadcast_are_named():
         rpt.signature_kernel(x, x[:2])
     with pytest.raises(ValueError, match=r"batch axes of X \(3,\), Y \(2,\) do not broadcast"):
         rpt.signature_kernel_gram(x[:, None], x[:2, None])
+
+
+@pytest.mark.parametrize("transform", [lambda f: torch.func.vmap(f), lambda f: torch.func.jacrev(f),
+                                       lambda f: torch.func.grad(lambda z: f(z).sum())])
+def test_torch_func_transforms_are_refused_with_the_fix(transform):
+    # torch's own error spoke of a missing setup_context staticmethod, which the caller cannot add
+    x = torch.from_numpy(_paths((4, 6, 2)))
+    with pytest.raises(TypeError, match="torch.func transform.*Batch with leading axes"):
+        transform(lambda z: rpt.signature(z, 2))(x)
+    with pytest.raises(TypeError, match="torch.func transform"):
+        transform(lambda z: rpt.signature_kernel(z, z))(x)
+    assert torch.func.vmap(rpt.lead_lag)(x).shape == (4, 11, 4)      # the transforms are torch operations
