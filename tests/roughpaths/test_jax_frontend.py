@@ -387,3 +387,10 @@ def test_kernel_arguments_are_refused_when_called_not_at_run_time(call, exc, wor
         assert not isinstance(info.value, jax.errors.JaxRuntimeError)
         for w in words:
             assert w in str(info.value), str(info.value)
+
+
+def test_the_numpy_api_inside_a_jax_transform_names_the_jax_function():
+    x = jnp.asarray(_paths((5, 2)))
+    for call in (lambda p: rp.signature(p, 2), lambda p: rp.signature_kernel(p, p)):
+        with pytest.raises(TypeError, match="roughpaths.jax function of the same name"):
+            jax.jit(call)(x)

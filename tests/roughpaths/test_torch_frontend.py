@@ -196,3 +196,11 @@ def test_torch_func_transforms_are_refused_with_the_fix(transform):
     with pytest.raises(TypeError, match="torch.func transform"):
         transform(lambda z: rpt.signature_kernel(z, z))(x)
     assert torch.func.vmap(rpt.lead_lag)(x).shape == (4, 11, 4)      # the transforms are torch operations
+
+
+def test_the_numpy_api_given_a_tensor_in_a_graph_names_the_differentiable_function():
+    # torch's own advice, ".detach().numpy()", would silently drop the gradient the caller is after
+    x = torch.from_numpy(_paths((5, 2))).requires_grad_()
+    for call in (lambda: rp.signature(x, 2), lambda: rp.lead_lag(x)):
+        with pytest.raises(TypeError, match=r"roughpaths.torch function of the same name.*paths.detach\(\).numpy\(\)"):
+            call()
