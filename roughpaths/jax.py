@@ -77,8 +77,8 @@ import jax.numpy as jnp
 import roughpaths as _rp
 from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
 from roughpaths._xla_ffi import host_handler
-from roughpaths.signatures._engine import _check_depth, _check_fits
-from roughpaths.signatures.kernel import _check_options, _check_pair_shapes
+from roughpaths.signatures.kernel import kernel_shape
+from roughpaths.signatures.signature import signature_shape
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -301,10 +301,8 @@ def _paths_core(cores, name="paths"):
 def _signature_shape(batch: tuple, cores: list, depth, *, log: bool) -> tuple:
     """The result's shape, after the numpy API's depth and memory checks: XLA allocates the result buffer before
     the host call runs, so a request the numpy API would refuse must be refused here, before it is traced."""
-    d = _paths_core(cores)
-    depth = _check_depth(depth)
-    _check_fits(math.prod(batch), d, depth, log=log, n=cores[0][0])
-    return batch + ((_rp.logsigdim if log else _rp.sigdim)(d, depth),)
+    _paths_core(cores)
+    return signature_shape(tuple(batch) + tuple(cores[0]), depth, log=log)
 
 
 _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
@@ -313,21 +311,20 @@ _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
                                partial(_signature_shape, log=True), names=("paths",), core=(2,))
-def _kernel_shape(batch: tuple, cores: list, *, names: tuple, dyadic_order, static_kernel) -> tuple:
+def _kernel_shape(batch: tuple, cores: list, *, gram: bool, dyadic_order, static_kernel) -> tuple:
     """The kernels' shape, after the numpy API's checks of what is known before tracing (the options, a point and
     a coordinate in each path, the same ``d``): refused with its ``ValueError`` or ``TypeError`` there, not at run
     time as a ``JaxRuntimeError``."""
-    _check_options(dyadic_order, static_kernel)
-    _check_pair_shapes(cores[0], cores[1], names, len(cores[0]))
-    return batch if len(cores[0]) == 2 else batch + (cores[0][0], cores[1][0])
+    return kernel_shape(tuple(batch) + tuple(cores[0]), tuple(batch) + tuple(cores[1]), gram=gram,
+                        dyadic_order=dyadic_order, static_kernel=static_kernel)
 
 
 _kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
                          lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
-                         partial(_kernel_shape, names=("x", "y")), names=("x", "y"), core=(2, 2))
+                         partial(_kernel_shape, gram=False), names=("x", "y"), core=(2, 2))
 _gram = differentiable(lambda x, y, **kw: _rp.signature_kernel_gram(x, y, **kw),
                        lambda x, y, g, **kw: _rp.signature_kernel_gram_vjp(x, y, g, **kw),
-                       partial(_kernel_shape, names=("X", "Y")), names=("X", "Y"), core=(3, 3))
+                       partial(_kernel_shape, gram=True), names=("X", "Y"), core=(3, 3))
 
 
 def signature(paths, depth: int):

@@ -258,6 +258,22 @@ def _scaled(a: np.ndarray, lead: int, factor: float) -> np.ndarray:
     return np.ascontiguousarray(flat * factor if factor != 1.0 else flat)
 
 
+def kernel_shape(x_shape: tuple, y_shape: tuple, *, gram: bool = False, dyadic_order=0, static_kernel=None) -> tuple:
+    """The shape of ``signature_kernel`` (``signature_kernel_gram`` with ``gram``) for paths of these shapes, after the
+    checks the shapes and the options decide (a point and a coordinate in each path, one ``d``, broadcasting batch
+    axes, ``dyadic_order``, ``static_kernel``). For callers that allocate the result themselves (the JAX front end)."""
+    axes = 3 if gram else 2
+    names = ("X", "Y") if gram else ("x", "y")
+    _check_options(dyadic_order, static_kernel)
+    for shape, name in zip((x_shape, y_shape), names):
+        if len(shape) < axes:
+            raise ValueError(f"{name} must have at least {axes} axes, got shape {tuple(shape)}; add the missing axes "
+                             f"(e.g. {name}[None]).")
+    _check_pair_shapes(x_shape, y_shape, names, axes)
+    batch = _batch(tuple(x_shape[:-axes]), tuple(y_shape[:-axes]), names)
+    return batch + ((x_shape[-3], y_shape[-3]) if gram else ())
+
+
 def signature_kernel(x, y, *, dyadic_order: int = 0, static_kernel=None):
     r"""Signature kernel ``k(x, y) = <S(x), S(y)>`` of pairs of piecewise-linear paths.
 

@@ -113,6 +113,16 @@ def logsignature(paths, depth: int) -> np.ndarray:
     return _finite_or_raise(out, x, depth, "log-signature").reshape(batch + (_logsigdim(d, depth),))
 
 
+def signature_shape(shape: tuple, depth, *, log: bool = False) -> tuple:
+    """The shape of ``signature(paths, depth)`` (``logsignature`` with ``log``) for paths of ``shape`` ``(..., n, d)``,
+    after the checks the shapes decide: the depth and the memory estimate. For callers that allocate the result
+    themselves (the JAX front end, whose result buffer XLA allocates before the host call runs)."""
+    *batch, n, d = shape
+    depth = _check_depth(depth)
+    _check_fits(int(np.prod(batch, dtype=np.int64)), d, depth, log=log, n=n)
+    return tuple(batch) + ((_logsigdim if log else _sigdim)(d, depth),)
+
+
 def rough_path_signature(X, depth: int) -> np.ndarray:
     r"""Depth-``m`` signature of a level-2 geometric :class:`~roughpaths.RoughPath` over its whole grid.
 
