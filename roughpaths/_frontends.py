@@ -10,7 +10,24 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["batch_broadcast", "sum_to", "check_times_batch"]
+__all__ = ["batch_broadcast", "batch_shape", "sum_to", "check_times_batch"]
+
+
+def batch_shape(shapes: list, core: tuple, names: tuple) -> tuple:
+    """The broadcast batch shape of inputs of ``shapes`` (``core[i]`` trailing axes of input ``i`` are not batch
+    axes), or a ``ValueError`` naming the inputs, their shapes and the fix."""
+    for shape, c, name in zip(shapes, core, names):
+        if len(shape) < c:
+            raise ValueError(f"{name} must have at least {c} axes, got shape {tuple(shape)}; add the missing axes "
+                             f"(e.g. {name}[None]).")
+    batches = [tuple(s[:len(s) - c]) for s, c in zip(shapes, core)]
+    try:
+        return tuple(np.broadcast_shapes(*batches))
+    except ValueError:
+        listed = ", ".join(f"{n} {b}" for n, b in zip(names, batches))
+        raise ValueError(f"the batch axes of {listed} do not broadcast (shapes "
+                         f"{', '.join(str(tuple(s)) for s in shapes)}); give them equal leading axes (or size 1 where "
+                         f"one is shared).") from None
 
 
 def batch_broadcast(arrays: list, core: tuple) -> list:

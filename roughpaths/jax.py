@@ -21,7 +21,10 @@ They work under ``jax.jit``, ``jax.vmap`` and ``jax.grad``
 * **Devices.** The numpy API runs on the host; on an accelerator the call is a ``pure_callback``
   and JAX copies the arrays to the host and back (correct, but the copy costs what it costs).
 * **Errors.** An error of the numpy API (a non-finite point, say) is raised by JAX where the result
-  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's.
+  is waited for, as a ``JaxRuntimeError`` whose message is the numpy API's. What the shapes and the
+  options decide (the batch axes, the depth and the memory a signature would take, the kernels' ``d``,
+  ``dyadic_order`` and ``static_kernel``) is checked when the call is made or traced, with the numpy API's
+  ``ValueError`` or ``TypeError``: XLA allocates the result before the host call runs.
 * **Gradients.** First order (reverse mode): ``jax.grad``, ``jax.vjp``, ``jax.jacrev``. Forward mode
   (``jax.jvp``, ``jacfwd``) and second derivatives are not defined for a ``custom_vjp`` of a host call.
 * **Cost.** A jitted forward plus backward (``value_and_grad``, two custom calls), CPU time on a loaded
@@ -65,14 +68,17 @@ from __future__ import annotations
 import ctypes
 import math
 import os
+from functools import partial
 
 import numpy as np
 import jax
 import jax.numpy as jnp
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
+from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
 from roughpaths._xla_ffi import host_handler
+from roughpaths.signatures.kernel import kernel_shape
+from roughpaths.signatures.signature import signature_shape
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -269,12 +275,9 @@ def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled
 
     def apply(*xs, **params):
         xs = [_as_jax(x, n) for x, n in zip(xs, names)]
-        for x, n, c in zip(xs, names, core):
-            if x.ndim < c:
-                raise ValueError(f"{n} must have at least {c} axes, got shape {x.shape}.")
+        batch = batch_shape([x.shape for x in xs], core, names)      # the ranks and the batch axes, named
         dtype = jnp.result_type(*xs)
         xs = [x.astype(dtype) for x in xs]
-        batch = np.broadcast_shapes(*(x.shape[:x.ndim - c] for x, c in zip(xs, core)))
         out_shape(batch, [x.shape[x.ndim - c:] for x, c in zip(xs, core)], **params)   # checks, before tracing
         key = (tuple(sorted(params.items())), np.dtype(dtype).name)
         try:
@@ -295,22 +298,33 @@ def _paths_core(cores, name="paths"):
     return d
 
 
+def _signature_shape(batch: tuple, cores: list, depth, *, log: bool) -> tuple:
+    """The result's shape, after the numpy API's depth and memory checks: XLA allocates the result buffer before
+    the host call runs, so a request the numpy API would refuse must be refused here, before it is traced."""
+    _paths_core(cores)
+    return signature_shape(tuple(batch) + tuple(cores[0]), depth, log=log)
+
+
 _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
                              lambda x, g, depth: _rp.signature_vjp(x, depth, g),
-                             lambda batch, cores, depth: batch + (_rp.sigdim(_paths_core(cores), depth),),
-                             ("paths",), (2,), _signature_compiled)
+                             partial(_signature_shape, log=False), ("paths",), (2,), _signature_compiled)
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
-                               lambda batch, cores, depth: batch + (_rp.logsigdim(_paths_core(cores), depth),),
-                               names=("paths",), core=(2,))
+                               partial(_signature_shape, log=True), names=("paths",), core=(2,))
+def _kernel_shape(batch: tuple, cores: list, *, gram: bool, dyadic_order, static_kernel) -> tuple:
+    """The kernels' shape, after the numpy API's checks of what is known before tracing (the options, a point and
+    a coordinate in each path, the same ``d``): refused with its ``ValueError`` or ``TypeError`` there, not at run
+    time as a ``JaxRuntimeError``."""
+    return kernel_shape(tuple(batch) + tuple(cores[0]), tuple(batch) + tuple(cores[1]), gram=gram,
+                        dyadic_order=dyadic_order, static_kernel=static_kernel)
+
+
 _kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
                          lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
-                         lambda batch, cores, **kw: batch,
-                         names=("x", "y"), core=(2, 2))
+                         partial(_kernel_shape, gram=False), names=("x", "y"), core=(2, 2))
 _gram = differentiable(lambda x, y, **kw: _rp.signature_kernel_gram(x, y, **kw),
                        lambda x, y, g, **kw: _rp.signature_kernel_gram_vjp(x, y, g, **kw),
-                       lambda batch, cores, **kw: batch + (cores[0][0], cores[1][0]),
-                       names=("X", "Y"), core=(3, 3))
+                       partial(_kernel_shape, gram=True), names=("X", "Y"), core=(3, 3))
 
 
 def signature(paths, depth: int):
@@ -409,11 +423,23 @@ def time_augment(paths, times=None):
         # into a product with its reciprocal and gave other times than numpy and torch (n = 7: t_2 differed)
         t = jnp.asarray((np.arange(n) / max(n - 1, 1)).astype(x.dtype))
     else:
-        t = _as_jax(times, "times").astype(x.dtype)
+        t = _times_array(times).astype(x.dtype)
     if t.ndim < 1 or t.shape[-1] != n:
         raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {t.shape}.")
     check_times_batch(tuple(t.shape), tuple(x.shape))
     return jnp.concatenate([jnp.broadcast_to(t, x.shape[:-1])[..., None], x], axis=-1)
+
+
+def _times_array(times):
+    """``time_augment``'s ``times`` as a JAX array (or tracer) of real numbers: integers too, as the numpy and torch
+    functions take them (they are cast to the paths' dtype)."""
+    if isinstance(times, (str, bytes)) or times is None:
+        raise TypeError(f"times must be an array of real numbers, got {type(times).__name__}; pass a jax or numpy "
+                        f"array of the points' times.")
+    t = jnp.asarray(times)
+    if t.dtype.kind not in "biuf":
+        raise TypeError(f"times has dtype {t.dtype}; pass real times (floats or integers).")
+    return t
 
 
 def basepoint(paths):

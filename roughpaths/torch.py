@@ -25,10 +25,12 @@ Shapes, layouts and conventions are those of the numpy functions (``(..., n, d)`
   kernels are float64 only): a float32 input is widened, the result (and the gradient) rounded back
   to float32, so float32 in gives float32 out, about as accurate as float32 can hold. Other dtypes
   (integers, float16, bfloat16, complex) are refused with a ``TypeError`` naming the fix.
-* **Gradients.** First derivatives only: the backward pass is not itself differentiable (a second
-  ``backward`` through it raises torch's error for ``once_differentiable`` functions), and
-  ``torch.func`` transforms (``vmap``, ``jacrev``) are not supported; batch with leading axes instead,
-  which runs as one call of the compiled kernels.
+* **Gradients.** First derivatives only: the backward pass is not itself differentiable. A gradient
+  taken with ``create_graph=True`` (a gradient penalty, a Hessian) is marked so that differentiating it
+  raises a ``RuntimeError`` saying so, whatever the cotangent that reached the function (a constant one
+  too, as from ``.sum()``: no silent zero second derivative), and
+  ``torch.func`` transforms (``vmap``, ``grad``, ``jacrev``) are not supported (refused with a ``TypeError``
+  naming the fix); batch with leading axes instead, which runs as one call of the compiled kernels.
 * **Cost.** The forward converts the tensors to numpy once, without a copy (float64) or with one
   cast (float32, whose float64 copy is kept for the backward), and the result back without a copy;
   the backward reuses those arrays, and the library's own VJPs get torch's cotangent without a copy
@@ -62,10 +64,11 @@ from __future__ import annotations
 
 import numpy as np
 import torch
-from torch.autograd.function import once_differentiable
+from torch._C import _functions as _autograd_functions
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, check_times_batch, sum_to
+from roughpaths.validation import as_float_array
+from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -87,6 +90,14 @@ def _check_tensor(t, name: str) -> None:
                              f"data: pass a CPU tensor (torch.empty_like({name}, device='cpu') filled with the values).")
         raise ValueError(f"{name} is on device {t.device}; roughpaths.torch runs its compiled kernels on the CPU: "
                          f"pass {name}.cpu() (and move the result back with .to({name}.device)).")
+
+
+def _is_functorch_wrapped(t: torch.Tensor) -> bool:
+    """Whether ``t`` is a tensor of a ``torch.func`` transform (its wrappers have no data numpy could read)."""
+    try:
+        return bool(torch._C._functorch.is_functorch_wrapped_tensor(t))
+    except AttributeError:                       # (a torch without that query: torch's own error follows)
+        return False
 
 
 def _numpy64(t: torch.Tensor) -> np.ndarray:
@@ -142,6 +153,14 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     return _function(forward, vjp, names=names, core=core, label=label, grad_readonly=True)
 
 
+def _second_derivative_message(label: str) -> str:
+    return (f"roughpaths.torch gives first derivatives only: a gradient through <{label}Backward> was taken with "
+            f"create_graph=True (a gradient penalty, a Hessian), but its backward pass runs in numpy and is not "
+            f"differentiable, so that gradient cannot be differentiated again. Take the gradient without "
+            f"create_graph=True, or compute the second-order term another way (e.g. finite differences of the "
+            f"gradient).")
+
+
 def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_readonly: bool):
     """:func:`differentiable`; ``grad_readonly=False`` for a ``vjp`` known not to write to its ``grad_output``
     (the library's own: a read-only cotangent would be copied by the numpy API's input check, ~1-2 us)."""
@@ -168,12 +187,25 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype) if need else None
                                for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
 
-    backward_once = once_differentiable(_compute_backward)
-
     def _backward(ctx, grad):
-        if torch.is_grad_enabled():               # create_graph=True: a second derivative raises torch's error
-            return backward_once(ctx, grad)
-        return _compute_backward(ctx, grad)       # the usual case, without once_differentiable's no_grad block
+        if not torch.is_grad_enabled():
+            return _compute_backward(ctx, grad)   # the usual case
+        # create_graph=True: the gradients are constants to autograd (the VJP runs in numpy), but they depend on
+        # the inputs. torch's once_differentiable marks them only when the cotangent requires grad, so the
+        # gradient of sig.sum() (a constant cotangent) came out as a plain tensor and a penalty built from it
+        # was silently differentiated as a constant. Every gradient is marked: differentiating it raises.
+        with torch.no_grad():
+            grads = _compute_backward(ctx, grad)
+        marked = [k for k, g in enumerate(grads) if g is not None]
+        if not marked:
+            return grads
+        err = _autograd_functions.DelayedError(_second_derivative_message(label), len(marked))
+        out = err(*[grads[k].detach().requires_grad_() for k in marked])
+        out = (out,) if isinstance(out, torch.Tensor) else tuple(out)
+        grads = list(grads)
+        for k, g in zip(marked, out):
+            grads[k] = g
+        return tuple(grads)
 
     fn = type(label, (torch.autograd.Function,),
               {"forward": staticmethod(_forward), "backward": staticmethod(_backward)})
@@ -181,10 +213,17 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
     def apply(*tensors, **params):
         for t, n in zip(tensors, names):
             _check_tensor(t, n)          # refuse a wrong device or dtype before autograd sees it
-        if len(tensors) > 1 and len({t.dtype for t in tensors}) > 1:
-            dtypes = {t.dtype for t in tensors}
-            raise TypeError(f"{' and '.join(names)} have different dtypes {sorted(map(str, dtypes))}; "
-                            f"convert them to one (e.g. .double()).")
+            if _is_functorch_wrapped(t):
+                raise TypeError(f"{n} is a tensor inside a torch.func transform (vmap, grad, jacrev, ...); the "
+                                f"roughpaths.torch functions run their kernels in numpy and support torch.autograd "
+                                f"only. Batch with leading axes instead of vmap (one call of the compiled kernels) "
+                                f"and take gradients with loss.backward() or torch.autograd.grad.")
+        if len(tensors) > 1:
+            if len({t.dtype for t in tensors}) > 1:
+                dtypes = {t.dtype for t in tensors}
+                raise TypeError(f"{' and '.join(names)} have different dtypes {sorted(map(str, dtypes))}; "
+                                f"convert them to one (e.g. .double()).")
+            batch_shape([tuple(t.shape) for t in tensors], core, names)   # refused naming them, before autograd
         return fn.apply(params, *tensors)
 
     return apply
@@ -301,13 +340,32 @@ def time_augment(paths: torch.Tensor, times=None) -> torch.Tensor:
     if times is None:
         t = torch.arange(n, dtype=x.dtype, device=x.device) / max(n - 1, 1)
     else:
-        t = torch.as_tensor(times, dtype=x.dtype, device=x.device)
+        t = _times_tensor(times, x)
         if t.ndim < 1 or t.shape[-1] != n:
             raise ValueError(f"times must have {n} entries on its last axis (one per point), got shape {tuple(t.shape)}.")
         if n > 1 and not bool(torch.all(t[..., 1:] > t[..., :-1])):
-            raise ValueError("times must be strictly increasing along its last axis; sort the points by time.")
+            where = tuple(int(i) for i in torch.nonzero(~(t[..., 1:] > t[..., :-1]))[0])
+            raise ValueError(f"times must be strictly increasing along its last axis, but at index {where} it goes from "
+                             f"{float(t[where])!r} to {float(t[where[:-1] + (where[-1] + 1,)])!r} (in {x.dtype}); sort "
+                             f"the points by time and drop repeated times.")
         check_times_batch(tuple(t.shape), tuple(x.shape))
     return torch.cat([t.expand(x.shape[:-1]).unsqueeze(-1), x], dim=-1)
+
+
+def _times_tensor(times, x: torch.Tensor) -> torch.Tensor:
+    """``time_augment``'s ``times`` as a finite tensor of the paths' dtype and device (a tensor keeps its graph), with
+    the numpy function's checks: real numbers (integers too), no NaN or inf."""
+    if isinstance(times, torch.Tensor):
+        if times.is_complex():
+            raise TypeError(f"times must be real, got a complex tensor of dtype {times.dtype}; pass times.real if the "
+                            f"imaginary part is zero.")
+        t = times.to(dtype=x.dtype, device=x.device)
+        if not bool(torch.isfinite(t).all()):
+            first = tuple(int(i) for i in torch.nonzero(~torch.isfinite(t))[0])
+            raise ValueError(f"times contains {int((~torch.isfinite(t)).sum())} non-finite value(s) (NaN or inf, "
+                             f"in {x.dtype}), the first at index {first}; remove or interpolate them before calling.")
+        return t
+    return torch.as_tensor(as_float_array(times, "times"), dtype=x.dtype, device=x.device)
 
 
 def basepoint(paths: torch.Tensor) -> torch.Tensor:

@@ -67,6 +67,19 @@ def _describe(x) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+def _framework_fix(x, name: str) -> str:
+    """The fix for an array that numpy cannot read: a torch tensor in a graph or a JAX tracer asks for the
+    differentiable front end (``.detach().numpy()`` alone, which torch proposes, would silently drop the gradient)."""
+    module = type(x).__module__.split(".")[0]
+    if module == "torch":
+        return (f"the numpy API does not differentiate: for a gradient call the roughpaths.torch function of the "
+                f"same name (signatures, transforms, kernels), for values only pass {name}.detach().numpy().")
+    if module in ("jax", "jaxlib"):
+        return ("the numpy API cannot run inside jax.jit, grad or vmap: call the roughpaths.jax function of the same "
+                "name (signatures, transforms, kernels), or call this one outside the transform on concrete arrays.")
+    return "pass a numpy array of floats."
+
+
 def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
                    last_dims: tuple | None = None, allow_nonfinite: bool = False) -> np.ndarray:
     """Convert ``x`` to a float64 array and check its rank, trailing shape and finiteness.
@@ -95,7 +108,7 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
         arr = np.asarray(x)
     except Exception as exc:  # pragma: no cover - exotic inputs
         raise TypeError(f"{name} could not be converted to an array ({exc}); "
-                        f"pass a numpy array of floats.") from None
+                        f"{_framework_fix(x, name)}") from None
     if arr.dtype.kind == "c":
         raise TypeError(f"{name} must be real, got a complex {_describe(arr)}; "
                         f"pass its real part (np.real) if the imaginary part is zero.")

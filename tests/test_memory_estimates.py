@@ -127,6 +127,8 @@ CASES = [
          lambda x, g: rp.logsignature_vjp(x, 4, g), lambda x, g: rp.logsignature_vjp(x[:8], 4, g[:8])),
     Case("signature_kernel_gram", lambda: (_paths((60, 30, 2)),),
          lambda X: rp.signature_kernel_gram(X, X, dyadic_order=1)),
+    Case("signature_kernel_gram, many short paths", lambda: (_paths((1500, 3, 2)),),
+         lambda X: rp.signature_kernel_gram(X, X), lambda X: rp.signature_kernel_gram(X[:3], X[:3])),
     Case("signature_kernel_gram_vjp", lambda: (_paths((60, 30, 2)), np.ones((60, 60))),
          lambda X, g: rp.signature_kernel_gram_vjp(X, X, g, dyadic_order=1)),
     Case("sig_mmd_test", lambda: (_paths((30, 30, 2), 1), _paths((30, 30, 2), 2)),

@@ -171,19 +171,47 @@ def _check_paths(paths, *, finite: bool = True) -> np.ndarray:
     return x
 
 
-def _finite_or_raise(out: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Return ``out``; if it holds NaN/inf, first raise the input check's error if the input does.
+def _abs_sum(a: np.ndarray) -> float:
+    """``sum |a|`` of a float64 array: NaN if it holds a NaN, inf if an inf (or if the sum overflows)."""
+    if a.size <= _SUM_SCAN:
+        return sum(map(abs, a.ravel().tolist()))
+    return float(np.add.reduce(np.abs(a), axis=None))
+
+
+def _finite_or_raise(out: np.ndarray, x: np.ndarray, depth: int, what: str = "signature") -> np.ndarray:
+    """Return ``out`` if it is finite; else raise the input check's error if the input holds NaN/inf, and if it
+    does not (the result overflowed float64), an error naming the size of the paths and the fix.
 
     At depth >= 2 and d >= 2 every point of a path of two or more points enters the output
     (through the increments on both sides of it, and NaN/inf never cancel), so a non-finite
     input always gives a non-finite output: scanning the small output replaces scanning the whole
-    path on every call. A finite input whose signature overflows returns the overflowed values,
-    as before. When the input is the smaller array (short paths at high depth) it is scanned
-    instead: the same outcome.
+    path on every call. When the input is the smaller array (short paths at high depth) it is scanned
+    instead, by ``A = sum |x|``: a NaN or inf makes it non-finite, and a finite ``A`` bounds every path's
+    length by ``L <= 2 A``, so level ``k`` of the signature by ``L**k / k!`` and of its logarithm (``depth``
+    terms of tensor powers) by ``(depth L)**k``; only inputs too large for that bound to stay below ``1e290``
+    have their output scanned as well.
     """
-    if not _all_finite(x if x.size < out.size else out):
+    if x.size < out.size:
+        total = _abs_sum(x)
+        if total <= 10.0 ** (290.0 / depth) / (2.0 * depth):      # finite, and too small to overflow
+            return out
+        as_float_array(x, "paths")                  # raises, naming the first non-finite point
+        if _all_finite(out):
+            return out
+    elif _all_finite(out):
+        return out
+    else:
         as_float_array(x, "paths")
-    return out
+    _overflow(x, depth, what)
+
+
+def _overflow(x: np.ndarray, depth: int, what: str):
+    """Raise: the ``what`` of the finite ``paths`` ``x`` at ``depth`` left float64."""
+    top = float(np.max(np.abs(x), initial=0.0))
+    raise ValueError(f"the depth-{depth} {what} of paths (finite, values up to {top:.3g} in absolute value) "
+                     f"overflows float64 (inf or nan): its level k grows like the k-th power of a path's length. "
+                     f"Rescale the paths (e.g. divide them by their length or standard deviation; the level-k terms "
+                     f"scale by c**k when the paths do by c) or lower depth.")
 
 
 #: From this width on every unit runs alone (:func:`_blocked.block_units`, the same bits as the lanes):
@@ -301,7 +329,8 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if nb == 0 or n == 1:
         return np.zeros((nb, _sigdim(d, depth)))
     if depth == 1:
-        return x[:, -1, :] - x[:, 0, :]
+        with np.errstate(over="ignore"):            # an overflow is refused with its fix (_finite_or_raise)
+            return x[:, -1, :] - x[:, 0, :]
     if depth == 2:
         return _level2_flat(x, log=False)
     nchunks = _horner_chunks(n, d, depth)

@@ -39,6 +39,19 @@ def _check_grad(grad_output, batch: tuple, width: int, what: str) -> np.ndarray:
     return _kernel_array(g, (-1, width))
 
 
+def _finite_grad(gx: np.ndarray, x: np.ndarray, g: np.ndarray, depth: int, what: str) -> np.ndarray:
+    """``gx``, the VJP of finite ``paths`` ``x`` and ``grad_output`` ``g``, if it is finite; else raise: it overflowed
+    (a scan of the points' cotangent, the size of the paths: cheap beside the VJP's ``depth d**depth`` a point)."""
+    if _all_finite(gx):
+        return gx
+    top = float(np.max(np.abs(x), initial=0.0))
+    gtop = float(np.max(np.abs(g), initial=0.0))
+    raise ValueError(f"the gradient of the depth-{depth} {what} overflows float64 (inf or nan) for finite paths (values "
+                     f"up to {top:.3g} in absolute value) and grad_output (up to {gtop:.3g}): the level-k terms grow "
+                     f"like the k-th power of a path's length. Rescale the paths (e.g. divide them by their length "
+                     f"or standard deviation) or grad_output, or lower depth.")
+
+
 def _increments_to_points(gd: np.ndarray, n: int) -> np.ndarray:
     """Cotangent of the points from that of the increments ``x_k - x_{k-1}``."""
     gx = np.zeros((gd.shape[0], n, gd.shape[-1]))
@@ -160,7 +173,7 @@ def signature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     g = _check_grad(grad_output, batch, _sigdim(d, depth), "signature")
     flat = _kernel_array(x, (-1, n, d))
     _check_fits(flat.shape[0], d, depth, log=True, n=n)
-    return _signature_vjp_flat(flat, depth, g).reshape(x.shape)
+    return _finite_grad(_signature_vjp_flat(flat, depth, g), x, g, depth, "signature").reshape(x.shape)
 
 
 def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
@@ -202,7 +215,7 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     if depth == 1 or d == 1:
         g_sig = np.zeros((flat.shape[0], _sigdim(d, depth)))
         g_sig[:, :d] = g
-        return _signature_vjp_flat(flat, depth, g_sig).reshape(x.shape)
+        return _finite_grad(_signature_vjp_flat(flat, depth, g_sig), x, g, depth, "log-signature").reshape(x.shape)
     _check_fits(flat.shape[0], d, depth, log=True, n=n)
     off = level_offsets(d, depth)
     perm = _reversed_to_rowmajor(d, depth)
@@ -218,8 +231,10 @@ def logsignature_vjp(paths, depth: int, grad_output) -> np.ndarray:
     _threads.run(lambda lo, hi: _vjp.log_vjp_rows(sig_rev, g_log_rev, d, depth, off, lo, hi, g_sig_rev),
                  _threads.ranges(sig_rev.shape[0], 2.0 * depth * depth * sig_rev.shape[1]))
     if small:
-        return _signature_vjp_flat(flat, depth, g_sig_rev.take(perm, axis=1)).reshape(x.shape)
-    return _signature_vjp_rev(flat, depth, g_sig_rev, part).reshape(x.shape)
+        gx = _signature_vjp_flat(flat, depth, g_sig_rev.take(perm, axis=1))
+    else:
+        gx = _signature_vjp_rev(flat, depth, g_sig_rev, part)
+    return _finite_grad(gx, x, g, depth, "log-signature").reshape(x.shape)
 
 
 def rough_path_signature_vjp(X, depth: int, grad_output) -> tuple:

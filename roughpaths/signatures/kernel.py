@@ -56,20 +56,23 @@ def _check_order(dyadic_order) -> int:
 
 def _check_pair(x, y, names: tuple, axes: int) -> tuple:
     """Validated float64 ``x``, ``y`` with at least ``axes`` axes and the same last axis ``d``."""
-    out = []
-    for arr, name in zip((x, y), names):
-        shape_doc = "(..., n, d)" if axes == 2 else "(..., a, n, d)"
-        a = as_float_array(arr, name, min_ndim=axes)
-        if a.shape[-2] < 1 or a.shape[-1] < 1:
-            raise ValueError(f"{name} must have shape {shape_doc} with at least one point and one coordinate, "
-                             f"got shape {a.shape}.")
-        out.append(a)
-    x, y = out
-    if x.shape[-1] != y.shape[-1]:
-        raise ValueError(f"{names[0]} has d={x.shape[-1]} coordinates (last axis) but {names[1]} has "
-                         f"d={y.shape[-1]}: both paths must live in the same R^d; select or pad the channels "
-                         f"so that {names[0]}.shape[-1] == {names[1]}.shape[-1].")
+    x, y = (as_float_array(arr, name, min_ndim=axes) for arr, name in zip((x, y), names))
+    _check_pair_shapes(x.shape, y.shape, names, axes)
     return x, y
+
+
+def _check_pair_shapes(xs: tuple, ys: tuple, names: tuple, axes: int) -> None:
+    """Refuse paths of shapes ``xs``, ``ys`` (at least ``axes`` axes) without a point or a coordinate, or whose
+    ``d`` differ (also the JAX front end's check, made on the shapes before tracing)."""
+    shape_doc = "(..., n, d)" if axes == 2 else "(..., a, n, d)"
+    for shape, name in zip((xs, ys), names):
+        if shape[-2] < 1 or shape[-1] < 1:
+            raise ValueError(f"{name} must have shape {shape_doc} with at least one point and one coordinate, "
+                             f"got shape {tuple(shape)}.")
+    if xs[-1] != ys[-1]:
+        raise ValueError(f"{names[0]} has d={xs[-1]} coordinates (last axis) but {names[1]} has "
+                         f"d={ys[-1]}: both paths must live in the same R^d; select or pad the channels "
+                         f"so that {names[0]}.shape[-1] == {names[1]}.shape[-1].")
 
 
 def _batch(bx: tuple, by: tuple, names: tuple) -> tuple:
@@ -92,14 +95,23 @@ def _padded(idx: np.ndarray) -> np.ndarray:
     return np.concatenate([idx, np.full(pad, idx[-1], dtype=np.int64)]) if pad else idx
 
 
-def _check_size(npairs: int, n: int, m: int, order: int, d: int, grad: bool) -> None:
+#: Bytes a pair holds in the public calls besides the PDE rows: its two flat indices and their padded copies
+#: (``_flat_index(...).ravel()``, :func:`_padded`), 32, and its kernel, 8; the gradients add its cotangent's flat
+#: copy, 8 (their per-pair point cotangents are counted apart).
+_PAIR_BYTES, _PAIR_BYTES_GRAD = 40.0, 48.0
+
+
+def _check_size(npairs: int, n: int, m: int, order: int, d: int, grad: bool, *, pairs: bool = False) -> None:
+    """Refuse a call whose work or memory is above the budget; ``pairs``: count the per-pair index arrays and
+    results too (the public calls check before they build them; the MMD test counts them in its own estimate)."""
     check_work(_work(npairs, n, m, order), f"signature kernel of {npairs} pair(s) of {n} and {m} points at "
                f"dyadic_order={order}", "lower dyadic_order, subsample the paths, or split the batch")
     S = 2 ** order
     per_group = 8.0 * _goursat.LANES * ((m - 1) * S + 1) * (2 + (n + S if grad else 0))
-    check_memory(per_group * 64 + (8.0 * npairs * (n + m) * d if grad else 0.0),
-                 f"signature kernel at dyadic_order={order} of paths of {n} and {m} points",
-                 "lower dyadic_order or split the batch")
+    per_pair = (_PAIR_BYTES_GRAD if grad else _PAIR_BYTES) if pairs else 0.0
+    check_memory(per_group * 64 + (8.0 * npairs * (n + m) * d if grad else 0.0) + per_pair * npairs,
+                 f"signature kernel{' gradient' if grad else ''} of {npairs} pair(s) at dyadic_order={order} of "
+                 f"paths of {n} and {m} points", "lower dyadic_order or split the batch (fewer pairs per call)")
 
 
 def _feature_length(Z: np.ndarray, rbf: bool) -> float:
@@ -161,13 +173,16 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return v
 
 
-def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, rbf: bool, order: int) -> np.ndarray:
-    """Kernels of the pairs ``(X[ia[k]], Y[ib[k]])`` of validated, scaled ``(A, n, d)``, ``(B, m, d)`` arrays."""
+def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, rbf: bool, order: int, *,
+                  checked: bool = False) -> np.ndarray:
+    """Kernels of the pairs ``(X[ia[k]], Y[ib[k]])`` of validated, scaled ``(A, n, d)``, ``(B, m, d)`` arrays
+    (``checked``: the caller checked the sizes already)."""
     npairs, n, m = ia.shape[0], X.shape[1], Y.shape[1]
     out = np.ones(npairs)
     if npairs == 0 or n < 2 or m < 2:
         return out
-    _check_size(npairs, n, m, order, X.shape[2], False)
+    if not checked:
+        _check_size(npairs, n, m, order, X.shape[2], False)
     ia, ib = _padded(ia), _padded(ib)
     ngroups = ia.shape[0] // _goursat.LANES
     per_group = _work(_goursat.LANES, n, m, order) * 4
@@ -179,12 +194,11 @@ def _pairs_kernel(X: np.ndarray, Y: np.ndarray, ia: np.ndarray, ib: np.ndarray, 
 
 
 def _pairs_vjp(X, Y, ia, ib, rbf: bool, order: int, gout: np.ndarray) -> tuple:
-    """Per-pair cotangents ``(P, n, d)``, ``(P, m, d)`` of the (scaled) points."""
+    """Per-pair cotangents ``(P, n, d)``, ``(P, m, d)`` of the (scaled) points (the caller checked the sizes)."""
     npairs, n, d, m = ia.shape[0], X.shape[1], X.shape[2], Y.shape[1]
     gx, gy = np.zeros((npairs, n, d)), np.zeros((npairs, m, d))
     if npairs == 0 or n < 2 or m < 2:
         return gx, gy
-    _check_size(npairs, n, m, order, d, True)
     ia, ib = _padded(ia), _padded(ib)
     X, Y, gout = _readonly(X), _readonly(Y), _readonly(np.ascontiguousarray(gout, dtype=np.float64))
     ngroups = ia.shape[0] // _goursat.LANES
@@ -211,7 +225,9 @@ def _flat_index(shape: tuple, batch: tuple, inner: int) -> np.ndarray:
     return np.broadcast_to(base, batch + (inner,))
 
 
-def _setup(x, y, dyadic_order, static_kernel, names, axes):
+def _check_options(dyadic_order, static_kernel) -> tuple:
+    """``(order, rbf, factor)`` of valid ``dyadic_order`` and ``static_kernel``, or a clear error (also the JAX
+    front end's check, before tracing)."""
     order = _check_order(dyadic_order)
     if order > _MAX_ORDER:
         raise ValueError(f"dyadic_order={order} refines each step 2**{order} times; use dyadic_order <= "
@@ -221,6 +237,11 @@ def _setup(x, y, dyadic_order, static_kernel, names, axes):
         raise ValueError(f"static_kernel={static_kernel!r}: the paths are divided by sigma, and 1/sigma overflows "
                          f"float64; pass a sigma of at least 1e-300 (in the units of the paths' values), or "
                          f"rescale the paths.")
+    return order, rbf, factor
+
+
+def _setup(x, y, dyadic_order, static_kernel, names, axes):
+    order, rbf, factor = _check_options(dyadic_order, static_kernel)
     x, y = _check_pair(x, y, names, axes)
     for arr, name in zip((x, y), names):
         if factor != 1.0 and arr.size:
@@ -235,6 +256,22 @@ def _setup(x, y, dyadic_order, static_kernel, names, axes):
 def _scaled(a: np.ndarray, lead: int, factor: float) -> np.ndarray:
     flat = a.reshape((-1,) + a.shape[a.ndim - lead:]) if a.size else a.reshape((0,) + a.shape[a.ndim - lead:])
     return np.ascontiguousarray(flat * factor if factor != 1.0 else flat)
+
+
+def kernel_shape(x_shape: tuple, y_shape: tuple, *, gram: bool = False, dyadic_order=0, static_kernel=None) -> tuple:
+    """The shape of ``signature_kernel`` (``signature_kernel_gram`` with ``gram``) for paths of these shapes, after the
+    checks the shapes and the options decide (a point and a coordinate in each path, one ``d``, broadcasting batch
+    axes, ``dyadic_order``, ``static_kernel``). For callers that allocate the result themselves (the JAX front end)."""
+    axes = 3 if gram else 2
+    names = ("X", "Y") if gram else ("x", "y")
+    _check_options(dyadic_order, static_kernel)
+    for shape, name in zip((x_shape, y_shape), names):
+        if len(shape) < axes:
+            raise ValueError(f"{name} must have at least {axes} axes, got shape {tuple(shape)}; add the missing axes "
+                             f"(e.g. {name}[None]).")
+    _check_pair_shapes(x_shape, y_shape, names, axes)
+    batch = _batch(tuple(x_shape[:-axes]), tuple(y_shape[:-axes]), names)
+    return batch + ((x_shape[-3], y_shape[-3]) if gram else ())
 
 
 def signature_kernel(x, y, *, dyadic_order: int = 0, static_kernel=None):
@@ -269,9 +306,10 @@ def signature_kernel(x, y, *, dyadic_order: int = 0, static_kernel=None):
     """
     x, y, order, rbf, factor = _setup(x, y, dyadic_order, static_kernel, ("x", "y"), 2)
     batch = _batch(x.shape[:-2], y.shape[:-2], ("x", "y"))
+    _check_size(int(np.prod(batch, dtype=np.int64)), x.shape[-2], y.shape[-2], order, x.shape[-1], False, pairs=True)
     ia = _flat_index(x.shape[:-2], batch, 1).ravel()
     ib = _flat_index(y.shape[:-2], batch, 1).ravel()
-    out = _pairs_kernel(_scaled(x, 2, factor), _scaled(y, 2, factor), ia, ib, rbf, order)
+    out = _pairs_kernel(_scaled(x, 2, factor), _scaled(y, 2, factor), ia, ib, rbf, order, checked=True)
     return out.reshape(batch)[()]
 
 
@@ -302,9 +340,11 @@ def signature_kernel_gram(X, Y, *, dyadic_order: int = 0, static_kernel=None) ->
     X, Y, order, rbf, factor = _setup(X, Y, dyadic_order, static_kernel, ("X", "Y"), 3)
     batch = _batch(X.shape[:-3], Y.shape[:-3], ("X", "Y"))
     a, b = X.shape[-3], Y.shape[-3]
+    _check_size(int(np.prod(batch + (a, b), dtype=np.int64)), X.shape[-2], Y.shape[-2], order, X.shape[-1], False,
+                pairs=True)
     ia = np.broadcast_to(_flat_index(X.shape[:-3], batch, a)[..., :, None], batch + (a, b)).ravel()
     ib = np.broadcast_to(_flat_index(Y.shape[:-3], batch, b)[..., None, :], batch + (a, b)).ravel()
-    out = _pairs_kernel(_scaled(X, 2, factor), _scaled(Y, 2, factor), ia, ib, rbf, order)
+    out = _pairs_kernel(_scaled(X, 2, factor), _scaled(Y, 2, factor), ia, ib, rbf, order, checked=True)
     return out.reshape(batch + (a, b))
 
 
@@ -346,6 +386,7 @@ def signature_kernel_vjp(x, y, grad_output, *, dyadic_order: int = 0, static_ker
     x, y, order, rbf, factor = _setup(x, y, dyadic_order, static_kernel, ("x", "y"), 2)
     batch = _batch(x.shape[:-2], y.shape[:-2], ("x", "y"))
     g = _check_grad(grad_output, batch, "signature_kernel(x, y)")
+    _check_size(g.size, x.shape[-2], y.shape[-2], order, x.shape[-1], True, pairs=True)
     ia = _flat_index(x.shape[:-2], batch, 1).ravel()
     ib = _flat_index(y.shape[:-2], batch, 1).ravel()
     gx, gy = _pairs_vjp(_scaled(x, 2, factor), _scaled(y, 2, factor), ia, ib, rbf, order, g.ravel())
@@ -381,6 +422,7 @@ def signature_kernel_gram_vjp(X, Y, grad_output, *, dyadic_order: int = 0, stati
     batch = _batch(X.shape[:-3], Y.shape[:-3], ("X", "Y"))
     a, b = X.shape[-3], Y.shape[-3]
     g = _check_grad(grad_output, batch + (a, b), "signature_kernel_gram(X, Y)")
+    _check_size(g.size, X.shape[-2], Y.shape[-2], order, X.shape[-1], True, pairs=True)
     ia = np.broadcast_to(_flat_index(X.shape[:-3], batch, a)[..., :, None], batch + (a, b)).ravel()
     ib = np.broadcast_to(_flat_index(Y.shape[:-3], batch, b)[..., None, :], batch + (a, b)).ravel()
     gx, gy = _pairs_vjp(_scaled(X, 2, factor), _scaled(Y, 2, factor), ia, ib, rbf, order, g.ravel())

@@ -64,7 +64,7 @@ def signature(paths, depth: int) -> np.ndarray:
     batch, (n, d) = x.shape[:-2], x.shape[-2:]
     flat = _kernel_array(x, (-1, n, d))
     _check_fits(flat.shape[0], d, depth, n=n)
-    return _finite_or_raise(_signature_flat(flat, depth), x).reshape(batch + (_sigdim(d, depth),))
+    return _finite_or_raise(_signature_flat(flat, depth), x, depth).reshape(batch + (_sigdim(d, depth),))
 
 
 def logsignature(paths, depth: int) -> np.ndarray:
@@ -105,9 +105,22 @@ def logsignature(paths, depth: int) -> np.ndarray:
         # which the level-2 kernel accumulates directly
         if flat.shape[0] == 0 or n == 1:
             return np.zeros(batch + (_logsigdim(d, 2),))
-        return _finite_or_raise(_level2_flat(flat, log=True), x).reshape(batch + (-1,))
-    sig = np.ascontiguousarray(_finite_or_raise(_signature_flat(flat, depth), x))
-    return lyndon_flat(log_flat(sig, d, depth), d, depth).reshape(batch + (_logsigdim(d, depth),))
+        return _finite_or_raise(_level2_flat(flat, log=True), x, 2, "log-signature").reshape(batch + (-1,))
+    sig = np.ascontiguousarray(_signature_flat(flat, depth))
+    # checked through the Lyndon coordinates: a NaN/inf point reaches them, and the log of a finite signature may
+    # itself overflow (its products of levels)
+    out = lyndon_flat(log_flat(sig, d, depth), d, depth)
+    return _finite_or_raise(out, x, depth, "log-signature").reshape(batch + (_logsigdim(d, depth),))
+
+
+def signature_shape(shape: tuple, depth, *, log: bool = False) -> tuple:
+    """The shape of ``signature(paths, depth)`` (``logsignature`` with ``log``) for paths of ``shape`` ``(..., n, d)``,
+    after the checks the shapes decide: the depth and the memory estimate. For callers that allocate the result
+    themselves (the JAX front end, whose result buffer XLA allocates before the host call runs)."""
+    *batch, n, d = shape
+    depth = _check_depth(depth)
+    _check_fits(int(np.prod(batch, dtype=np.int64)), d, depth, log=log, n=n)
+    return tuple(batch) + ((_logsigdim if log else _sigdim)(d, depth),)
 
 
 def rough_path_signature(X, depth: int) -> np.ndarray:

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algebra import lyndon_coordinates, sigdim, tensor_log, tensor_product
+from ..algebra import logsigdim, lyndon_coordinates, sigdim, tensor_log, tensor_product
 from ..validation import as_float_array, check_memory, check_positive_int
 from .signature import signature
 
@@ -53,6 +53,8 @@ __all__ = ["SignatureStream", "windowed_signature"]
 
 #: Target number of floats in one gathered chunk of queries (about 32 MiB).
 _CHUNK_FLOATS = 1 << 22
+#: Working floats of a query, in signatures (measured peak about 6; a margin for the log and other layouts).
+_QUERY_WORK = 8.0
 #: Sliding windows of at most this many steps are signed directly (gathered), longer ones by a stream.
 _DIRECT_WINDOW = 64
 
@@ -122,7 +124,13 @@ class SignatureStream:
                 f"depth={self.depth}, block={self.block})")
 
     # ------------------------------------------------------------------------------ queries
-    def _check_query(self, s, t) -> tuple:
+    def _chunk(self) -> int:
+        """Queries answered together: their working arrays (about :data:`_QUERY_WORK` signatures each, and the
+        gathered points of two partial blocks) stay near :data:`_CHUNK_FLOATS` floats."""
+        per_query = float(np.prod(self.batch_shape, dtype=float)) * max((self.block + 1) * self.dim, 4 * self._sigdim)
+        return max(1, int(_CHUNK_FLOATS // max(per_query, 1.0)))
+
+    def _check_query(self, s, t, width: int) -> tuple:
         out = []
         for v, name in ((s, "s"), (t, "t")):
             if isinstance(v, (str, bytes)) or v is None:
@@ -140,8 +148,13 @@ class SignatureStream:
         # 16 more (s, t raveled), so an outer product of index arrays allocated gigabytes before this refusal
         n_paths = float(np.prod(self.batch_shape, dtype=float))
         size = float(np.prod(q, dtype=float))
-        check_memory(size * (n_paths * self._sigdim * 8.0 + 17.0), f"the answers ({self.batch_shape} paths x "
-                     f"{size:.0f} queries x {self._sigdim})", "ask fewer queries at a time")
+        # the answers (width floats a query) and the working arrays of one chunk of queries: the gathered points of
+        # two partial blocks and about _QUERY_WORK signatures a query (the partial blocks' signatures and their
+        # engine arrays, the tree's left and right products, the Chen products, the log and its coordinates)
+        work = min(size, self._chunk()) * n_paths * (2.0 * (self.block + 1) * self.dim + _QUERY_WORK * self._sigdim)
+        check_memory(size * (n_paths * width * 8.0 + 17.0) + 8.0 * work, f"the answers ({self.batch_shape} paths x "
+                     f"{size:.0f} queries x {width}) and the working arrays of {min(size, self._chunk()):.0f} queries",
+                     "ask fewer queries at a time")
         for a, name in zip(out, ("s", "t")):
             if a.size and (a.min() < 0 or a.max() > self.n_points - 1):
                 bad = int(a[(a < 0) | (a > self.n_points - 1)].ravel()[0])
@@ -197,16 +210,20 @@ class SignatureStream:
             In :func:`roughpaths.signature`'s layout: equal (to rounding, see the module docstring) to
             ``signature(paths[..., s:t + 1, :], depth)``; zero where ``s == t``.
         """
-        s, t = self._check_query(s, t)
+        return self._answers(s, t, log=False)
+
+    def _answers(self, s, t, *, log: bool) -> np.ndarray:
+        """The signatures (or with ``log`` the log-signatures) of the queries, a chunk at a time into the result."""
+        width = logsigdim(self.dim, self.depth) if log else self._sigdim
+        s, t = self._check_query(s, t, width)
         q = s.shape
         s, t = s.ravel(), t.ravel()
-        per_query = float(np.prod(self.batch_shape, dtype=float)) * max((self.block + 1) * self.dim,
-                                                                         4 * self._sigdim)
-        chunk = max(1, int(_CHUNK_FLOATS // max(per_query, 1.0)))
-        out = np.empty(self.batch_shape + (s.size, self._sigdim))
+        chunk = self._chunk()
+        out = np.empty(self.batch_shape + (s.size, width))
         for lo in range(0, s.size, chunk):
-            out[..., lo:lo + chunk, :] = self._answer(s[lo:lo + chunk], t[lo:lo + chunk])
-        return out.reshape(self.batch_shape + q + (self._sigdim,))
+            sig = self._answer(s[lo:lo + chunk], t[lo:lo + chunk])
+            out[..., lo:lo + chunk, :] = lyndon_coordinates(tensor_log(sig, self.dim), self.dim) if log else sig
+        return out.reshape(self.batch_shape + q + (width,))
 
     def logsignature(self, s, t) -> np.ndarray:
         r"""The log-signature of the path between grid points ``s`` and ``t``, in the Lyndon basis.
@@ -222,7 +239,7 @@ class SignatureStream:
             ``lyndon_coordinates(tensor_log(self.signature(s, t), d), d)``: the coordinates of
             :func:`roughpaths.logsignature` of the sub-path.
         """
-        return lyndon_coordinates(tensor_log(self.signature(s, t), self.dim), self.dim)
+        return self._answers(s, t, log=True)
 
 
 def windowed_signature(paths, depth: int, length: int, *, step: int = 1, expanding: bool = False,
@@ -286,13 +303,22 @@ def windowed_signature(paths, depth: int, length: int, *, step: int = 1, expandi
     if not expanding and length <= _DIRECT_WINDOW:
         # short sliding windows: each one's points gathered and signed directly (cheaper than the tree's
         # partial blocks and products: 16 steps, 10^5 windows, d = 3, depth 3 took 0.3 s against 1.6 s)
+        d = x.shape[-1]
         n_paths = float(np.prod(x.shape[:-2], dtype=float))
-        check_memory(n_paths * k.size * sigdim(x.shape[-1], depth) * 8.0, f"the windows' signatures "
-                     f"({x.shape[:-2]} paths x {k.size} windows)", "pass a larger step or fewer paths at a time")
-        chunk = max(1, int(_CHUNK_FLOATS // max(1.0, n_paths * (length + 1) * x.shape[-1])))
-        parts = [signature(x[..., s[lo:lo + chunk, None] + np.arange(length + 1), :], depth)
-                 for lo in range(0, k.size, chunk)]
-        sig = np.concatenate(parts, axis=-2)
-        return lyndon_coordinates(tensor_log(sig, x.shape[-1]), x.shape[-1]) if log else sig
+        dim = sigdim(d, depth)
+        width = logsigdim(d, depth) if log else dim
+        # a chunk of windows at a time, written into the result: its gathered points, its signatures with the
+        # engine's arrays (about 3 signatures a window) and, with log, the log and its coordinates (2 more; 6 in all
+        # with a margin: measured 5.4 at d = 3, depth 3)
+        chunk = max(1, int(_CHUNK_FLOATS // max(1.0, n_paths * max((length + 1) * d, dim))))
+        work = min(k.size, chunk) * n_paths * ((length + 1) * d + 6.0 * dim)
+        check_memory((n_paths * k.size * width + work) * 8.0, f"the windows' {'log-' if log else ''}signatures "
+                     f"({x.shape[:-2]} paths x {k.size} windows x {width}) and the working arrays of "
+                     f"{min(k.size, chunk)} windows", "pass a larger step or fewer paths at a time")
+        out = np.empty(x.shape[:-2] + (k.size, width))
+        for lo in range(0, k.size, chunk):
+            sig = signature(x[..., s[lo:lo + chunk, None] + np.arange(length + 1), :], depth)
+            out[..., lo:lo + chunk, :] = lyndon_coordinates(tensor_log(sig, d), d) if log else sig
+        return out
     stream = SignatureStream(x, depth)
     return stream.logsignature(s, t) if log else stream.signature(s, t)

@@ -12,7 +12,7 @@ one-unit kernels on XLA's buffers:
   ``d <= 7``, ``n >= 2`` points, a path short enough to be one work unit, and at most :func:`plan`'s
   ``most`` paths (2 at d <= 3, where the engine runs lanes from 3 paths on), float32 or float64
   buffers. Every other call, and every call whose values the numpy API refuses (a NaN or inf point
-  or cotangent), goes to the Python handler of the same call (called through its address), so that
+  or cotangent, a signature or gradient that overflows), goes to the Python handler of the same call (called through its address), so that
   errors keep the numpy API's messages.
 * **The same numbers**: the numpy API's steps in its order: one unit a path, the kernel variant the
   engine picks for ``(n, d, depth)`` (the very compiled function: its address), the time reversal of a
@@ -216,6 +216,16 @@ def _load_cotangent(b, g, off, d, m):
 
 
 @njit(**_JIT)
+def _finite(a):
+    """Whether the float64 array ``a`` is all finite (a signature or cotangent that overflowed is not: such calls go
+    to the Python handler, whose numpy API refuses them with its message)."""
+    finite = True
+    for v in a.ravel():
+        finite &= v - v == 0.0
+    return finite
+
+
+@njit(**_JIT)
 def _store(b, e, v):
     """``v`` into entry ``e`` of the float32 or float64 buffer at ``b`` (rounded to float32 there)."""
     if i32(b + 16) == F64:
@@ -314,7 +324,8 @@ def _forward(frame_pointer):
     flipped = n * d < off[m + 1]                        # S(x)_w = S(-x reversed)_{w*}: row-major out of the kernel
     x = np.empty((nb, n, d))
     part = np.empty((nb, off[m + 1]))
-    if not _load_paths(xb, x, flipped) or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part):
+    if not _load_paths(xb, x, flipped) or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
+            or not _finite(part):
         return voidptr(call(i64(p), frame))
     _store_signature(ob, part, flipped, off, d, m)
     _count(p, 0)
@@ -339,7 +350,7 @@ def _backward(frame_pointer):
     gd = np.zeros((nb, n - 1, d))
     if not _load_paths(xb, x, False) or not _load_cotangent(gb, g, off, d, m) \
             or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
-            or _vjp_units(vjp, x, ub, ulo, uhi, m, off, part, g, 0, nb, gd):
+            or _vjp_units(vjp, x, ub, ulo, uhi, m, off, part, g, 0, nb, gd) or not _finite(gd):
         return voidptr(call(i64(p), frame))
     _store_points(ob, gd)
     _count(p, 1)

@@ -114,6 +114,23 @@ def test_bad_input_is_refused(bad, exc, words):
         assert w in str(info.value)
 
 
+@pytest.mark.parametrize("name", ["signature", "logsignature"])
+def test_a_request_beyond_the_memory_budget_is_refused_before_xla_allocates_its_result(monkeypatch, name):
+    # XLA allocates the result buffer before the host call (where the numpy API checks the memory) runs: depth 12 in
+    # d = 4 (2.2e7 floats a path) was traced, its result allocated, and refused only then, as a JaxRuntimeError (at
+    # depth 30, 1.5e16 bytes, XLA's own RESOURCE_EXHAUSTED, naming neither depth nor a fix)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(256 * 2 ** 20))
+    x = jnp.zeros((1, 3, 4))
+    fn = getattr(rpj, name)
+    for call in (lambda: fn(x, 12), lambda: jax.jit(lambda p: fn(p, 12)).lower(x)):
+        with pytest.raises(ValueError, match=r"depth=12 with d=4 .* would take .*lower depth") as info:
+            call()
+        assert not isinstance(info.value, jax.errors.JaxRuntimeError)
+    with pytest.raises(ValueError, match=r"depth=30 with d=3 .* would take .* TiB"):
+        fn(jnp.zeros((2, 5, 3)), 30)
+    assert fn(x, 3).shape == (1, (rp.sigdim if name == "signature" else rp.logsigdim)(4, 3))
+
+
 def test_the_call_is_an_xla_custom_call():
     hlo = jax.jit(lambda p: rpj.signature(p, 2)).lower(jnp.zeros((3, 4, 2))).as_text()
     assert "roughpaths_host_" in hlo and "callback" not in hlo.lower(), hlo
@@ -307,6 +324,20 @@ def test_compiled_handlers_leave_errors_to_the_numpy_api(x64, where):
         jax.block_until_ready(_step(3)(x, np.ones(rp.sigdim(3, 3))))
 
 
+def test_compiled_handlers_leave_an_overflow_to_the_numpy_api(x64):
+    """Finite paths whose signature (or gradient) leaves float64 are refused by the numpy API; the compiled
+    handlers stored the overflowed values (inf) instead of handing the call on."""
+    x = _paths((8, 3), seed=24) * 1e110                             # level 3 ~ 1e330
+    before = _calls()
+    with pytest.raises(Exception, match="depth-3 signature of paths .* overflows float64"):
+        jax.block_until_ready(jax.jit(lambda p: rpj.signature(p, 3))(x))
+    x = _paths((8, 3), seed=24) * 1e60                              # level 3 fits, the gradient ~ 1e120 * 1e200
+    G = np.full(rp.sigdim(3, 3), 1e200)
+    with pytest.raises(Exception, match="gradient of the depth-3 signature overflows float64"):
+        jax.block_until_ready(_step(3)(x, G))
+    assert _calls()[1] == before[1]
+
+
 def test_a_compiled_handler_without_its_parameters_returns_an_error():
     """A call of a compiled handler without (or with another) attribute is refused with an XLA error, not a crash:
     without the parameters there is no Python handler to hand it to."""
@@ -335,3 +366,31 @@ def test_kernel_variants_have_their_own_symbols():
     assert xla_handlers.kernels(200, 7, 3, False)[0] == addresses[0, 0, False]     # the engine's blocked kernel
     assert xla_handlers.kernels(8, 7, 3, False)[0] == xla_handlers.kernel_address(     # a short path: the plain one
         _lanes.scalar_units(7), xla_handlers.BLOCK_ARGS)
+
+
+@pytest.mark.parametrize("call, exc, words", [
+    (lambda x, y: rpj.signature_kernel(x, y[:2]), ValueError, ["batch axes of x (3,), y (2,)", "broadcast"]),
+    (lambda x, y: rpj.signature_kernel_gram(x[None], y[None, :2, :, :1]), ValueError, ["d=2", "d=1"]),
+    (lambda x, y: rpj.signature_kernel(x, y[..., :1]), ValueError, ["x has d=2", "y has d=1"]),
+    (lambda x, y: rpj.signature_kernel(x, y, dyadic_order=-1), ValueError, ["dyadic_order must be >= 0"]),
+    (lambda x, y: rpj.signature_kernel(x, y, static_kernel="rbf"), TypeError, ["static_kernel must be", "RBFKernel"]),
+    (lambda x, y: rpj.signature_kernel(x[0, 0], y), ValueError, ["x must have at least 2 axes", "x[None]"]),
+])
+def test_kernel_arguments_are_refused_when_called_not_at_run_time(call, exc, words):
+    # what the shapes and the options decide is refused with the numpy API's error when the function is called
+    # (or traced): a batch mismatch gave numpy's anonymous "shape mismatch", a d mismatch or a bad option a
+    # JaxRuntimeError at run time
+    x, y = jnp.asarray(_paths((3, 5, 2), seed=1)), jnp.asarray(_paths((3, 4, 2), seed=2))
+    for run in (lambda: call(x, y), lambda: jax.jit(call).lower(x, y)):
+        with pytest.raises(exc) as info:
+            run()
+        assert not isinstance(info.value, jax.errors.JaxRuntimeError)
+        for w in words:
+            assert w in str(info.value), str(info.value)
+
+
+def test_the_numpy_api_inside_a_jax_transform_names_the_jax_function():
+    x = jnp.asarray(_paths((5, 2)))
+    for call in (lambda p: rp.signature(p, 2), lambda p: rp.signature_kernel(p, p)):
+        with pytest.raises(TypeError, match="roughpaths.jax function of the same name"):
+            jax.jit(call)(x)

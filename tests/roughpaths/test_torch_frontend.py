@@ -75,8 +75,28 @@ def test_no_grad_and_second_derivative():
     with torch.no_grad():
         assert not rpt.signature(x, 2).requires_grad
     (g,) = torch.autograd.grad(rpt.signature(x, 2).sum(), x, create_graph=True)
-    with pytest.raises(RuntimeError, match="once_differentiable|does not require grad"):
+    with pytest.raises(RuntimeError, match="first derivatives only.*create_graph=True"):
         g.sum().backward()
+
+
+@pytest.mark.parametrize("call", [lambda x: rpt.signature(x, 3), lambda x: rpt.logsignature(x, 3),
+                                  lambda x: rpt.signature_kernel(x, 0.5 * x),
+                                  lambda x: rpt.signature_kernel_gram(x[None], x[None])])
+def test_a_gradient_penalty_is_refused_not_silently_constant(call):
+    # a gradient penalty (WGAN-GP, input-gradient regularisation) differentiates the gradient again; with a
+    # constant cotangent (a fixed linear read-out) the gradient came back as a plain tensor, and the penalty's
+    # dependence on x was silently dropped: loss.backward() ran and gave the gradient of the first term only
+    x = torch.from_numpy(_paths((5, 2), seed=3) * 0.3).requires_grad_()
+    out = call(x)
+    w = torch.from_numpy(np.random.default_rng(4).standard_normal(tuple(out.shape)))   # fixed read-out
+    loss = (out * w).sum()
+    (g,) = torch.autograd.grad(loss, x, create_graph=True)
+    assert g.requires_grad
+    with pytest.raises(RuntimeError, match="first derivatives only"):
+        (loss + (g ** 2).sum()).backward()
+    x.grad = None
+    (g,) = torch.autograd.grad((call(x) * w).sum(), x)          # without create_graph: a plain gradient
+    assert not g.requires_grad and torch.isfinite(g).all()
 
 
 @pytest.mark.parametrize("make, exc, words", [
@@ -148,3 +168,39 @@ def test_backward_leaves_the_cotangent_unchanged(name, depth):
     before = g.clone()
     out.backward(g)
     assert torch.equal(g, before)
+
+
+def test_an_overflowing_signature_is_refused_not_returned_as_inf_or_nan():
+    x = torch.from_numpy(_paths((3, 6, 2), seed=5) * 1e110).requires_grad_()
+    with pytest.raises(ValueError, match="overflows float64.*Rescale the paths"):
+        rpt.signature(x, 3)
+    with pytest.raises(ValueError, match="overflows float64.*Rescale the paths"):
+        rpt.logsignature(x, 3)
+
+
+def test_kernel_batch_axes_that_do_not_broadcast_are_named():
+    x = torch.from_numpy(_paths((3, 5, 2), seed=1))
+    with pytest.raises(ValueError, match=r"batch axes of x \(3,\), y \(2,\) do not broadcast"):
+        rpt.signature_kernel(x, x[:2])
+    with pytest.raises(ValueError, match=r"batch axes of X \(3,\), Y \(2,\) do not broadcast"):
+        rpt.signature_kernel_gram(x[:, None], x[:2, None])
+
+
+@pytest.mark.parametrize("transform", [lambda f: torch.func.vmap(f), lambda f: torch.func.jacrev(f),
+                                       lambda f: torch.func.grad(lambda z: f(z).sum())])
+def test_torch_func_transforms_are_refused_with_the_fix(transform):
+    # torch's own error spoke of a missing setup_context staticmethod, which the caller cannot add
+    x = torch.from_numpy(_paths((4, 6, 2)))
+    with pytest.raises(TypeError, match="torch.func transform.*Batch with leading axes"):
+        transform(lambda z: rpt.signature(z, 2))(x)
+    with pytest.raises(TypeError, match="torch.func transform"):
+        transform(lambda z: rpt.signature_kernel(z, z))(x)
+    assert torch.func.vmap(rpt.lead_lag)(x).shape == (4, 11, 4)      # the transforms are torch operations
+
+
+def test_the_numpy_api_given_a_tensor_in_a_graph_names_the_differentiable_function():
+    # torch's own advice, ".detach().numpy()", would silently drop the gradient the caller is after
+    x = torch.from_numpy(_paths((5, 2))).requires_grad_()
+    for call in (lambda: rp.signature(x, 2), lambda: rp.lead_lag(x)):
+        with pytest.raises(TypeError, match=r"roughpaths.torch function of the same name.*paths.detach\(\).numpy\(\)"):
+            call()

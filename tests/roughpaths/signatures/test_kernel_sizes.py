@@ -55,3 +55,20 @@ def test_kernel_work_is_refused_before_it_starts(monkeypatch):
     x = np.zeros((4, 100, 2))
     with pytest.raises(ValueError, match="signature kernel of 4 pair"):
         rp.signature_kernel(x, x, dyadic_order=3)
+
+
+@pytest.mark.parametrize("call", [
+    lambda X: rp.signature_kernel_gram(X, X),
+    lambda X: rp.signature_kernel(X[:, None], X[None]),                   # the same pairs by broadcasting
+    lambda X: rp.signature_kernel_gram_vjp(X, X, np.ones((X.shape[0], X.shape[0]))),
+])
+def test_many_pairs_of_short_paths_are_checked_before_their_indices_are_built(monkeypatch, call):
+    # 2000 x 2000 pairs of 2-point paths: little PDE work, but every pair holds two indices, their padded
+    # copies and its kernel (~40 bytes, 160 MB here); only the PDE rows were counted (25 KB), so a Gram matrix
+    # of 10^5 short paths (10^10 pairs) went on to allocate its index arrays, hundreds of GB
+    X = np.random.default_rng(0).normal(size=(2000, 2, 1)) * 0.1
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(100 * 2 ** 20))
+    with pytest.raises(ValueError, match=r"4000000 pair\(s\).* would take \d+ MiB.*split the batch"):
+        call(X)
+    monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(2 ** 30))
+    assert call(X[:50])[0].shape[0] == 50

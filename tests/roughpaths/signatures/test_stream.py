@@ -230,3 +230,35 @@ def test_broadcast_queries_are_refused_before_their_allocation(rng, monkeypatch)
     got = stream.signature(s[:3], t[:, :4])                     # a small outer product is answered
     assert got.shape == (3, 4, 6)
     np.testing.assert_allclose(got[1, 3], rp.signature(x[0:4], 2), rtol=1e-12)
+
+
+@pytest.mark.parametrize("call", [
+    lambda x: rp.windowed_signature(x, 3, 16),
+    lambda x: rp.windowed_signature(x, 3, 16, log=True),
+    lambda x: rp.windowed_signature(x, 3, 100, log=True),
+    lambda x: rp.windowed_signature(x, 3, 100, expanding=True),
+    lambda x: rp.SignatureStream(x, 3, block=8).logsignature(np.arange(1000), np.arange(999, 1999)),
+], ids=["sliding", "sliding log", "long sliding log", "expanding", "stream queries log"])
+def test_a_call_the_memory_budget_accepts_stays_within_it(monkeypatch, call):
+    """Under any budget a call is refused or allocates at most the budget (tracemalloc). Only the result was
+    estimated (1.2e7 bytes for the sliding signatures) while the chunks' signatures were joined by a concatenation
+    (twice the result) and the log taken of all of them at once: 4.6 to 6.5 times the estimate was allocated."""
+    import tracemalloc
+
+    x = np.random.default_rng(0).normal(size=(20, 2000, 3)).cumsum(axis=-2) * 0.05
+    call(x[:1])                                           # compiled and cached before measuring
+    accepted = 0
+    for mib in (8, 16, 32, 64, 128, 256):
+        monkeypatch.setenv("ROUGHPATHS_MAX_BYTES", str(mib * 2 ** 20))
+        tracemalloc.start()
+        try:
+            call(x)
+            peak = tracemalloc.get_traced_memory()[1]
+        except ValueError as err:
+            assert "would take" in str(err)
+            continue
+        finally:
+            tracemalloc.stop()
+        accepted += 1
+        assert peak <= mib * 2 ** 20, f"accepted under a budget of {mib} MiB, allocated {peak / 2 ** 20:.1f} MiB"
+    assert accepted, "refused under every budget"

@@ -301,3 +301,33 @@ def test_frontend_times_with_batch_axes_paths_lack_are_refused_naming_times(t_sh
     t2 = np.broadcast_to(np.arange(3.0), (2, 3)).copy()
     np.testing.assert_array_equal(rpt.time_augment(torch.from_numpy(ok), torch.from_numpy(t2)).numpy(),
                                   rp.time_augment(ok, t2))
+
+
+def test_frontend_times_take_and_refuse_what_the_numpy_function_does():
+    """The same ``times`` in the three front ends: integer times are taken (JAX refused them: "pass
+    times.astype(jnp.float32)"), NaN and inf refused as non-finite (torch took inf, called NaN "not increasing"),
+    a string refused naming ``times`` (torch raised its own "new(): invalid data type 'str'")."""
+    torch = pytest.importorskip("torch")
+    pytest.importorskip("jax")
+    import jax.numpy as jnp
+
+    import roughpaths.jax as rpj
+    import roughpaths.torch as rpt
+
+    x = np.arange(10.0).reshape(5, 2)
+    want = rp.time_augment(x, [0, 1, 2, 3, 4])
+    np.testing.assert_array_equal(rpt.time_augment(torch.from_numpy(x), [0, 1, 2, 3, 4]).numpy(), want)
+    np.testing.assert_array_equal(rpt.time_augment(torch.from_numpy(x), torch.arange(5)).numpy(), want)
+    np.testing.assert_array_equal(np.asarray(rpj.time_augment(jnp.asarray(x), np.arange(5))), want.astype(np.float32))
+    for bad in ([0, 1, np.nan, 3, 4], [0, 1, 2, 3, np.inf]):
+        with pytest.raises(ValueError, match="times contains 1 non-finite"):
+            rp.time_augment(x, bad)
+        with pytest.raises(ValueError, match="times contains 1 non-finite"):
+            rpt.time_augment(torch.from_numpy(x), bad)
+        with pytest.raises(ValueError, match="times contains 1 non-finite"):
+            rpt.time_augment(torch.from_numpy(x), torch.tensor(bad))
+    for frontend, arr in ((rpt, torch.from_numpy(x)), (rpj, jnp.asarray(x))):
+        with pytest.raises(TypeError, match="times"):
+            frontend.time_augment(arr, "abc")
+    with pytest.raises(ValueError, match=r"strictly increasing .* at index \(2,\) it goes from 2.0 to 2.0"):
+        rpt.time_augment(torch.from_numpy(x), [0, 1, 2, 2, 4])
