@@ -307,7 +307,10 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     nb, n, d = x.shape
     nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
     part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
-    per_task = (n / nchunks) * d * d
+    # a multiply-add per unit, about 0.1 ns on one core: half the time of a unit of the deeper kernels' estimate, so
+    # the serial threshold is ~0.2 ms here too (16 x 256 paths at d = 16-20, two lane groups: split 1.2-1.4x the
+    # time on one thread in 3 of 4 cells, single calls, load ~1; 64 x 256 at d = 12-20: split 0.70-0.78x)
+    per_task = (n / nchunks) * d * d / 2
     groups = nb // _lanes.LANES if d >= _l2.LANE_WIDTH else 0      # same bits either way
     if groups:
         _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
