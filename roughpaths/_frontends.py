@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["batch_broadcast", "batch_shape", "sum_to", "check_times_batch"]
+__all__ = ["batch_broadcast", "batch_shape", "sum_to", "check_times_batch", "rounded"]
+
+_F32_MAX = float(np.finfo(np.float32).max)
 
 
 def batch_shape(shapes: list, core: tuple, names: tuple) -> tuple:
@@ -57,3 +59,25 @@ def check_times_batch(t_shape: tuple, x_shape: tuple) -> None:
     if not ok:
         raise ValueError(f"times of shape {t_shape} does not broadcast to the points of paths (shape {x_shape}, points "
                          f"{x_shape[:-1]}); pass times of shape (n,) or (..., n) with the batch axes of paths.")
+
+
+def rounded(a, dtype, what: str, names: tuple, fix: str) -> np.ndarray:
+    """The float64 result ``a`` (finite: the numpy API refuses an overflow of float64) as an array of ``dtype``; a
+    float32 one that left float32's range (finite beyond 3.4e38, rounded to inf) is refused with a ``ValueError``
+    naming ``what``, the inputs ``names``, the dtype and the fix (``fix``: how to pass float64 in the framework).
+
+    The check is one float64 sum of the float32 result (inf or NaN if an entry is inf): the size of the result, not
+    of the work that made it.
+    """
+    if np.dtype(dtype) != np.float32:
+        return np.asarray(a, dtype=dtype)
+    with np.errstate(over="ignore", invalid="ignore"):        # an overflow is refused below, with its fix
+        out = np.asarray(a, dtype=np.float32)
+        if not out.size or np.isfinite(np.add.reduce(out, axis=None, dtype=np.float64)):
+            return out
+    top = float(np.max(np.abs(np.asarray(a, dtype=np.float64))))
+    inputs = " and ".join(names)
+    raise ValueError(f"{what} overflows float32, the dtype of {inputs}: it is finite in float64 (values up to "
+                     f"{top:.3g} in absolute value) but float32 holds at most {_F32_MAX:.3g}, so it would be returned "
+                     f"as inf. Rescale {inputs} (e.g. divide the paths by their length or standard deviation: level k "
+                     f"of a signature scales by c**k when the paths do by c), or pass float64 ({fix}).")

@@ -75,7 +75,7 @@ import jax
 import jax.numpy as jnp
 
 import roughpaths as _rp
-from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
+from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, rounded, sum_to
 from roughpaths._xla_ffi import host_handler
 from roughpaths.signatures.kernel import kernel_shape
 from roughpaths.signatures.signature import signature_shape
@@ -195,7 +195,7 @@ def _signature_compiled(params: dict, dtype):
     return chooser("forward"), chooser("backward")
 
 
-def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
+def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple, label: str = "the function"):
     """Build a differentiable, jit- and vmap-able JAX function from a numpy map and its vector–Jacobian product.
 
     Parameters
@@ -211,6 +211,8 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
         The arguments' names, for error messages.
     core : tuple of int
         How many trailing axes of each input are not batch axes; the batch axes broadcast.
+    label : str
+        The function's name in error messages (a float32 result or gradient beyond float32's range is refused).
 
     Returns
     -------
@@ -225,12 +227,13 @@ def differentiable(forward, vjp, out_shape, *, names: tuple, core: tuple):
     >>> jax.grad(lambda a: square(a).sum())(jnp.array([3.0]))
     Array([6.], dtype=float32)
     """
-    return _differentiable(forward, vjp, out_shape, names, core)
+    return _differentiable(forward, vjp, out_shape, names, core, label=label)
 
 
-def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled=None):
+def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled=None, label: str = "the function"):
     """:func:`differentiable`, whose host calls may go to compiled handlers: ``compiled(params, dtype)`` gives the
     choosers (forward, backward) of :func:`_host_call`'s ``compiled``, or ``None``."""
+    fix = f"jax.config.update('jax_enable_x64', True) and {names[0]}.astype(jnp.float64)"
 
     def build(params: dict, dtype, register: bool = True):
         def forward_host(*arrs):
@@ -238,7 +241,7 @@ def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled
                 arrays = (np.asarray(arrs[0], dtype=np.float64),)
             else:
                 arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
-            return (np.asarray(forward(*arrays, **params), dtype=dtype),)
+            return (rounded(forward(*arrays, **params), dtype, f"the result of {label}", names, fix),)
 
         def backward_host(*arrs):
             *arrs, g = arrs
@@ -246,11 +249,12 @@ def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled
             if len(arrs) == 1:
                 a, = arrs
                 grad = vjp(np.asarray(a, dtype=np.float64), g, **params)
-                return (np.asarray(sum_to(np.asarray(grad), a.shape), dtype=dtype),)
+                return (rounded(sum_to(np.asarray(grad), a.shape), dtype, _grad(label, names[0]), names, fix),)
             shapes = [a.shape for a in arrs]        # as received: with vmap's axes in front
             arrays = batch_broadcast([np.asarray(a, dtype=np.float64) for a in arrs], core)
             grads = tuple(vjp(*arrays, g, **params))
-            return tuple(np.asarray(sum_to(np.asarray(gr), s), dtype=dtype) for gr, s in zip(grads, shapes))
+            return tuple(rounded(sum_to(np.asarray(gr), s), dtype, _grad(label, n), names, fix)
+                         for gr, s, n in zip(grads, shapes, names))
 
         hooks = compiled(params, dtype) if compiled is not None and register else None
         forward_call = _host_call(forward_host, register, hooks[0] if hooks else None)
@@ -291,6 +295,10 @@ def _differentiable(forward, vjp, out_shape, names: tuple, core: tuple, compiled
     return apply
 
 
+def _grad(label: str, name: str) -> str:
+    return f"the gradient of {label} with respect to {name}"
+
+
 def _paths_core(cores, name="paths"):
     (n, d), = cores
     if n < 1 or d < 1:
@@ -307,10 +315,10 @@ def _signature_shape(batch: tuple, cores: list, depth, *, log: bool) -> tuple:
 
 _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
                              lambda x, g, depth: _rp.signature_vjp(x, depth, g),
-                             partial(_signature_shape, log=False), ("paths",), (2,), _signature_compiled)
+                             partial(_signature_shape, log=False), ("paths",), (2,), _signature_compiled, "signature")
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
-                               partial(_signature_shape, log=True), names=("paths",), core=(2,))
+                               partial(_signature_shape, log=True), names=("paths",), core=(2,), label="logsignature")
 def _kernel_shape(batch: tuple, cores: list, *, gram: bool, dyadic_order, static_kernel) -> tuple:
     """The kernels' shape, after the numpy API's checks of what is known before tracing (the options, a point and
     a coordinate in each path, the same ``d``): refused with its ``ValueError`` or ``TypeError`` there, not at run
@@ -321,10 +329,10 @@ def _kernel_shape(batch: tuple, cores: list, *, gram: bool, dyadic_order, static
 
 _kernel = differentiable(lambda x, y, **kw: _rp.signature_kernel(x, y, **kw),
                          lambda x, y, g, **kw: _rp.signature_kernel_vjp(x, y, g, **kw),
-                         partial(_kernel_shape, gram=False), names=("x", "y"), core=(2, 2))
+                         partial(_kernel_shape, gram=False), names=("x", "y"), core=(2, 2), label="signature_kernel")
 _gram = differentiable(lambda x, y, **kw: _rp.signature_kernel_gram(x, y, **kw),
                        lambda x, y, g, **kw: _rp.signature_kernel_gram_vjp(x, y, g, **kw),
-                       partial(_kernel_shape, gram=True), names=("X", "Y"), core=(3, 3))
+                       partial(_kernel_shape, gram=True), names=("X", "Y"), core=(3, 3), label="signature_kernel_gram")
 
 
 def signature(paths, depth: int):

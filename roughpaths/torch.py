@@ -68,7 +68,7 @@ from torch._C import _functions as _autograd_functions
 
 import roughpaths as _rp
 from roughpaths.validation import as_float_array
-from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, sum_to
+from roughpaths._frontends import batch_broadcast, batch_shape, check_times_batch, rounded, sum_to
 
 __all__ = ["signature", "logsignature", "signature_kernel", "signature_kernel_gram", "differentiable", "lead_lag",
            "time_augment", "basepoint", "invisibility_reset"]
@@ -106,15 +106,17 @@ def _numpy64(t: torch.Tensor) -> np.ndarray:
     return a if t.dtype == torch.float64 else a.astype(np.float64)
 
 
-def _tensor(a: np.ndarray, dtype) -> torch.Tensor:
-    """A float64 numpy result as a tensor of ``dtype`` (no copy for a float64 result torch can wrap)."""
+def _tensor(a: np.ndarray, dtype, what: str, names: tuple) -> torch.Tensor:
+    """A float64 numpy result as a tensor of ``dtype`` (no copy for a float64 result torch can wrap); a float32 one
+    that overflows float32 is refused naming ``what`` and the inputs ``names`` (:func:`roughpaths._frontends.rounded`)."""
+    if dtype != torch.float64:
+        return torch.from_numpy(rounded(a, np.float32, what, names, f"{names[0]}.double()"))
     if a.dtype != np.float64 or not a.flags.writeable:
         a = np.array(a, dtype=np.float64)
     try:
-        t = torch.from_numpy(a)
+        return torch.from_numpy(a)
     except ValueError:                       # negative strides
-        t = torch.from_numpy(a.copy())
-    return t if dtype == torch.float64 else t.to(dtype)
+        return torch.from_numpy(a.copy())
 
 
 def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
@@ -153,6 +155,19 @@ def differentiable(forward, vjp, *, names: tuple, core: tuple, label: str):
     return _function(forward, vjp, names=names, core=core, label=label, grad_readonly=True)
 
 
+#: The public function of each autograd node of this module, for error messages (others: their label).
+_PUBLIC = {"_Signature": "signature", "_LogSignature": "logsignature", "_SignatureKernel": "signature_kernel",
+           "_SignatureKernelGram": "signature_kernel_gram"}
+
+
+def _result_what(label: str) -> str:
+    return f"the result of {_PUBLIC.get(label, label)}"
+
+
+def _grad_what(label: str, name: str) -> str:
+    return f"the gradient of {_PUBLIC.get(label, label)} with respect to {name}"
+
+
 def _second_derivative_message(label: str) -> str:
     return (f"roughpaths.torch gives first derivatives only: a gradient through <{label}Backward> was taken with "
             f"create_graph=True (a gradient penalty, a Hessian), but its backward pass runs in numpy and is not "
@@ -171,7 +186,7 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         out = forward(*arrays, **params)
         ctx.params, ctx.arrays = params, arrays
         ctx.save_for_backward(*tensors)           # torch's check that no input was modified in place
-        return _tensor(out, tensors[0].dtype)
+        return _tensor(out, tensors[0].dtype, _result_what(label), names)
 
     def _compute_backward(ctx, grad):
         tensors = ctx.saved_tensors               # (raises if an input was modified in place since)
@@ -181,11 +196,12 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         grads = vjp(*ctx.arrays, g if g.dtype == np.float64 else g.astype(np.float64), **ctx.params)
         if len(tensors) == 1:                     # (one input: no generator, no zip)
             t = tensors[0]
-            return None, (_tensor(sum_to(np.asarray(grads), tuple(t.shape)), t.dtype) if ctx.needs_input_grad[1]
-                          else None)
+            return None, (_tensor(sum_to(np.asarray(grads), tuple(t.shape)), t.dtype, _grad_what(label, names[0]),
+                                  names) if ctx.needs_input_grad[1] else None)
         grads = tuple(grads)
-        return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype) if need else None
-                               for gr, t, need in zip(grads, tensors, ctx.needs_input_grad[1:]))
+        return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype, _grad_what(label, n), names)
+                               if need else None
+                               for gr, t, n, need in zip(grads, tensors, names, ctx.needs_input_grad[1:]))
 
     def _backward(ctx, grad):
         if not torch.is_grad_enabled():

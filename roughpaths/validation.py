@@ -88,7 +88,8 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     ----------
     x : array_like
         Real numbers (integer or float; bool arrays count as 0/1, a lone bool is rejected); complex and
-        object arrays are rejected.
+        object arrays are rejected, and so are masked arrays (``numpy.ma``: their mask would be dropped).
+        Other ndarray subclasses are read as their values.
     name : str
         The argument's name, used in error messages.
     min_ndim, ndim : int, optional
@@ -104,6 +105,13 @@ def as_float_array(x, name: str, *, min_ndim: int = 0, ndim: int | None = None,
     if isinstance(x, (bool, np.bool_)):          # a lone True/False is a flag passed in the wrong place
         raise TypeError(f"{name} must be a real number or an array of them, got the bool {x!r}; "
                         f"pass a float.")
+    if isinstance(x, np.ma.MaskedArray):         # np.asarray would drop the mask and use the values under it
+        masked = int(np.count_nonzero(np.ma.getmaskarray(x)))
+        raise TypeError(f"{name} is a numpy masked array with {masked} masked value(s) of {x.size}; the mask would be "
+                        f"dropped and the values under it used. Fill or drop the masked points first: "
+                        f"{name}.filled(value) (or interpolate them), or keep the unmasked points "
+                        f"(for points along axis -2: "
+                        f"{name}.data[~np.ma.getmaskarray({name}).any(axis=-1)]); with nothing masked, pass {name}.data.")
     try:
         arr = np.asarray(x)
     except Exception as exc:  # pragma: no cover - exotic inputs

@@ -21,7 +21,7 @@ from .. import _threads
 from . import _kernels as _k
 from ._lyndon import lyndon_levels
 
-__all__ = ["level_offsets", "log_flat", "lyndon_flat", "lyndon_flat_vjp"]
+__all__ = ["level_offsets", "log_flat", "lyndon_flat", "lyndon_flat_vjp", "product_flat"]
 
 
 @lru_cache(maxsize=512)
@@ -73,3 +73,21 @@ def lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
     for k, (lidx, indptr, indices, data) in enumerate(projections, start=1):
         _k.lyndon_vjp(gc, starts[k - 1], lidx, indptr, indices, data, gz, off[k])
     return gz
+
+
+def product_flat(a: np.ndarray, b: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """Chen product ``(1 + a)(1 + b) - 1`` of float64 ``(..., sigdim)`` batches (broadcast), the arithmetic of
+    :func:`roughpaths.tensor_product` without its input checks and without overflow warnings: an entry that
+    overflows is inf or NaN, for the caller to refuse (checking only what it returns)."""
+    off = level_offsets(dim, depth)
+    batch = np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
+    out = []
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(1, depth + 1):
+            c = np.zeros(batch + (dim ** k,))
+            c += b[..., off[k]:off[k + 1]]
+            c += a[..., off[k]:off[k + 1]]
+            for i in range(1, k):
+                c += (a[..., off[i]:off[i + 1], None] * b[..., None, off[k - i]:off[k - i + 1]]).reshape(c.shape)
+            out.append(c)
+    return np.concatenate(out, axis=-1)

@@ -45,8 +45,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algebra import logsigdim, lyndon_coordinates, sigdim, tensor_log, tensor_product
+from ..algebra import logsigdim, lyndon_coordinates, sigdim, tensor_log
+from ..algebra.flat import product_flat
 from ..validation import as_float_array, check_memory, check_positive_int
+from ._engine import _all_finite, _overflow
 from .signature import signature
 
 __all__ = ["SignatureStream", "windowed_signature"]
@@ -57,6 +59,27 @@ _CHUNK_FLOATS = 1 << 22
 _QUERY_WORK = 8.0
 #: Sliding windows of at most this many steps are signed directly (gathered), longer ones by a stream.
 _DIRECT_WINDOW = 64
+
+
+def _product(a: np.ndarray, b: np.ndarray, dim: int) -> np.ndarray:
+    """Chen product of two batches of signatures of one depth, unchecked: a tree node that overflowed (inf or NaN)
+    reaches the answers of the queries that use it, and the answers are checked (:func:`_refuse_overflow`)."""
+    return product_flat(a, b, dim, _depth(a.shape[-1], dim))
+
+
+def _depth(width: int, dim: int) -> int:
+    depth, size = 0, 0
+    while size < width:
+        depth += 1
+        size += dim ** depth
+    return depth
+
+
+def _refuse_overflow(values: np.ndarray, x: np.ndarray, depth: int, what: str) -> None:
+    """Refuse the answers ``values`` of a chunk of queries on the finite paths ``x`` if one overflowed float64 (a
+    product of the tree's nodes, or its logarithm): a scan of the answers, not of the path."""
+    if not _all_finite(values):
+        _overflow(x, depth, what)
 
 
 class SignatureStream:
@@ -116,7 +139,7 @@ class SignatureStream:
         while level.shape[-2] > 1:
             if level.shape[-2] % 2:                                    # pad with the identity (zeros)
                 level = np.concatenate([level, np.zeros(level.shape[:-2] + (1, self._sigdim))], axis=-2)
-            level = tensor_product(level[..., 0::2, :], level[..., 1::2, :], self.dim)
+            level = _product(level[..., 0::2, :], level[..., 1::2, :], self.dim)
             self._levels.append(level)
 
     def __repr__(self) -> str:
@@ -179,21 +202,21 @@ class SignatureStream:
         for level in self._levels:
             take = np.nonzero((lo < hi) & (lo % 2 == 1))[0]
             if take.size:                                  # left <- left ⊗ node[lo], on those rows only
-                left[..., take, :] = tensor_product(left[..., take, :], level[..., lo[take], :], self.dim)
+                left[..., take, :] = _product(left[..., take, :], level[..., lo[take], :], self.dim)
                 lo[take] += 1
             take = np.nonzero((lo < hi) & (hi % 2 == 1))[0]
             if take.size:                                  # right <- node[hi - 1] ⊗ right
                 hi[take] -= 1
-                right[..., take, :] = tensor_product(level[..., hi[take], :], right[..., take, :], self.dim)
+                right[..., take, :] = _product(level[..., hi[take], :], right[..., take, :], self.dim)
             lo, hi = lo // 2, hi // 2
-        return tensor_product(left, right, self.dim)
+        return _product(left, right, self.dim)
 
     def _answer(self, s: np.ndarray, t: np.ndarray) -> np.ndarray:
         B = self.block
         first = np.minimum(-(-s // B) * B, t)            # first block boundary at or after s (or t)
         last = np.maximum(t // B * B, first)             # last block boundary at or before t (or first)
         middle = self._tree(first // B, last // B)
-        return tensor_product(tensor_product(self._direct(s, first), middle, self.dim),
+        return _product(_product(self._direct(s, first), middle, self.dim),
                               self._direct(last, t), self.dim)
 
     def signature(self, s, t) -> np.ndarray:
@@ -222,7 +245,11 @@ class SignatureStream:
         out = np.empty(self.batch_shape + (s.size, width))
         for lo in range(0, s.size, chunk):
             sig = self._answer(s[lo:lo + chunk], t[lo:lo + chunk])
-            out[..., lo:lo + chunk, :] = lyndon_coordinates(tensor_log(sig, self.dim), self.dim) if log else sig
+            _refuse_overflow(sig, self._x, self.depth, "signature (a SignatureStream query)")
+            if log:                                      # (the log of a finite signature may itself overflow)
+                sig = lyndon_coordinates(tensor_log(sig, self.dim), self.dim)
+                _refuse_overflow(sig, self._x, self.depth, "log-signature (a SignatureStream query)")
+            out[..., lo:lo + chunk, :] = sig
         return out.reshape(self.batch_shape + q + (width,))
 
     def logsignature(self, s, t) -> np.ndarray:
@@ -318,7 +345,10 @@ def windowed_signature(paths, depth: int, length: int, *, step: int = 1, expandi
         out = np.empty(x.shape[:-2] + (k.size, width))
         for lo in range(0, k.size, chunk):
             sig = signature(x[..., s[lo:lo + chunk, None] + np.arange(length + 1), :], depth)
-            out[..., lo:lo + chunk, :] = lyndon_coordinates(tensor_log(sig, d), d) if log else sig
+            if log:                                      # (signature refused an overflow; its log may overflow)
+                sig = lyndon_coordinates(tensor_log(sig, d), d)
+                _refuse_overflow(sig, x, depth, "log-signature (a window)")
+            out[..., lo:lo + chunk, :] = sig
         return out
     stream = SignatureStream(x, depth)
     return stream.logsignature(s, t) if log else stream.signature(s, t)

@@ -12,8 +12,8 @@ one-unit kernels on XLA's buffers:
   ``d <= 7``, ``n >= 2`` points, a path short enough to be one work unit, and at most :func:`plan`'s
   ``most`` paths (2 at d <= 3, where the engine runs lanes from 3 paths on), float32 or float64
   buffers. Every other call, and every call whose values the numpy API refuses (a NaN or inf point
-  or cotangent, a signature or gradient that overflows), goes to the Python handler of the same call (called through its address), so that
-  errors keep the numpy API's messages.
+  or cotangent, a signature or gradient that overflows, or that a float32 buffer cannot hold), goes to the
+  Python handler of the same call (called through its address), so that errors keep the numpy API's messages.
 * **The same numbers**: the numpy API's steps in its order: one unit a path, the kernel variant the
   engine picks for ``(n, d, depth)`` (the very compiled function: its address), the time reversal of a
   path smaller than its signature, the permutations between the row-major and the kernels' reversed
@@ -216,13 +216,17 @@ def _load_cotangent(b, g, off, d, m):
 
 
 @njit(**_JIT)
-def _finite(a):
-    """Whether the float64 array ``a`` is all finite (a signature or cotangent that overflowed is not: such calls go
-    to the Python handler, whose numpy API refuses them with its message)."""
-    finite = True
+def _fits(a, b, share):
+    """Whether every entry of the float64 array ``a`` is at most ``share`` times the largest finite value of the
+    buffer at ``b``'s dtype in absolute value (NaN is not). A signature or cotangent that overflowed float64, or that
+    float32 cannot hold (it would be stored as inf), does not fit: such calls go to the Python handler, whose numpy
+    API and front end refuse them with their messages. ``share = 0.5`` for the points' cotangent, stored as the
+    difference of two entries."""
+    top = share * (1.7976931348623157e308 if i32(b + 16) == F64 else 3.4028234663852886e38)
+    fits = True
     for v in a.ravel():
-        finite &= v - v == 0.0
-    return finite
+        fits &= abs(v) <= top
+    return fits
 
 
 @njit(**_JIT)
@@ -325,7 +329,7 @@ def _forward(frame_pointer):
     x = np.empty((nb, n, d))
     part = np.empty((nb, off[m + 1]))
     if not _load_paths(xb, x, flipped) or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
-            or not _finite(part):
+            or not _fits(part, ob, 1.0):
         return voidptr(call(i64(p), frame))
     _store_signature(ob, part, flipped, off, d, m)
     _count(p, 0)
@@ -350,7 +354,7 @@ def _backward(frame_pointer):
     gd = np.zeros((nb, n - 1, d))
     if not _load_paths(xb, x, False) or not _load_cotangent(gb, g, off, d, m) \
             or _block_units(i64(p + 8 * _BLOCK), x, ub, ulo, uhi, m, off, 0, nb, part) \
-            or _vjp_units(vjp, x, ub, ulo, uhi, m, off, part, g, 0, nb, gd) or not _finite(gd):
+            or _vjp_units(vjp, x, ub, ulo, uhi, m, off, part, g, 0, nb, gd) or not _fits(gd, ob, 0.5):
         return voidptr(call(i64(p), frame))
     _store_points(ob, gd)
     _count(p, 1)

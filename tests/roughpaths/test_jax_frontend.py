@@ -394,3 +394,21 @@ def test_the_numpy_api_inside_a_jax_transform_names_the_jax_function():
     for call in (lambda p: rp.signature(p, 2), lambda p: rp.signature_kernel(p, p)):
         with pytest.raises(TypeError, match="roughpaths.jax function of the same name"):
             jax.jit(call)(x)
+
+
+@pytest.mark.parametrize("name", ["signature", "logsignature"])
+@pytest.mark.parametrize("jit", [False, True])
+def test_a_float32_result_or_gradient_beyond_float32s_range_is_refused(name, jit):
+    """Computed in float64 (finite) and rounded to float32, a result or gradient beyond 3.4e38 came back as inf
+    (from the host call and from the compiled handlers alike)."""
+    f = getattr(rpj, name)
+    wrap = jax.jit if jit else (lambda g: g)
+    x = jnp.asarray(_paths((2, 6, 2), seed=25) * 1e14, dtype=jnp.float32)
+    with pytest.raises(Exception, match=rf"result of {name} overflows float32.*Rescale paths.*jax_enable_x64"):
+        jax.block_until_ready(wrap(lambda p: f(p, 3))(x))
+    assert np.all(np.isfinite(np.asarray(f(x / 1e14, 3))))
+    x = jnp.asarray(_paths((2, 6, 2), seed=25) * 1e10, dtype=jnp.float32)
+    assert np.all(np.isfinite(np.asarray(f(x, 3))))
+    G = jnp.full(f(x, 3).shape, 1e20, dtype=jnp.float32)
+    with pytest.raises(Exception, match=rf"gradient of {name} with respect to paths overflows float32"):
+        jax.block_until_ready(wrap(jax.grad(lambda p: jnp.sum(f(p, 3) * G)))(x))

@@ -204,3 +204,32 @@ def test_the_numpy_api_given_a_tensor_in_a_graph_names_the_differentiable_functi
     for call in (lambda: rp.signature(x, 2), lambda: rp.lead_lag(x)):
         with pytest.raises(TypeError, match=r"roughpaths.torch function of the same name.*paths.detach\(\).numpy\(\)"):
             call()
+
+
+@pytest.mark.parametrize("name", ["signature", "logsignature"])
+def test_a_float32_result_beyond_float32s_range_is_refused_not_returned_as_inf(name):
+    # computed in float64 (finite, ~1e42) and rounded to float32: it came back as inf without an error
+    f = getattr(rpt, name)
+    x = torch.tensor(_paths((2, 6, 2), seed=6) * 1e14, dtype=torch.float32, requires_grad=True)
+    with pytest.raises(ValueError, match=rf"result of {name} overflows float32.*Rescale paths.*paths\.double\(\)"):
+        f(x, 3)
+    assert torch.isfinite(f(x.double(), 3)).all()                   # float64 holds it
+    assert torch.isfinite(f(x / 1e14, 3)).all()
+
+
+def test_a_float32_gradient_beyond_float32s_range_is_refused_not_returned_as_inf():
+    x = torch.tensor(_paths((2, 6, 2), seed=6) * 1e10, dtype=torch.float32, requires_grad=True)
+    s = rpt.signature(x, 3)
+    assert torch.isfinite(s).all()
+    with pytest.raises(ValueError, match=r"gradient of signature with respect to paths overflows float32.*double"):
+        s.backward(torch.full_like(s, 1e20))
+    x64 = x.detach().double().requires_grad_()
+    s64 = rpt.signature(x64, 3)
+    s64.backward(torch.full_like(s64, 1e20))
+    assert torch.isfinite(x64.grad).all() and x64.grad.abs().max() > 3.5e38
+
+
+def test_a_float32_kernel_beyond_float32s_range_is_refused():
+    x = torch.tensor(_paths((4, 2), seed=7) * 1e3, dtype=torch.float32)
+    with pytest.raises(ValueError, match=r"result of signature_kernel overflows float32.*x and y"):
+        rpt.signature_kernel(x, x)

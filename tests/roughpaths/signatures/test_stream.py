@@ -262,3 +262,36 @@ def test_a_call_the_memory_budget_accepts_stays_within_it(monkeypatch, call):
         accepted += 1
         assert peak <= mib * 2 ** 20, f"accepted under a budget of {mib} MiB, allocated {peak / 2 ** 20:.1f} MiB"
     assert accepted, "refused under every budget"
+
+
+def _two_ramps(first: float, second: float) -> np.ndarray:
+    """A 41-point path in d = 1 rising by ``first`` over points 0..32 and by ``second`` over 32..40."""
+    return np.concatenate([np.linspace(0.0, first, 33), first + np.linspace(0.0, second, 9)[1:]])[:, None]
+
+
+@pytest.mark.parametrize("log", [False, True])
+def test_a_query_whose_tree_product_overflows_is_refused_with_the_fix(log):
+    # the block [0, 32] and the partial block [32, 40] have finite signatures (level 2 ~ 1.1e308 each), their Chen
+    # product does not (~4.5e308): the query returned inf (its log-signature nan) without an error
+    x = _two_ramps(1.5e154, 1.5e154)
+    stream = rp.SignatureStream(x, 2, block=32)
+    query = stream.logsignature if log else stream.signature
+    assert np.all(np.isfinite(query([0, 32], [32, 40])))            # each piece alone is representable
+    with pytest.raises(ValueError, match=r"depth-2 (log-)?signature \(a SignatureStream query\).*overflows "
+                                         r"float64.*Rescale the paths"):
+        query(0, 40)
+    with pytest.raises(ValueError, match=r"overflows float64.*Rescale the paths"):
+        rp.windowed_signature(x, 2, 8, step=32, expanding=True, log=log)   # windows [0, 8], [0, 40]
+    y = _two_ramps(1.5e153, 1.5e153)                                 # rescaled: answered, equal to the direct one
+    np.testing.assert_allclose(rp.SignatureStream(y, 2, block=32).signature(0, 40), rp.signature(y, 2), rtol=1e-13)
+
+
+def test_a_query_through_an_overflowed_tree_node_is_refused_naming_the_paths():
+    # a node of the tree (the product of two blocks) overflowed: the next product refused it as "b contains non-finite
+    # values ... remove or interpolate them", an input the caller never passed
+    x = np.cumsum(np.ones((1000, 2)), axis=0) * 3e151
+    stream = rp.SignatureStream(x, 2, block=32)
+    assert np.all(np.isfinite(stream.signature(0, 31)))
+    with pytest.raises(ValueError, match=r"depth-2 signature \(a SignatureStream query\) of paths \(finite, values "
+                                         r"up to 3e\+154.*Rescale the paths"):
+        stream.signature(0, 999)
