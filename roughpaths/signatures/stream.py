@@ -61,18 +61,10 @@ _QUERY_WORK = 8.0
 _DIRECT_WINDOW = 64
 
 
-def _product(a: np.ndarray, b: np.ndarray, dim: int) -> np.ndarray:
+def _product(a: np.ndarray, b: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Chen product of two batches of signatures of one depth, unchecked: a tree node that overflowed (inf or NaN)
     reaches the answers of the queries that use it, and the answers are checked (:func:`_refuse_overflow`)."""
-    return product_flat(a, b, dim, _depth(a.shape[-1], dim))
-
-
-def _depth(width: int, dim: int) -> int:
-    depth, size = 0, 0
-    while size < width:
-        depth += 1
-        size += dim ** depth
-    return depth
+    return product_flat(a, b, dim, depth)
 
 
 def _refuse_overflow(values: np.ndarray, x: np.ndarray, depth: int, what: str) -> None:
@@ -139,7 +131,7 @@ class SignatureStream:
         while level.shape[-2] > 1:
             if level.shape[-2] % 2:                                    # pad with the identity (zeros)
                 level = np.concatenate([level, np.zeros(level.shape[:-2] + (1, self._sigdim))], axis=-2)
-            level = _product(level[..., 0::2, :], level[..., 1::2, :], self.dim)
+            level = _product(level[..., 0::2, :], level[..., 1::2, :], self.dim, self.depth)
             self._levels.append(level)
 
     def __repr__(self) -> str:
@@ -202,22 +194,22 @@ class SignatureStream:
         for level in self._levels:
             take = np.nonzero((lo < hi) & (lo % 2 == 1))[0]
             if take.size:                                  # left <- left ⊗ node[lo], on those rows only
-                left[..., take, :] = _product(left[..., take, :], level[..., lo[take], :], self.dim)
+                left[..., take, :] = _product(left[..., take, :], level[..., lo[take], :], self.dim, self.depth)
                 lo[take] += 1
             take = np.nonzero((lo < hi) & (hi % 2 == 1))[0]
             if take.size:                                  # right <- node[hi - 1] ⊗ right
                 hi[take] -= 1
-                right[..., take, :] = _product(level[..., hi[take], :], right[..., take, :], self.dim)
+                right[..., take, :] = _product(level[..., hi[take], :], right[..., take, :], self.dim, self.depth)
             lo, hi = lo // 2, hi // 2
-        return _product(left, right, self.dim)
+        return _product(left, right, self.dim, self.depth)
 
     def _answer(self, s: np.ndarray, t: np.ndarray) -> np.ndarray:
         B = self.block
         first = np.minimum(-(-s // B) * B, t)            # first block boundary at or after s (or t)
         last = np.maximum(t // B * B, first)             # last block boundary at or before t (or first)
         middle = self._tree(first // B, last // B)
-        return _product(_product(self._direct(s, first), middle, self.dim),
-                              self._direct(last, t), self.dim)
+        return _product(_product(self._direct(s, first), middle, self.dim, self.depth),
+                        self._direct(last, t), self.dim, self.depth)
 
     def signature(self, s, t) -> np.ndarray:
         r"""The signature :math:`S(X)_{s,t}` of the path between grid points ``s`` and ``t``.
