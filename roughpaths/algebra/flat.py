@@ -76,18 +76,17 @@ def lyndon_flat_vjp(gc: np.ndarray, dim: int, depth: int) -> np.ndarray:
 
 
 def product_flat(a: np.ndarray, b: np.ndarray, dim: int, depth: int) -> np.ndarray:
-    """Chen product ``(1 + a)(1 + b) - 1`` of float64 ``(..., sigdim)`` batches (broadcast), the arithmetic of
-    :func:`roughpaths.tensor_product` without its input checks and without overflow warnings: an entry that
-    overflows is inf or NaN, for the caller to refuse (checking only what it returns)."""
+    """Chen product ``(1 + a)(1 + b) - 1`` of float64 ``(..., sigdim)`` batches (broadcast), unchecked: the arithmetic
+    of :func:`roughpaths.tensor_product` (which checks its inputs and calls this). Level ``k`` is
+    ``b_k + a_k + sum_{0<i<k} a_i (x) b_{k-i}``, added in that order."""
     off = level_offsets(dim, depth)
     batch = np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
     out = []
-    with np.errstate(over="ignore", invalid="ignore"):
-        for k in range(1, depth + 1):
-            c = np.zeros(batch + (dim ** k,))
-            c += b[..., off[k]:off[k + 1]]
-            c += a[..., off[k]:off[k + 1]]
-            for i in range(1, k):
-                c += (a[..., off[i]:off[i + 1], None] * b[..., None, off[k - i]:off[k - i + 1]]).reshape(c.shape)
-            out.append(c)
+    for k in range(1, depth + 1):
+        c = np.zeros(batch + (dim ** k,))
+        c += b[..., off[k]:off[k + 1]]
+        c += a[..., off[k]:off[k + 1]]
+        for i in range(1, k):
+            c += (a[..., off[i]:off[i + 1], None] * b[..., None, off[k - i]:off[k - i + 1]]).reshape(c.shape)
+        out.append(c)
     return np.concatenate(out, axis=-1)

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .flat import log_flat, lyndon_flat
+from .flat import log_flat, lyndon_flat, product_flat
 from ._lyndon import (bracket_string, count_lyndon_words, expansion_matrix,
                       lyndon_words)
 from ..validation import as_float_array, check_memory, check_positive_int, check_same_batch
@@ -138,16 +138,12 @@ def _join(levels: list) -> np.ndarray:
     return np.concatenate(levels, axis=-1)
 
 
-def _mul(A: list, B: list, a0: float, b0: float, depth: int) -> list:
-    """Truncated product of ``a0 + A`` and ``b0 + B`` (level lists), dropping the scalar of the result."""
+def _mul(A: list, B: list, depth: int) -> list:
+    """Truncated product of ``A`` and ``B`` (level lists without scalar parts)."""
     batch = np.broadcast_shapes(A[0].shape[:-1], B[0].shape[:-1])
     out = []
     for k in range(1, depth + 1):
         c = np.zeros(batch + (A[k - 1].shape[-1],))
-        if a0:
-            c += a0 * B[k - 1]
-        if b0:
-            c += b0 * A[k - 1]
         for i in range(1, k):
             c += (A[i - 1][..., :, None] * B[k - i - 1][..., None, :]).reshape(c.shape)   # not -1: batch may be empty
         out.append(c)
@@ -159,7 +155,7 @@ def _power_series(Z: list, coeffs: list, depth: int) -> list:
     total = [coeffs[1] * z for z in Z]
     power = Z
     for n in range(2, depth + 1):
-        power = _mul(power, Z, 0.0, 0.0, depth)
+        power = _mul(power, Z, depth)
         if coeffs[n]:
             total = [t + coeffs[n] * p for t, p in zip(total, power)]
     return total
@@ -195,7 +191,7 @@ def tensor_product(a, b, dim: int) -> np.ndarray:
         raise ValueError(f"a and b must have the same depth: last axes {a.shape[-1]} and {b.shape[-1]} "
                          f"differ; truncate the deeper one (e.g. b[..., :{a.shape[-1]}]).")
     check_same_batch(a.shape[:-1], b.shape[:-1], "a", "b")
-    return _join(_mul(_split(a, dim, depth), _split(b, dim, depth), 1.0, 1.0, depth))
+    return product_flat(a, b, dim, depth)
 
 
 def tensor_inverse(a, dim: int) -> np.ndarray:

@@ -64,7 +64,8 @@ _DIRECT_WINDOW = 64
 def _product(a: np.ndarray, b: np.ndarray, dim: int, depth: int) -> np.ndarray:
     """Chen product of two batches of signatures of one depth, unchecked: a tree node that overflowed (inf or NaN)
     reaches the answers of the queries that use it, and the answers are checked (:func:`_refuse_overflow`)."""
-    return product_flat(a, b, dim, depth)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return product_flat(a, b, dim, depth)
 
 
 def _refuse_overflow(values: np.ndarray, x: np.ndarray, depth: int, what: str) -> None:
