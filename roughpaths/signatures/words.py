@@ -139,8 +139,8 @@ def signature_coefficients(paths, words) -> np.ndarray:
     # the coefficients and their finiteness mask; a C-contiguous copy of paths that are not (a strided view); the
     # words' letters with three temporaries of their lengths, and 64 KiB for the call's own bookkeeping
     copy = 0.0 if x.flags.c_contiguous else 8.0 * float(x.size)
-    check_memory(n_paths * n_words * 9.0 + copy + 8.0 * letters.size + 32.0 * n_words + 65536.0, f"the coefficients ({batch} paths x {n_words} words)"
-                 + (" and a contiguous copy of the paths" if copy else ""),
+    what = f"the coefficients ({batch} paths x {n_words} words)" + (" and a copy of the paths" if copy else "")
+    check_memory(n_paths * n_words * 9.0 + copy + 8.0 * letters.size + 32.0 * n_words + 65536.0, what,
                  "ask for fewer words or paths at a time" + (" (or pass C-contiguous paths)" if copy else ""))
     # a word of length k costs k (k + 1) / 2 multiply-adds a step (the Horner recursion), not k: counting
     # the total length let one long word (k = 10^4 on 10^5 points) pass as 10^9 units and run for hours
