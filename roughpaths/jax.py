@@ -319,6 +319,8 @@ _signature = _differentiable(lambda x, depth: _rp.signature(x, depth),
 _logsignature = differentiable(lambda x, depth: _rp.logsignature(x, depth),
                                lambda x, g, depth: _rp.logsignature_vjp(x, depth, g),
                                partial(_signature_shape, log=True), names=("paths",), core=(2,), label="logsignature")
+
+
 def _kernel_shape(batch: tuple, cores: list, *, gram: bool, dyadic_order, static_kernel) -> tuple:
     """The kernels' shape, after the numpy API's checks of what is known before tracing (the options, a point and
     a coordinate in each path, the same ``d``): refused with its ``ValueError`` or ``TypeError`` there, not at run
