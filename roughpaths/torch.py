@@ -106,10 +106,12 @@ def _numpy64(t: torch.Tensor) -> np.ndarray:
     return a if t.dtype == torch.float64 else a.astype(np.float64)
 
 
-def _tensor(a: np.ndarray, dtype, what: str, names: tuple) -> torch.Tensor:
+def _tensor(a: np.ndarray, dtype, label: str, names: tuple, wrt: str | None = None) -> torch.Tensor:
     """A float64 numpy result as a tensor of ``dtype`` (no copy for a float64 result torch can wrap); a float32 one
-    that overflows float32 is refused naming ``what`` and the inputs ``names`` (:func:`roughpaths._frontends.rounded`)."""
+    that overflows float32 is refused (:func:`roughpaths._frontends.rounded`) naming the result of ``label`` (its
+    gradient with respect to ``wrt``) and the inputs ``names``; the message is built only then."""
     if dtype != torch.float64:
+        what = _grad_what(label, wrt) if wrt is not None else _result_what(label)
         return torch.from_numpy(rounded(a, np.float32, what, names, f"{names[0]}.double()"))
     if a.dtype != np.float64 or not a.flags.writeable:
         a = np.array(a, dtype=np.float64)
@@ -186,7 +188,7 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         out = forward(*arrays, **params)
         ctx.params, ctx.arrays = params, arrays
         ctx.save_for_backward(*tensors)           # torch's check that no input was modified in place
-        return _tensor(out, tensors[0].dtype, _result_what(label), names)
+        return _tensor(out, tensors[0].dtype, label, names)
 
     def _compute_backward(ctx, grad):
         tensors = ctx.saved_tensors               # (raises if an input was modified in place since)
@@ -196,10 +198,10 @@ def _function(forward, vjp, *, names: tuple, core: tuple, label: str, grad_reado
         grads = vjp(*ctx.arrays, g if g.dtype == np.float64 else g.astype(np.float64), **ctx.params)
         if len(tensors) == 1:                     # (one input: no generator, no zip)
             t = tensors[0]
-            return None, (_tensor(sum_to(np.asarray(grads), tuple(t.shape)), t.dtype, _grad_what(label, names[0]),
-                                  names) if ctx.needs_input_grad[1] else None)
+            return None, (_tensor(sum_to(np.asarray(grads), tuple(t.shape)), t.dtype, label, names, names[0])
+                          if ctx.needs_input_grad[1] else None)
         grads = tuple(grads)
-        return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype, _grad_what(label, n), names)
+        return (None,) + tuple(_tensor(sum_to(np.asarray(gr), tuple(t.shape)), t.dtype, label, names, n)
                                if need else None
                                for gr, t, n, need in zip(grads, tensors, names, ctx.needs_input_grad[1:]))
 
