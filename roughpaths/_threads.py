@@ -100,8 +100,11 @@ class _Job:
         self.work()
 
     def wait(self) -> None:
+        """Return when every range is done, and let go of ``fn`` (and the arrays its closure holds): a worker may
+        still hold the job object (a late helper finds no range left)."""
         if not self.done.is_set() and not (LINGER and _watch(self.flag, 0, LINGER)):
             self.done.wait()
+        self.parts, self.fn = (), None
 
 
 class _Workers:
@@ -143,6 +146,7 @@ class _Workers:
             job = self.job
             if job is not None:
                 job.help()
+            job = None                     # not kept while watching or asleep (wait() frees the job's own arrays)
 
 
 _WORKERS = _Workers()
@@ -192,6 +196,8 @@ def run(fn, parts: list, *, merge: bool = False) -> None:
     _WORKERS.post(job, threads - 1)
     job.work()
     job.wait()
+    if _WORKERS.job is job:                 # not offered (nor kept) after it is done
+        _WORKERS.job = None
     if job.errors:
         raise job.errors[0]
 

@@ -192,3 +192,27 @@ def test_a_sleeping_worker_is_woken_and_an_awake_one_helps():
         time.sleep(pause)
         parallel_ranges(fn, 2, 1)
         assert who[0] != who[1], f"no worker took range 1 after a pause of {pause} s"
+
+
+def test_a_finished_job_keeps_nothing_alive():
+    """The arrays a job's function holds are freed when the call returns (the workers keep no finished job): a
+    signature's scratch of hundreds of MB must not live on until the next parallel call."""
+    import gc
+    import weakref
+
+    if numba.get_num_threads() < 2:
+        pytest.skip("one thread: no workers")
+
+    class Big:
+        pass
+
+    big = Big()
+    ref = weakref.ref(big)
+
+    def fn(lo, hi, big=big):
+        assert big is not None
+
+    parallel_ranges(fn, 8, 1)
+    del fn, big
+    gc.collect()
+    assert ref() is None
