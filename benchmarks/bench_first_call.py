@@ -44,7 +44,7 @@ FAMILIES = {
     # one short path: the compiled XLA handlers of roughpaths.jax (roughpaths.signatures.xla_handlers) take it
     "jax step, one path (depth 3)": ("sig jax", "jax.grad(lambda a: rj.signature(a, 3).sum())(x[0, :8])"),
     "signature_coefficients (words)": ("sig", "rp.signature_coefficients(x, [(0, 1), (2, 0, 1), (1, 1, 2, 0)])"),
-    # the first job split over threads: the workers' watch loop (roughpaths._threads._watch) compiles
+    # the first job split over threads: the workers' idle and watch loops (roughpaths._threads._idle, _watch, _open) compile
     "parallel_ranges (work sharing)": ("", "from roughpaths.validation import parallel_ranges\n"
                                            "parallel_ranges(lambda lo, hi: None, 2, 1)"),
     "signature kernel + gram": ("sig", "rp.signature_kernel(x[:4], x[4:8]); "

@@ -9,12 +9,20 @@ at worst waits for one range that a descheduled thread had started. Small jobs r
 thread only (no thread hand-off at all).
 
 Hand-off. A worker that finishes a job watches for the next one for a short while (:data:`LINGER`
-rounds of ``sched_yield``, about 0.1 ms here) before it sleeps on a condition, and the caller watches
-for its workers' last ranges in the same way before it sleeps: waking a sleeping thread cost 35-170 us
-on this 2-core machine (a virtual CPU wakes from idle), against 5-26 us for a watching one, and a split
-job of 0.24 ms paid it twice. Calls in quick succession (a training loop, a benchmark, an adaptive
-solve's walks) find their workers awake; a lone call pays the wake-up once, as before. Watching costs
-CPU time only, never results, and yields the core to any other runnable thread.
+rounds of ``sched_yield``, about 0.1 ms here) before it sleeps, and the caller watches for its workers'
+last ranges in the same way before it sleeps: waking a sleeping thread cost 35-170 us on this 2-core
+machine (a virtual CPU wakes from idle), against 5-26 us for a watching one. A worker idles without the GIL
+(:func:`_idle`: it watches, then sleeps on Linux's futex; elsewhere on a condition), and asks for the GIL
+only for a job still open to it (from the caller's first range until its last range is taken) and only
+after the caller is likely to have let go of it (:data:`SETTLE`): a thread that asks for a GIL held by
+another sleeps until it is released, and pays the wake-up again. So a worker woken too late for its job
+does not take the GIL from the caller, and one that finished the job's last range tells the caller once it
+has let go of the GIL. Calls in quick succession (a training loop, a benchmark, an adaptive solve's walks)
+find their workers awake; a lone call pays the wake-up once. Watching costs CPU time only, never results,
+and yields the core to any other runnable thread. Measured (a compiled kernel over two ranges, a 1 ms pause
+and an untimed call before each timed one, medians of 61, three interleaved processes each): 2 x 25 us
+took 55 us split (63-75 before the GIL-free idling; 50 serial), 2 x 50 us 72-109 (110-137; 100), 2 x 100
+us 121-144 (143-148; 200).
 
 The split into ranges never changes a result: every item is computed by the same code whatever
 thread runs it. The number of threads is numba's (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``).
@@ -24,6 +32,8 @@ from __future__ import annotations
 
 import itertools
 import os
+import platform
+import sys
 import threading
 
 import numba
@@ -40,8 +50,24 @@ RANGE_WORK = 1 << 17
 #: Rounds of ``sched_yield`` (0.2-0.4 us each here) a thread watches for a job or its end before it sleeps;
 #: 0 where the C library has no ``sched_yield`` (watching then never compiles).
 LINGER = 500 if hasattr(os, "sched_yield") else 0
+#: Rounds a worker still waits after it saw a job open, before it asks for the GIL: the caller opens the job right
+#: before its own first range and holds the GIL until that range's kernel starts (1-3 us); a worker asking for the
+#: GIL before that sleeps until the caller lets go of it, and waking it costs 10-50 us here.
+SETTLE = 8
+#: Linux's ``futex`` system call (its number; -1 elsewhere): idle workers sleep on the open job's word and are woken
+#: without the GIL, so a worker woken late (after the job it was woken for was done) keeps watching for the next one
+#: instead of waiting for the GIL. Elsewhere they sleep on a condition.
+_FUTEX = ({"x86_64": 202, "aarch64": 98}.get(platform.machine(), -1)
+          if LINGER and sys.platform.startswith("linux") and sys.byteorder == "little" else -1)
+_FUTEX_WAIT, _FUTEX_WAKE = 128, 129            # FUTEX_WAIT_PRIVATE, FUTEX_WAKE_PRIVATE
 
 _sched_yield = types.ExternalFunction("sched_yield", types.int32())
+_syscall = types.ExternalFunction("syscall", types.int64(types.int64, types.uintp, types.int64, types.int64,
+                                                         types.uintp))
+
+
+def _int64_array(a) -> bool:
+    return isinstance(a, types.Array) and a.dtype == types.int64
 
 
 @intrinsic
@@ -49,7 +75,7 @@ def _read_acquire(typingctx, flag):
     """``flag[0]`` of an int64 array, read with acquire ordering. Another thread stores there while this one reads:
     for a plain load that race is undefined, and a compiler may hoist the load out of a loop (only the opaque C call
     in :func:`_watch`'s loop keeps it there); an atomic read is never hoisted or merged."""
-    if not (isinstance(flag, types.Array) and flag.dtype == types.int64):
+    if not _int64_array(flag):
         return None
 
     def codegen(context, builder, signature, args):
@@ -58,11 +84,36 @@ def _read_acquire(typingctx, flag):
     return types.int64(flag), codegen
 
 
+@intrinsic
+def _exchange(typingctx, flag, value):
+    """``flag[0] = value`` as an atomic exchange (a full barrier: later reads are not moved before it); the old value."""
+    if not (_int64_array(flag) and isinstance(value, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        v = context.cast(builder, args[1], signature.args[1], types.int64)
+        return builder.atomic_rmw("xchg", data, v, "seq_cst")
+    return types.int64(flag, value), codegen
+
+
+@intrinsic
+def _add(typingctx, flag, value):
+    """``flag[0] += value`` atomically (a full barrier); the old value."""
+    if not (_int64_array(flag) and isinstance(value, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        v = context.cast(builder, args[1], signature.args[1], types.int64)
+        return builder.atomic_rmw("add", data, v, "seq_cst")
+    return types.int64(flag, value), codegen
+
+
 @numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _watch(flag, value, rounds):
     """Whether ``flag[0]`` leaves ``value`` within ``rounds`` rounds of ``sched_yield``, without the GIL.
-    Compile: 0.1 s cold, on the first call split over threads, cached (``bench_first_call.py``, "parallel_ranges
-    (work sharing)": 0.9 s cold with the import, 0.55 s warm)."""
+    Compiled with :func:`_idle` (its cost there)."""
     for _ in range(rounds):
         if _read_acquire(flag) != value:
             return True
@@ -70,18 +121,62 @@ def _watch(flag, value, rounds):
     return _read_acquire(flag) != value
 
 
-class _Job:
-    """One call of :func:`run`: its ranges, taken in turn by the caller and by at most ``helpers`` workers."""
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
+def _idle(opened, sleepers, last, rounds, settle, signal, futex):
+    """A worker between jobs, without the GIL: raise ``signal[0]`` (the flag of the job it just finished, if any: its
+    caller watching the flag then finds the GIL free), then return the number of the next job opened
+    (``opened[0]`` not 0 nor ``last``) after watching ``rounds`` rounds of ``sched_yield`` and then sleeping on
+    Linux's futex until woken; with ``futex < 0``, 0 after the watch (the worker then sleeps on a condition).
+    Compile: with :func:`_open` and :func:`_watch`, 0.5 s cold on the first call split over threads (0.3 s for
+    :func:`_watch` alone before), cached (``bench_first_call.py``, "parallel_ranges (work sharing)")."""
+    if signal.shape[0]:
+        _exchange(signal, 1)
+    while True:
+        for _ in range(rounds):
+            v = _read_acquire(opened)
+            if v != 0 and v != last:
+                for _ in range(settle):
+                    _sched_yield()
+                return v
+            _sched_yield()
+        if futex < 0:
+            return 0
+        _add(sleepers, 1)
+        v = _read_acquire(opened)              # after the count: an opener that did not see it stored first
+        if v == 0 or v == last:
+            _syscall(futex, opened.ctypes.data, _FUTEX_WAIT, v & 0xFFFFFFFF, 0)
+        _add(sleepers, -1)
 
-    def __init__(self, fn, parts, helpers):
-        self.fn, self.parts, self.helpers = fn, parts, helpers
+
+@numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
+def _open(opened, sleepers, job, futex):
+    """Open job number ``job`` to the workers, and wake those asleep on the futex (the library's flags: it lets go of
+    the GIL for its fraction of a microsecond, a watching worker waits :data:`SETTLE` rounds before it asks)."""
+    _exchange(opened, job)
+    if futex >= 0 and _read_acquire(sleepers) > 0:
+        _syscall(futex, opened.ctypes.data, _FUTEX_WAKE, 0x7FFFFFFF, 0)
+
+
+class _Job:
+    """One call of :func:`run`: its ranges, taken in turn by the caller and by at most ``helpers`` workers. The job
+    is open to the workers from the caller's first range until its last range is taken."""
+
+    def __init__(self, fn, parts, helpers, workers, number):
+        self.fn, self.parts, self.helpers, self.workers, self.number = fn, parts, helpers, workers, number
         self.next, self.left = itertools.count(), len(parts)
-        self.lock, self.done, self.flag = threading.Lock(), threading.Event(), np.zeros(1, dtype=np.int64)
+        self.lock, self.flag = threading.Lock(), np.zeros(1, dtype=np.int64)
+        self.done = None                   # an Event, made only when the caller sleeps (making one costs ~3 us)
         self.errors: list = []
 
-    def work(self) -> None:
-        """Run ranges until none is left (exceptions are kept for the caller)."""
+    def work(self) -> bool:
+        """Run ranges until none is left (exceptions are kept for the caller); whether this thread finished the
+        job's last range."""
+        last = False
         while (i := next(self.next)) < len(self.parts):
+            if i == 0:
+                self.workers.open(self.number)
+            if i == len(self.parts) - 1:
+                self.workers.close(self.number)
             try:
                 self.fn(*self.parts[i])
             except BaseException as exc:      # re-raised in the caller
@@ -89,23 +184,34 @@ class _Job:
             with self.lock:
                 self.left -= 1
                 if self.left == 0:
-                    self.flag[0] = 1
-                    self.done.set()
+                    last = True
+                    if self.done is not None:
+                        self.done.set()
+        return last
 
-    def help(self) -> None:
-        """A worker joins, if the job still takes helpers (numba's thread count of the caller)."""
+    def help(self) -> np.ndarray:
+        """A worker joins, if the job still takes helpers (numba's thread count of the caller); the flag the worker
+        raises once it has let go of the GIL if it finished the job's last range, else :data:`_NOTHING`."""
         with self.lock:
             if self.helpers <= 0:
-                return
+                return _NOTHING
             self.helpers -= 1
-        self.work()
+        return self.flag if self.work() else _NOTHING
 
     def wait(self) -> None:
         """Return when every range is done, and let go of ``fn`` (and the arrays its closure holds): a worker may
         still hold the job object (a late helper finds no range left)."""
-        if not self.done.is_set() and not (LINGER and _watch(self.flag, 0, LINGER)):
-            self.done.wait()
+        if self.left and not (LINGER and _watch(self.flag, 0, LINGER)):
+            with self.lock:
+                if self.left:
+                    self.done = threading.Event()
+            if self.done is not None:
+                self.done.wait()
         self.parts, self.fn = (), None
+
+
+#: ``signal`` of :func:`_idle` when there is nothing to raise.
+_NOTHING = np.zeros(0, dtype=np.int64)
 
 
 class _Workers:
@@ -114,39 +220,61 @@ class _Workers:
 
     def __init__(self):
         self.threads: list = []
-        self.cond = threading.Condition()
+        self.cond = threading.Condition()         # where workers sleep without the futex
         self.sleeping = 0
-        self.generation = np.zeros(1, dtype=np.int64)       # bumped for every job posted
+        self.opened = np.zeros(1, dtype=np.int64)  # the number of the job open to the workers, or 0
+        self.sleepers = np.zeros(1, dtype=np.int64)  # workers asleep on the futex
+        self.numbers = itertools.count(1)
         self.job = None
 
-    def post(self, job: _Job, workers: int) -> None:
+    def post(self, fn, parts: list, helpers: int, workers: int) -> _Job:
         if len(self.threads) < workers:
             with self.cond:
-                if LINGER and not self.threads:
-                    _watch(self.generation, -1, 0)           # compiled (or loaded) here, not on a worker
+                if LINGER and not self.threads:         # compiled (or loaded) here, not on a worker
+                    _watch(self.opened, -1, 0)
+                    _open(np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), 0, -1)
+                    _idle(np.ones(1, dtype=np.int64), self.sleepers, 0, 1, 0, _NOTHING, -1)
                 while len(self.threads) < workers:
                     t = threading.Thread(target=self._serve, name=f"roughpaths-sig-{len(self.threads)}", daemon=True)
                     self.threads.append(t)
                     t.start()
+        job = _Job(fn, parts, helpers, self, next(self.numbers))
         self.job = job
-        self.generation[0] += 1
-        if self.sleeping:                                   # read after the bump: a worker counted itself first
+        return job
+
+    def open(self, number: int) -> None:
+        if LINGER:
+            _open(self.opened, self.sleepers, number, _FUTEX)
+        else:
+            self.opened[0] = number
+        if self.sleeping:                                   # read after the store: a worker counted itself first
             with self.cond:
                 self.cond.notify_all()
 
+    def close(self, number: int) -> None:
+        if self.opened[0] == number:
+            self.opened[0] = 0
+
     def _serve(self) -> None:
-        seen = int(self.generation[0])
+        last, signal = 0, _NOTHING
         while True:
-            if not (LINGER and _watch(self.generation, seen, LINGER)):
+            if LINGER:
+                number = _idle(self.opened, self.sleepers, last, LINGER, SETTLE, signal, _FUTEX)
+            else:
+                number = 0
+                signal[:] = 1
+            signal = _NOTHING
+            if number == 0:                                 # no futex: sleep on the condition
                 with self.cond:
                     self.sleeping += 1
-                    while int(self.generation[0]) == seen:
+                    while int(self.opened[0]) in (0, last):
                         self.cond.wait()
                     self.sleeping -= 1
-            seen = int(self.generation[0])
+                number = int(self.opened[0])
+            last = number
             job = self.job
-            if job is not None:
-                job.help()
+            if job is not None and job.number == number:
+                signal = job.help()
             job = None                     # not kept while watching or asleep (wait() frees the job's own arrays)
 
 
@@ -161,12 +289,13 @@ def _forget_workers() -> None:             # in a forked child the parent's work
 os.register_at_fork(after_in_child=_forget_workers)
 
 
-def ranges(n_items: int, work_per_item: float) -> list:
-    """Split ``range(n_items)`` into contiguous ``(lo, hi)`` ranges of about :data:`RANGE_WORK` each."""
+def ranges(n_items: int, work_per_item: float, serial_work: float = SERIAL_WORK) -> list:
+    """Split ``range(n_items)`` into contiguous ``(lo, hi)`` ranges of about :data:`RANGE_WORK` each; one range
+    below ``serial_work`` in all."""
     if n_items <= 0:
         return []
     total = n_items * max(work_per_item, 1.0)
-    if total < SERIAL_WORK:
+    if total < serial_work:
         return [(0, n_items)]
     k = int(min(n_items, max(1, total // RANGE_WORK), 64))
     step = -(-n_items // k)
@@ -193,8 +322,7 @@ def run(fn, parts: list, *, merge: bool = False) -> None:
         for lo, hi in parts:
             fn(lo, hi)
         return
-    job = _Job(fn, parts, min(threads - 1, len(parts) - 1))
-    _WORKERS.post(job, threads - 1)
+    job = _WORKERS.post(fn, parts, min(threads - 1, len(parts) - 1), threads - 1)
     job.work()
     job.wait()
     if _WORKERS.job is job:                 # not offered (nor kept) after it is done

@@ -216,3 +216,32 @@ def test_a_finished_job_keeps_nothing_alive():
     del fn, big
     gc.collect()
     assert ref() is None
+
+
+def test_no_wake_up_is_lost_whenever_the_job_comes():
+    """Jobs posted at every phase of a worker's idling (watching, falling asleep, asleep): each time range 0 waits for
+    range 1 to start on another thread, which only a worker can do. A wake-up lost between a worker counting itself
+    asleep and the job opening would leave range 0 waiting for its 5 s and the caller running range 1 itself."""
+    import time
+
+    if numba.get_num_threads() < 2:
+        pytest.skip("one thread: no workers")
+    rng = np.random.default_rng(0)
+    lost = []
+    for pause in rng.uniform(0.0, 4e-4, 150):          # the workers watch for about 1e-4 s, then sleep
+        started = threading.Event()
+        who = {}
+
+        def fn(lo, hi):
+            who[lo] = threading.get_ident()
+            if lo == 0:
+                if not started.wait(timeout=5):
+                    lost.append(pause)
+            else:
+                started.set()
+
+        time.sleep(pause)
+        parallel_ranges(fn, 2, 1)
+        if lost:
+            break
+    assert not lost, f"no worker took range 1 after a pause of {lost[0]:.2e} s"
