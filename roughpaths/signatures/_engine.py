@@ -267,6 +267,13 @@ def alone_kernel(n: int, d: int, depth: int):
     return _blocked.block_units(d, depth)
 
 
+#: The deep kernels' jobs from this estimate on are split over threads: about 0.12 ms on one core (a unit of
+#: :func:`_parts_plan`'s estimate is ~0.23 ns here), half the threads' default. Since idle workers wait for the
+#: next job without the GIL, a split pays from about 0.1 ms (the benchmark's protocol, two runs, split / serial:
+#: 16 x 256 paths at d = 3, depth 4: 0.83 / 0.93; d = 5, 6 at depth 3: 0.67-1.0 / 0.87-0.91; d = 4: 0.79 / 1.04).
+_SPLIT_WORK = _threads.SERIAL_WORK / 2
+
+
 @lru_cache(maxsize=64)
 def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
     """What :func:`_reversed_parts` runs for a ``(nb, n, d)`` batch: a function of the shape only, made once.
@@ -284,8 +291,8 @@ def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
     lanes = _lanes.lane_groups(d, depth) if ngroups else None
     alone = alone_kernel(n, d, depth) if first_alone < nunits else None
     return (_units(nb, n, nchunks), level_offsets(d, depth), (nunits, dim),
-            lanes, _threads.ranges(ngroups, per_unit * _lanes.LANES),
-            first_alone, alone, _threads.ranges(nunits - first_alone, per_unit))
+            lanes, _threads.ranges(ngroups, per_unit * _lanes.LANES, _SPLIT_WORK),
+            first_alone, alone, _threads.ranges(nunits - first_alone, per_unit, _SPLIT_WORK))
 
 
 def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
