@@ -288,10 +288,15 @@ def sig2_lane_tasks(x, nchunks, lo, hi, part):
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _glue_total(part, b, nchunks, d, tot):
-    """``tot <- (increment, twice the Lévy area over i<j)`` of path ``b``, chunks glued by Chen in order."""
+    """``tot <- (increment, twice the Lévy area over i<j)`` of path ``b``, chunks glued by Chen in order.
+
+    The first chunk is glued to zero: ``0 + (p + 0 p_j - 0 p_i)`` is ``0 + p`` for finite entries (a zero of either
+    sign becomes +0 both ways), so it is copied as ``0.0 + p``, the same bits without the products (16 paths at
+    d = 19 in one chunk: 10 us of the glue's 16 before)."""
+    p = part[b * nchunks]
     for r in range(tot.shape[0]):
-        tot[r] = 0.0
-    for c in range(nchunks):
+        tot[r] = 0.0 + p[r]
+    for c in range(1, nchunks):
         p = part[b * nchunks + c]
         q = 0
         for i in range(d):
