@@ -267,10 +267,11 @@ def alone_kernel(n: int, d: int, depth: int):
     return _blocked.block_units(d, depth)
 
 
-#: The deep kernels' jobs from this estimate on are split over threads: about 0.12 ms on one core (a unit of
-#: :func:`_parts_plan`'s estimate is ~0.23 ns here), half the threads' default. Since idle workers wait for the
-#: next job without the GIL, a split pays from about 0.1 ms (the benchmark's protocol, two runs, split / serial:
-#: 16 x 256 paths at d = 3, depth 4: 0.83 / 0.93; d = 5, 6 at depth 3: 0.67-1.0 / 0.87-0.91; d = 4: 0.79 / 1.04).
+#: The engine's jobs from this estimate on are split over threads: about 0.12 ms on one core for the deep kernels
+#: (a unit of :func:`_parts_plan`'s estimate is ~0.23 ns here), half the threads' default. Since idle workers wait
+#: for the next job without the GIL, a split pays from about 0.1 ms (the benchmark's protocol, 5 interleaved
+#: process pairs, 16 x 256 paths: d = 3 at depth 4 and d = 6 at depth 3 0.15-0.25 ms serial, split 0.82-0.93 and
+#: 0.73-0.91 of it; d = 4 at depth 3, 0.09 ms, even).
 _SPLIT_WORK = _threads.SERIAL_WORK / 2
 
 
@@ -315,17 +316,18 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
     part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
     # a multiply-add per unit, about 0.1 ns on one core: half the time of a unit of the deeper kernels' estimate, so
-    # the serial threshold is ~0.2 ms here too (16 x 256 paths at d = 16-20, two lane groups: split 1.2-1.4x the
-    # time on one thread in 3 of 4 cells, single calls, load ~1; 64 x 256 at d = 12-20: split 0.70-0.78x)
+    # the engine's threshold is ~0.06 ms here (the benchmark's protocol, 4 interleaved process pairs, split at
+    # _SPLIT_WORK against serial before: 64 x 256 paths at d = 8, 9, 10: 0.86-0.91, 0.81-0.83, 0.68-0.72 of the
+    # time (0.15-0.21 ms serial); 16 x 256 at d = 17, 19, 20, two lane groups: 0.78-1.04, 0.78-0.97, 0.76-0.83)
     per_task = (n / nchunks) * d * d / 2
     groups = nb // _lanes.LANES if d >= _l2.LANE_WIDTH else 0      # same bits either way
     if groups:
         _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
-                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES), merge=True)
+                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES, _SPLIT_WORK), merge=True)
     first = groups * _lanes.LANES * nchunks
     tasks = _l2.sig2_tasks(d)
     _threads.run(lambda lo, hi: tasks(x, nchunks, first + lo, first + hi, part),
-                 _threads.ranges(nb * nchunks - first, per_task), merge=True)
+                 _threads.ranges(nb * nchunks - first, per_task, _SPLIT_WORK), merge=True)
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
