@@ -267,14 +267,6 @@ def alone_kernel(n: int, d: int, depth: int):
     return _blocked.block_units(d, depth)
 
 
-#: The engine's jobs from this estimate on are split over threads: about 0.12 ms on one core for the deep kernels
-#: (a unit of :func:`_parts_plan`'s estimate is ~0.23 ns here), half the threads' default. Since idle workers wait
-#: for the next job without the GIL, a split pays from about 0.1 ms (the benchmark's protocol, 5 interleaved
-#: process pairs, 16 x 256 paths: d = 3 at depth 4 and d = 6 at depth 3 0.15-0.25 ms serial, split 0.82-0.93 and
-#: 0.73-0.91 of it; d = 4 at depth 3, 0.09 ms, even).
-_SPLIT_WORK = _threads.SERIAL_WORK / 2
-
-
 @lru_cache(maxsize=64)
 def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
     """What :func:`_reversed_parts` runs for a ``(nb, n, d)`` batch: a function of the shape only, made once.
@@ -288,12 +280,16 @@ def _parts_plan(nb: int, n: int, d: int, depth: int, nchunks: int) -> tuple:
     # at d = 2, depth 5: 64 x 256 such paths take 0.22-0.36 ms, on two threads 18-27 % less since the workers
     # watch for jobs (load 1.3-1.8); before, waking them cost about as much as it saved)
     per_unit = (n / nchunks) * (1.5 * d ** depth + 12 * depth)
+    # split from _threads.SPLIT_WORK (about 0.12 ms here, a unit ~0.23 ns), half the threads' default: since idle
+    # workers wait for the next job without the GIL, a split pays from about 0.1 ms (the benchmark's protocol, 5
+    # interleaved process pairs, 16 x 256 paths: d = 3 at depth 4 and d = 6 at depth 3, 0.15-0.25 ms serial, split
+    # 0.82-0.93 and 0.73-0.91 of it; d = 4 at depth 3, 0.09 ms, even)
     ngroups, first_alone = _split_units(nunits, d, depth)
     lanes = _lanes.lane_groups(d, depth) if ngroups else None
     alone = alone_kernel(n, d, depth) if first_alone < nunits else None
     return (_units(nb, n, nchunks), level_offsets(d, depth), (nunits, dim),
-            lanes, _threads.ranges(ngroups, per_unit * _lanes.LANES, _SPLIT_WORK),
-            first_alone, alone, _threads.ranges(nunits - first_alone, per_unit, _SPLIT_WORK))
+            lanes, _threads.ranges(ngroups, per_unit * _lanes.LANES, _threads.SPLIT_WORK),
+            first_alone, alone, _threads.ranges(nunits - first_alone, per_unit, _threads.SPLIT_WORK))
 
 
 def _reversed_parts(x: np.ndarray, depth: int, nchunks: int) -> np.ndarray:
@@ -317,17 +313,17 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
     # a multiply-add per unit, about 0.1 ns on one core: half the time of a unit of the deeper kernels' estimate, so
     # the engine's threshold is ~0.06 ms here (the benchmark's protocol, 4 interleaved process pairs, split at
-    # _SPLIT_WORK against serial before: 64 x 256 paths at d = 8, 9, 10: 0.86-0.91, 0.81-0.83, 0.68-0.72 of the
+    # SPLIT_WORK against serial before: 64 x 256 paths at d = 8, 9, 10: 0.86-0.91, 0.81-0.83, 0.68-0.72 of the
     # time (0.15-0.21 ms serial); 16 x 256 at d = 17, 19, 20, two lane groups: 0.78-1.04, 0.78-0.97, 0.76-0.83)
     per_task = (n / nchunks) * d * d / 2
     groups = nb // _lanes.LANES if d >= _l2.LANE_WIDTH else 0      # same bits either way
     if groups:
         _threads.run(lambda lo, hi: _l2.sig2_lane_tasks(x, nchunks, lo, hi, part),
-                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES, _SPLIT_WORK), merge=True)
+                     _threads.ranges(groups * nchunks, per_task * _lanes.LANES, _threads.SPLIT_WORK), merge=True)
     first = groups * _lanes.LANES * nchunks
     tasks = _l2.sig2_tasks(d)
     _threads.run(lambda lo, hi: tasks(x, nchunks, first + lo, first + hi, part),
-                 _threads.ranges(nb * nchunks - first, per_task, _SPLIT_WORK), merge=True)
+                 _threads.ranges(nb * nchunks - first, per_task, _threads.SPLIT_WORK), merge=True)
     return (_l2.logsig2_glue if log else _l2.sig2_glue)(part, nb, nchunks, d)
 
 
