@@ -10,7 +10,7 @@ thread only (no thread hand-off at all).
 
 Hand-off. A worker that finishes a job watches for the next one for a short while (:data:`LINGER`
 rounds of ``sched_yield``, about 0.1 ms here) before it sleeps, and the caller watches for its workers'
-last ranges in the same way before it sleeps: waking a sleeping thread cost 35-170 us on this 2-core
+last ranges in the same way (for up to 5 ms, :data:`FINISH`) before it sleeps: waking a sleeping thread cost 35-170 us on this 2-core
 machine (a virtual CPU wakes from idle), against 5-26 us for a watching one. A worker idles without the GIL
 (:func:`_idle`: it watches, then sleeps on Linux's futex; elsewhere on a condition), and asks for the GIL
 only for a job still open to it (from the caller's first range until its last range is taken) and only
@@ -54,6 +54,12 @@ RANGE_WORK = 1 << 17
 #: Rounds of ``sched_yield`` (0.2-0.4 us each here) a thread watches for a job or its end before it sleeps;
 #: 0 where the C library has no ``sched_yield`` (watching then never compiles).
 LINGER = 500 if hasattr(os, "sched_yield") else 0
+#: Rounds (about 5 ms here) the caller watches for its workers' last ranges before it sleeps. A caller that slept
+#: there woke 100-250 us after the job was done, by when its worker had stopped watching for the next job: the next
+#: call then waited for a sleeping worker too, and so on (16 paths at d = 3, depth 6 split over two lane groups, a
+#: 1 ms pause and an untimed call before each timed one: 17-19 of 61 calls took 0.55-0.65 ms instead of ~0.4 ms
+#: with 500 rounds, 0-1 of 61 with this). The wait is for a range already running, so the watch is short.
+FINISH = 25000 if LINGER else 0
 #: Rounds a worker still waits after it saw a job open, before it asks for the GIL: the caller opens the job right
 #: before its own first range and holds the GIL until that range's kernel starts (1-3 us); a worker asking for the
 #: GIL before that sleeps until the caller lets go of it, and waking it costs 10-50 us here. Two ranges of 50 / 100 us
@@ -207,7 +213,7 @@ class _Job:
     def wait(self) -> None:
         """Return when every range is done, and let go of ``fn`` (and the arrays its closure holds): a worker may
         still hold the job object (a late helper finds no range left)."""
-        if self.left and not (LINGER and _watch(self.flag, 0, LINGER)):
+        if self.left and not (LINGER and _watch(self.flag, 0, FINISH)):
             with self.lock:
                 if self.left:
                     self.done = threading.Event()
