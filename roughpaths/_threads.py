@@ -95,31 +95,24 @@ def _read_acquire(typingctx, flag):
     return types.int64(flag), codegen
 
 
-@intrinsic
-def _exchange(typingctx, flag, value):
-    """``flag[0] = value`` as an atomic exchange (a full barrier: later reads are not moved before it); the old
-    value."""
-    if not (_int64_array(flag) and isinstance(value, types.Integer)):
-        return None
+def _atomic(op: str):
+    """An intrinsic ``f(flag, value)``: ``flag[0] <- op(flag[0], value)`` of an int64 array, atomically, as a full
+    barrier (later reads are not moved before it); returns the old value."""
+    @intrinsic
+    def rmw(typingctx, flag, value):
+        if not (_int64_array(flag) and isinstance(value, types.Integer)):
+            return None
 
-    def codegen(context, builder, signature, args):
-        data = context.make_array(signature.args[0])(context, builder, args[0]).data
-        v = context.cast(builder, args[1], signature.args[1], types.int64)
-        return builder.atomic_rmw("xchg", data, v, "seq_cst")
-    return types.int64(flag, value), codegen
+        def codegen(context, builder, signature, args):
+            data = context.make_array(signature.args[0])(context, builder, args[0]).data
+            v = context.cast(builder, args[1], signature.args[1], types.int64)
+            return builder.atomic_rmw(op, data, v, "seq_cst")
+        return types.int64(flag, value), codegen
+    return rmw
 
 
-@intrinsic
-def _add(typingctx, flag, value):
-    """``flag[0] += value`` atomically (a full barrier); the old value."""
-    if not (_int64_array(flag) and isinstance(value, types.Integer)):
-        return None
-
-    def codegen(context, builder, signature, args):
-        data = context.make_array(signature.args[0])(context, builder, args[0]).data
-        v = context.cast(builder, args[1], signature.args[1], types.int64)
-        return builder.atomic_rmw("add", data, v, "seq_cst")
-    return types.int64(flag, value), codegen
+_exchange = _atomic("xchg")      # flag[0] = value
+_add = _atomic("add")            # flag[0] += value
 
 
 @numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
