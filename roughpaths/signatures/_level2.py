@@ -14,7 +14,7 @@ from numba import njit
 
 from .._variants import variants
 
-from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
+from ._simd import LANES, vadd, vload, vmul, vsplat, vstore, vsub
 
 _NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
@@ -230,10 +230,13 @@ def sig2_lane_tasks(x, nchunks, lo, hi, part):
     """:func:`sig2_tasks` for LANES paths at a time, one per lane: tasks ``t = lo..hi-1`` are (path group
     ``t // nchunks``, chunk ``t % nchunks``), the paths ``LANES (t // nchunks) + l``.
 
-    Each lane adds, per pair ``i < j`` and point, ``a + (p_i c_j + p_j (-c_i))`` in point order: the
-    operations of :func:`_area_chunk_generic` on one path, so a path gets the same bits in a group or
-    alone. (The generic kernel runs the table of one path over packed rows; at d = 8 it costs ~115
-    cycles a segment, mostly the packing, against ~20 here.)
+    Each lane adds, per pair ``i < j`` and point, ``a + (p_i c_j - p_j c_i)`` in point order: the
+    operations of :func:`_area_chunk_generic` on one path (``p_j (-c_i)`` is ``-(p_j c_i)`` exactly, and
+    ``u + (-w)`` is the IEEE ``u - w``), so a path gets the same bits in a group or alone. (The generic
+    kernel runs the table of one path over packed rows; at d = 8 it costs ~115 cycles a segment, mostly the
+    packing, against ~20 here.) The points' rows swap buffers instead of being copied, and ``-c`` is not
+    stored: at d = 20 the gather of eight paths' points (two stores an entry) and the copy were ~20 % of a
+    segment's time.
     """
     n = x.shape[1]
     d = x.shape[2]
@@ -243,7 +246,6 @@ def sig2_lane_tasks(x, nchunks, lo, hi, part):
     x0 = np.empty(d * LANES)
     pv = np.empty(d * LANES)                   # y_{k-1}, lane l of coordinate i at i * LANES + l
     cv = np.empty(d * LANES)                   # y_k
-    nc = np.empty(d * LANES)                   # -y_k
     acc = np.empty(npair * LANES)
     for t in range(lo, hi):
         g = t // nchunks
@@ -265,19 +267,16 @@ def sig2_lane_tasks(x, nchunks, lo, hi, part):
         for k in range(a + 1, e + 1):
             for i in range(d):
                 for l in range(LANES):
-                    v = x[b0 + l, k, i] - x0[i * LANES + l]
-                    cv[i * LANES + l] = v
-                    nc[i * LANES + l] = -v
+                    cv[i * LANES + l] = x[b0 + l, k, i] - x0[i * LANES + l]
             q = np.uint64(0)
             for i in range(np.uint64(d)):
                 pi = vload(pv, i * L)
-                ni = vload(nc, i * L)
+                ci = vload(cv, i * L)
                 for j in range(i + np.uint64(1), np.uint64(d)):
                     s = vload(acc, q)
-                    vstore(acc, q, vadd(s, vadd(vmul(pi, vload(cv, j * L)), vmul(vload(pv, j * L), ni))))
+                    vstore(acc, q, vadd(s, vsub(vmul(pi, vload(cv, j * L)), vmul(vload(pv, j * L), ci))))
                     q += L
-            for r in range(d * LANES):
-                pv[r] = cv[r]
+            pv, cv = cv, pv                    # y_k becomes y_{k-1}; the next point overwrites the other
         for l in range(LANES):
             row = part[(b0 + l) * nchunks + c]
             for i in range(d):

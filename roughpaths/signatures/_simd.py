@@ -89,6 +89,17 @@ def vadd(typingctx, v, w):
 
 
 @intrinsic
+def vsub(typingctx, v, w):
+    """Element-wise ``v - w`` (the IEEE operation ``v + (-w)``: the same bits as adding the negated row)."""
+    if not (v == row and w == row):
+        return None
+
+    def codegen(context, builder, sig, args):
+        return builder.fsub(args[0], args[1])
+    return row(v, w), codegen
+
+
+@intrinsic
 def vmul(typingctx, v, w):
     """Element-wise ``v * w``."""
     if not (v == row and w == row):
