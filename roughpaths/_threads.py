@@ -21,9 +21,8 @@ has let go of the GIL. Calls in quick succession (a training loop, a benchmark, 
 find their workers awake; a lone call pays the wake-up once. Watching costs CPU time only, never results,
 and yields the core to any other runnable thread. Measured (a compiled kernel over two ranges, a 1 ms pause
 and an untimed call before each timed one, medians of 61, three interleaved processes each, before
-:data:`FINISH` was raised): 2 x 25 us
-took 55 us split (63-75 before the GIL-free idling; 50 serial), 2 x 50 us 72-109 (110-137; 100), 2 x 100
-us 121-144 (143-148; 200).
+:data:`FINISH` was raised): 2 x 25 us took 55 us split (63-75 before the GIL-free idling; 50 serial), 2 x 50
+us 72-109 (110-137; 100), 2 x 100 us 121-144 (143-148; 200).
 
 The split into ranges never changes a result: every item is computed by the same code whatever
 thread runs it. The number of threads is numba's (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``).
