@@ -77,37 +77,22 @@ def vstore(typingctx, a, i, v):
     return types.void(a, i, v), codegen
 
 
-@intrinsic
-def vadd(typingctx, v, w):
-    """Element-wise ``v + w``."""
-    if not (v == row and w == row):
-        return None
+def _elementwise(op: str):
+    """An intrinsic ``f(v, w)``: the element-wise IEEE operation ``op`` (``fadd``, ``fsub``, ``fmul``) of two rows."""
+    @intrinsic
+    def f(typingctx, v, w):
+        if not (v == row and w == row):
+            return None
 
-    def codegen(context, builder, sig, args):
-        return builder.fadd(args[0], args[1])
-    return row(v, w), codegen
-
-
-@intrinsic
-def vsub(typingctx, v, w):
-    """Element-wise ``v - w`` (the IEEE operation ``v + (-w)``: the same bits as adding the negated row)."""
-    if not (v == row and w == row):
-        return None
-
-    def codegen(context, builder, sig, args):
-        return builder.fsub(args[0], args[1])
-    return row(v, w), codegen
+        def codegen(context, builder, sig, args):
+            return getattr(builder, op)(args[0], args[1])
+        return row(v, w), codegen
+    return f
 
 
-@intrinsic
-def vmul(typingctx, v, w):
-    """Element-wise ``v * w``."""
-    if not (v == row and w == row):
-        return None
-
-    def codegen(context, builder, sig, args):
-        return builder.fmul(args[0], args[1])
-    return row(v, w), codegen
+vadd = _elementwise("fadd")      # v + w
+vsub = _elementwise("fsub")      # v - w: the IEEE v + (-w), the same bits as adding the negated row
+vmul = _elementwise("fmul")      # v * w
 
 
 @intrinsic
