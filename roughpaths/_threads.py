@@ -8,21 +8,21 @@ scheduled yet (a busy machine) simply finds nothing left to do, so the call neve
 at worst waits for one range that a descheduled thread had started. Small jobs run on the calling
 thread only (no thread hand-off at all).
 
-Hand-off. A worker that finishes a job watches for the next one for a short while (:data:`LINGER`
-rounds of ``sched_yield``, about 0.1 ms here) before it sleeps, and the caller watches for its workers'
-last ranges in the same way (for up to 5 ms, :data:`FINISH`) before it sleeps: waking a sleeping thread cost 35-170 us on this 2-core
-machine (a virtual CPU wakes from idle), against 5-26 us for a watching one. A worker idles without the GIL
-(:func:`_idle`: it watches, then sleeps on Linux's futex; elsewhere on a condition), and asks for the GIL
-only for a job still open to it (from the caller's first range until its last range is taken) and only
-after the caller is likely to have let go of it (:data:`SETTLE`): a thread that asks for a GIL held by
-another sleeps until it is released, and pays the wake-up again. So a worker woken too late for its job
-does not take the GIL from the caller, and one that finished the job's last range tells the caller once it
-has let go of the GIL. Calls in quick succession (a training loop, a benchmark, an adaptive solve's walks)
-find their workers awake; a lone call pays the wake-up once. Watching costs CPU time only, never results,
-and yields the core to any other runnable thread. Measured (a compiled kernel over two ranges, a 1 ms pause
-and an untimed call before each timed one, medians of 61, three interleaved processes each, before
-:data:`FINISH` was raised): 2 x 25 us took 55 us split (63-75 before the GIL-free idling; 50 serial), 2 x 50
-us 72-109 (110-137; 100), 2 x 100 us 121-144 (143-148; 200).
+Hand-off. A worker that finishes a job watches for the next one for a short while (:data:`LINGER` rounds of
+``sched_yield``, about 0.1 ms here) before it sleeps, and the caller watches for its workers' last ranges in the
+same way (for up to 5 ms, :data:`FINISH`) before it sleeps: waking a sleeping thread cost 35-170 us on this
+2-core machine (a virtual CPU wakes from idle), against 5-26 us for a watching one. A worker idles without the
+GIL (:func:`_idle`: it watches, then sleeps on Linux's futex; elsewhere on a condition), and asks for the GIL
+only for a job still open to it (from the caller's first range until its last range is taken) and only after the
+caller is likely to have let go of it (:data:`SETTLE`): a thread that asks for a GIL held by another sleeps
+until it is released, and pays the wake-up again. So a worker woken too late for its job does not take the GIL
+from the caller, and one that finished the job's last range tells the caller once it has let go of the GIL.
+Calls in quick succession (a training loop, a benchmark, an adaptive solve's walks) find their workers awake; a
+lone call pays the wake-up once. Watching costs CPU time only, never results, and yields the core to any other
+runnable thread. Measured (a compiled kernel over two ranges, a 1 ms pause and an untimed call before each timed
+one, medians of 61, three interleaved processes each, before :data:`FINISH` was raised): 2 x 25 us took 55 us
+split (63-75 before the GIL-free idling; 50 serial), 2 x 50 us 72-109 (110-137; 100), 2 x 100 us 121-144
+(143-148; 200).
 
 The split into ranges never changes a result: every item is computed by the same code whatever
 thread runs it. The number of threads is numba's (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``).
@@ -47,7 +47,8 @@ __all__ = ["run", "ranges", "parallel_ranges"]
 SERIAL_WORK = 1 << 20
 #: The serial threshold of estimates counted in units of about 0.23 ns of one core here (the signature kernels'
 #: and the tensor algebra's rows): about 0.12 ms. Since idle workers wait without the GIL, a split pays from about
-#: 0.1 ms (the measurements at :data:`roughpaths.signatures._engine` and :func:`roughpaths.algebra.flat.log_flat`).
+#: 0.1 ms (the measurements in :func:`roughpaths.signatures._engine._parts_plan` and
+#: :func:`roughpaths.algebra.flat._log_work`).
 SPLIT_WORK = SERIAL_WORK / 2
 #: Target work per range (enough to amortise a hand-off of a few tens of microseconds).
 RANGE_WORK = 1 << 17

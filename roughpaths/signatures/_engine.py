@@ -311,8 +311,9 @@ def _level2_flat(x: np.ndarray, *, log: bool) -> np.ndarray:
     nb, n, d = x.shape
     nchunks = _n_chunks(n, _MAX_CHUNKS_L2, _MIN_CHUNK_L2)
     part = np.empty((nb * nchunks, d + d * (d - 1) // 2))
-    # a multiply-add per unit, about 0.1 ns on one core: half the time of a unit of the deeper kernels' estimate, so
-    # the engine's threshold is ~0.06 ms here (the benchmark's protocol, 4 interleaved process pairs, split at
+    # half a unit per multiply-add: a unit takes about 0.2 ns on one core (one thread, CPU: 16 x 256 paths at d = 13,
+    # 346k units, 67-74 us; 64 x 256 at d = 8, 524k units, 131-135 us), as the deeper kernels' (~0.23 ns), so
+    # SPLIT_WORK means about 0.1 ms here too (the benchmark's protocol, 4 interleaved process pairs, split at
     # SPLIT_WORK against serial before: 64 x 256 paths at d = 8, 9, 10: 0.86-0.91, 0.81-0.83, 0.68-0.72 of the
     # time (0.15-0.21 ms serial); 16 x 256 at d = 17, 19, 20, two lane groups: 0.78-1.04, 0.78-0.97, 0.76-0.83)
     per_task = (n / nchunks) * d * d / 2
