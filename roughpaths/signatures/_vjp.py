@@ -23,7 +23,8 @@ import numpy as np
 from numba import njit
 
 from .._variants import variants
-from ._lanes import BLOCK, _addto, _axpy, _horner_step_d, _lane_step_d, _wide_step, mul_inplace, step_key
+from ._lanes import (BLOCK, _addto, _axpy, _horner_step_d, _lane_step_d, _top_registers, _top_rows, _wide_step,
+                     mul_inplace, step_key)
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
@@ -364,7 +365,7 @@ def _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gprev, tb, ga, gb, gdelta):
 
 @njit(cache=True, inline="always")
 def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk, neg, buf, tb, ga, gb,
-                  gdelta, gd):
+                  gdelta, gd, top):
     L = LANES
     for l in range(L):                                       # increments, last segment first
         u = grp * L + l
@@ -382,7 +383,7 @@ def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk,
                 neg[(t * d + i) * L + l] = 0.0
     for t in range(nt):
         do = t * d * L
-        _lane_step_d(s, neg, do, d, m, offsets, buf)          # S_prev = S ⊗ exp(-D)
+        _lane_step_d(s, neg, do, d, m, offsets, buf, top)     # S_prev = S ⊗ exp(-D)
         _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gn, tb, ga, gb, gdelta)
         for l in range(L):
             if t0 + t < nsteps[l]:
@@ -398,6 +399,7 @@ def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk,
 @variants
 def _sig_vjp_groups_kernel(V: int):
     """The compiled lane backward pass for the variant ``V`` (:func:`vjp_key`)."""
+    rows4k = V in (0, 2)               # rows of a level 4 KiB apart can occur (d = 2, 4): :func:`._lanes._top_rows`
 
     @njit(**_NOGIL)
     def sig_vjp_groups_variant(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd):
@@ -415,7 +417,7 @@ def _sig_vjp_groups_kernel(V: int):
         gdelta = np.empty(d * L)
         blk = np.empty(T * d * L)
         neg = np.empty(T * d * L)
-        buf = np.empty(2 * d ** max(m - 2, 1) * L)
+        buf = np.empty((2 * d ** max(m - 2, 1) + d ** max(m - 1, 1)) * L)         # see _lane_step_d
         nsteps = np.zeros(L, dtype=np.int64)
         for grp in range(lo, hi):
             steps = 0
@@ -434,8 +436,12 @@ def _sig_vjp_groups_kernel(V: int):
                 steps = max(steps, nsteps[l])
             for t0 in range(0, steps, T):
                 nt = min(T, steps - t0)
-                _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, V if V else d, m, offsets, s, g, gn, blk, neg, buf,
-                              tb, ga, gb, gdelta, gd)
+                if rows4k:             # a branch on the variant's constant (see _lanes.lane_groups)
+                    _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, V if V else d, m, offsets, s, g, gn, blk, neg,
+                                  buf, tb, ga, gb, gdelta, gd, _top_rows)
+                else:
+                    _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, V if V else d, m, offsets, s, g, gn, blk, neg,
+                                  buf, tb, ga, gb, gdelta, gd, _top_registers)
 
     return sig_vjp_groups_variant
 
