@@ -21,7 +21,7 @@ from .. import _threads
 from . import _kernels as _k
 from ._lyndon import lyndon_levels
 
-__all__ = ["level_offsets", "log_flat", "lyndon_flat", "lyndon_flat_vjp", "product_flat"]
+__all__ = ["level_offsets", "log_flat", "lyndon_flat", "log_lyndon_flat", "lyndon_flat_vjp", "product_flat"]
 
 
 @lru_cache(maxsize=512)
@@ -75,6 +75,36 @@ def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
             lidx, indptr, indices, data = projections[k - 1]
             _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, starts[k - 1], lo, hi)
     _threads.run(rows, parts)
+    return out
+
+
+#: Bytes of logs a thread of :func:`log_lyndon_flat` holds at once (at least one row).
+_LOG_ROWS_BYTES = 8 * 2 ** 20
+
+
+def log_lyndon_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
+    """``lyndon_flat(log_flat(a, dim, depth), dim, depth)`` without the batch of logs: each thread takes the logs of
+    its rows a few at a time (:data:`_LOG_ROWS_BYTES`, at least a row) into a scratch and their Lyndon coordinates
+    from it. The same kernels on the same rows: the same bits. A batch of logs as large as the signatures was the
+    log-signature's largest allocation; memory that a process has not touched before costs its first write (16
+    signatures at d = 15, depth 5, 104 MB: the log took 330 ms into a new array, 22 ms into one written before)."""
+    off = level_offsets(dim, depth)
+    projections, starts, work = lyndon_levels(dim, depth)
+    B, width = a.shape[0], int(off[depth + 1])
+    out = np.empty((B, starts[-1]))
+    step = max(1, _LOG_ROWS_BYTES // (8 * width))
+
+    def rows(lo, hi):
+        z = np.empty((min(step, hi - lo), width))
+        for r0 in range(lo, hi, step):
+            r1 = min(r0 + step, hi)
+            n, o = r1 - r0, out[r0:r1]
+            _k.log_rows(a[r0:r1], dim, depth, off, 0, n, z)
+            o[:, :dim] = z[:n, :dim]       # level 1: every letter is a Lyndon word, its own coordinate
+            for k in range(2, depth + 1):
+                lidx, indptr, indices, data = projections[k - 1]
+                _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, o, starts[k - 1], 0, n)
+    _threads.run(rows, _threads.ranges(B, _log_work(dim, depth) + 5.0 * work + 150.0, _threads.SPLIT_WORK), merge=True)
     return out
 
 

@@ -125,7 +125,8 @@ def _check_fits(batch: int, d: int, depth: int, *, log: bool = False, n: int = 0
     """Refuse, before allocating, a request whose working arrays would not fit in memory.
 
     The signature needs about 3 arrays of ``batch * sigdim`` floats (result, chunk partials,
-    layout permutation); the log-signature 2 more (log, scratch) plus the sparse Lyndon map, whose
+    layout permutation); the log-signature 2 more (its coordinates; the logs of the few rows each thread holds at a
+    time, :func:`roughpaths.algebra.flat.log_lyndon_flat`) plus the sparse Lyndon map, whose
     top level holds at most ``n_m * 2**(m-1)`` entries (12 bytes each while it is built). Paths of
     ``n`` points cut into ``c > 1`` work units (:func:`_horner_chunks`) add the units' signatures,
     ``batch * c * sigdim`` floats (twice with ``log``: the gradients' units' cotangents too).

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _threads
-from ..algebra.flat import level_offsets, log_flat, lyndon_flat
+from ..algebra.flat import level_offsets, log_lyndon_flat
 from . import _kernels as _k
 from ._engine import (_check_depth, _check_fits, _check_paths, _finite_or_raise, _kernel_array, _level2_flat,
                       _logsigdim, _reversed_to_rowmajor, _sigdim, _signature_flat)
@@ -109,7 +109,7 @@ def logsignature(paths, depth: int) -> np.ndarray:
     sig = np.ascontiguousarray(_signature_flat(flat, depth))
     # checked through the Lyndon coordinates: a NaN/inf point reaches them, and the log of a finite signature may
     # itself overflow (its products of levels)
-    out = lyndon_flat(log_flat(sig, d, depth), d, depth)
+    out = log_lyndon_flat(sig, d, depth)
     return _finite_or_raise(out, x, depth, "log-signature").reshape(batch + (_logsigdim(d, depth),))
 
 
