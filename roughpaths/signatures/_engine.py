@@ -23,7 +23,7 @@ from .. import _threads
 from ..algebra.flat import level_offsets
 from ..algebra.tensor import logsigdim, sigdim
 from ..validation import as_float_array, check_memory, check_positive_int
-from . import _blocked, _lanes
+from . import _blocked, _lanes, _layout
 from . import _level2 as _l2
 
 # Work splitting depends on each path's length only (never on the thread count nor on the batch), so
@@ -357,7 +357,7 @@ def _signature_flat(x: np.ndarray, depth: int) -> np.ndarray:
     if out.size <= _SMALL_PERMUTE:
         return out.take(perm, axis=1)               # out[:, perm], in C order and ~1 us sooner
     res = np.empty_like(out)
-    _threads.run(lambda lo, hi: _blocked.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
+    _threads.run(lambda lo, hi: _layout.to_rowmajor(out, perm, level_offsets(d, depth), depth, lo, hi, res),
                  _threads.ranges(nb, 4 * perm.shape[0]), merge=True)
     return res
 

@@ -22,7 +22,7 @@ import pytest
 
 from roughpaths import signature
 from roughpaths.algebra.flat import level_offsets
-from roughpaths.signatures import _blocked, _lanes
+from roughpaths.signatures import _blocked, _lanes, _layout
 from roughpaths.signatures._engine import _reversed_to_rowmajor, _units
 
 CASES = [(6, 3), (6, 4), (8, 3), (8, 4), (20, 3), (7, 3), (4, 6), (7, 2), (20, 2)]   # depth 2: _level2
@@ -93,12 +93,12 @@ def test_short_lone_paths_take_the_plain_kernel_with_the_bits_of_the_others(rng,
 
 @pytest.mark.parametrize("d,m", [(4, 8), (5, 7)])   # 8 x 8 tiles only; tiles and edges (125 x 625)
 def test_tiled_permutation_equals_numpy_gather(rng, d, m):
-    assert d ** m > _blocked._TILED               # the top level is permuted in tiles
+    assert d ** m > _layout._TILED                # the top level is permuted in tiles
     off = level_offsets(d, m)
     perm = _reversed_to_rowmajor(d, m)
     src = rng.standard_normal((2, off[m + 1]))
     out = np.empty_like(src)
-    _blocked.to_rowmajor(src, perm, off, m, 0, 2, out)
+    _layout.to_rowmajor(src, perm, off, m, 0, 2, out)
     assert out.tobytes() == src[:, perm].tobytes()
 
 
