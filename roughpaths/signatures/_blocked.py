@@ -31,9 +31,9 @@ the top level's rows are swept in a zero-padded scratch, four rows at a time (:f
 Before, those ends were scalar loops, and the top level's a chain of dependent adds per entry:
 d = 6, 7, 10, 14 at depth 3 took 127, 148, 198, 437 ns a segment, now 68, 95, 148, 298 (one thread,
 16 x 256 points; pysiglib 4.0 ``n_jobs=1`` 61, 89, 161, 399).
-The (6, 4) variant and d = 4 from depth 7 update the lower levels in place instead (rows end one entry
-at a time; no second copy to zero and to copy out), which is faster there (:func:`block_key`); the
-same bits.
+The (6, 4) variant, d = 4 from depth 7 and every other width once a row of the top level's ``T`` passes 4096
+entries update the lower levels in place instead (rows end one entry at a time; no second copy to zero, to
+stream and to copy out), which is faster there (:func:`block_key`); the same bits.
 Where ``d^(m-1)`` is a multiple of 512 floats, the block's rows are ``LANES`` entries more apart
 (:func:`_tb_stride`; 64 bytes a row, at most 1 KiB a call): 4 KiB apart, the sweep ran up to 12 % slower in
 some processes (memory placement) than in others. Measured one thread, old and new interleaved in one
@@ -397,12 +397,21 @@ def block_key(d: int, m: int) -> tuple:
     A variant compiles one of the two (cold, empty cache, CPU with the import, two runs interleaved with
     the code before: (6, 4) 5.9 and 5.4 s against 5.6 and 5.3, d = 4 at depth 8 6.0 and 5.4 against 6.2
     and 6.1, the run-time variant, whose code is unchanged, 5.7 and 5.2 against 5.3 and 6.0).
+
+    The run-time variant runs in place too where a row of ``T`` passes 4096 entries (32 KiB, the L1 cache):
+    there the second copy of the lower levels is memory traffic. One thread, CPU time, three process pairs,
+    in place against double-buffered: d = 10 at depth 6 (8 x 256 points) 267-273 ms against 306-323, d = 11 at
+    depth 6 302-322 against 349-376, d = 12 at depth 5 45-48 against 51, d = 8 at depth 6 31-32 against 35-36,
+    d = 6 at depth 6 27-28 against 29-31, d = 3 at depth 9 3.7-3.8 against 4.0-4.2, d = 2 at depth 14 6.3-6.5
+    against 7.1-8.0; at 4096 entries and below even or slower (d = 8 at depth 5, d = 16 and d = 10 at depth 4).
+    That variant compiles in 3.9-4.2 s (cold, numba's events; the double-buffered one 3.8 s), once, for the
+    calls that need it.
     """
     if (d, m) == (6, 4):
         return 6, 4, True
     if (d, m) in ((8, 3), (8, 4)):
         return d, m, False
-    return (4, 0, m >= 7) if d == 4 else (0, 0, False)
+    return (4, 0, m >= 7) if d == 4 else (0, 0, d ** (m - 1) > 4096)
 
 
 @variants
