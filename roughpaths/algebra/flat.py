@@ -65,17 +65,25 @@ def lyndon_flat(z: np.ndarray, dim: int, depth: int) -> np.ndarray:
     off = level_offsets(dim, depth)
     projections, starts, work = lyndon_levels(dim, depth)
     out = np.empty((z.shape[0], starts[-1]))
-    # ~5 units of SPLIT_WORK (~0.23 ns) a coordinate or map entry, and 150 a row: measured 0.07-5 us a row at d = 2-20
-    # (d = 3, depth 6: 0.62 us; d = 20, depth 3: 5.0 us), 4-6 times the count (10 times at d = 2)
-    parts = _threads.ranges(z.shape[0], 5.0 * work + 150.0, _threads.SPLIT_WORK)
-
-    def rows(lo, hi):                       # every level of rows lo .. hi-1, one hand-off in all
-        out[lo:hi, :dim] = z[lo:hi, :dim]   # level 1: every letter is a Lyndon word, its own coordinate
-        for k in range(2, depth + 1):
-            lidx, indptr, indices, data = projections[k - 1]
-            _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, starts[k - 1], lo, hi)
-    _threads.run(rows, parts)
+    parts = _threads.ranges(z.shape[0], _lyndon_work(work), _threads.SPLIT_WORK)
+    _threads.run(lambda lo, hi: _lyndon_block(z[lo:hi], out[lo:hi], dim, depth, off, projections, starts), parts)
     return out
+
+
+def _lyndon_work(work: float) -> float:
+    """A row's work in :func:`lyndon_flat`, in the units of :func:`_log_work`, from ``lyndon_levels``' count: ~5 a
+    coordinate or map entry and 150 a row (measured 0.07-5 us a row at d = 2-20: d = 3, depth 6 0.62 us; d = 20,
+    depth 3 5.0 us; 4-6 times the count, 10 times at d = 2)."""
+    return 5.0 * work + 150.0
+
+
+def _lyndon_block(z: np.ndarray, out: np.ndarray, dim: int, depth: int, off, projections, starts) -> None:
+    """``out[:n]`` <- the Lyndon coordinates of the Lie elements ``z[:n]``, ``n = len(out)``, every level."""
+    n = out.shape[0]
+    out[:, :dim] = z[:n, :dim]              # level 1: every letter is a Lyndon word, its own coordinate
+    for k in range(2, depth + 1):
+        lidx, indptr, indices, data = projections[k - 1]
+        _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, out, starts[k - 1], 0, n)
 
 
 #: Bytes of logs a thread of :func:`log_lyndon_flat` holds at once (at least one row).
@@ -98,13 +106,9 @@ def log_lyndon_flat(a: np.ndarray, dim: int, depth: int) -> np.ndarray:
         z = np.empty((min(step, hi - lo), width))
         for r0 in range(lo, hi, step):
             r1 = min(r0 + step, hi)
-            n, o = r1 - r0, out[r0:r1]
-            _k.log_rows(a[r0:r1], dim, depth, off, 0, n, z)
-            o[:, :dim] = z[:n, :dim]       # level 1: every letter is a Lyndon word, its own coordinate
-            for k in range(2, depth + 1):
-                lidx, indptr, indices, data = projections[k - 1]
-                _k.lyndon_rows(z, off[k], lidx, indptr, indices, data, o, starts[k - 1], 0, n)
-    _threads.run(rows, _threads.ranges(B, _log_work(dim, depth) + 5.0 * work + 150.0, _threads.SPLIT_WORK), merge=True)
+            _k.log_rows(a[r0:r1], dim, depth, off, 0, r1 - r0, z)
+            _lyndon_block(z, out[r0:r1], dim, depth, off, projections, starts)
+    _threads.run(rows, _threads.ranges(B, _log_work(dim, depth) + _lyndon_work(work), _threads.SPLIT_WORK), merge=True)
     return out
 
 
