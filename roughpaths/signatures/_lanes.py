@@ -287,9 +287,9 @@ def _top_rows(s, delta, do, d, ok, o, size, cur, buf, half):
 def _lane_step_d(s, delta, do, d, m, offsets, buf, top):
     """``S <- S ⊗ exp(D)`` on every lane; ``D`` is rows ``do/LANES ..`` of ``delta``.
 
-    ``T_1 .. T_{k-2}`` go through ``buf`` (two blocks of ``d^(m-2)`` rows, then room for ``d^(m-1)``); ``T_{k-1}``,
-    the largest, and the update of the top level are ``top``'s: :func:`_top_registers` or :func:`_top_rows`,
-    chosen by the kernel for its ``d``.
+    ``T_1 .. T_{k-2}`` go through ``buf`` (two blocks of ``d^(m-2)`` rows, then ``d^(m-1)`` for :func:`_top_rows`);
+    ``T_{k-1}``, the largest, and the update of the top level are ``top``'s: :func:`_top_registers` or
+    :func:`_top_rows`, chosen by the kernel for its ``d``.
     """
     L = LANES
     half = d ** max(m - 2, 1) * L
@@ -401,7 +401,7 @@ def _lane_groups_kernel(D: int, M: int):
         dim = offsets[mm + 1]
         nunits = ub.shape[0]
         s = np.empty(dim * L)
-        buf = np.empty((2 * d ** max(mm - 2, 1) + d ** max(mm - 1, 1)) * L)       # see _lane_step_d
+        buf = np.empty((2 * d ** max(mm - 2, 1) + (d ** max(mm - 1, 1) if rows4k else 0)) * L)   # _top_rows' T
         blk = np.empty(T * d * L)
         nsteps = np.zeros(L, dtype=np.int64)
         for g in range(lo, hi):

@@ -383,7 +383,7 @@ def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk,
                 neg[(t * d + i) * L + l] = 0.0
     for t in range(nt):
         do = t * d * L
-        _lane_step_d(s, neg, do, d, m, offsets, buf, top)     # S_prev = S ⊗ exp(-D)
+        _lane_step_d(s, neg, do, d, m - 1, offsets, buf, top)  # S_prev = S ⊗ exp(-D): its top level is never read
         _lane_step_vjp_d(s, g, blk, do, d, m, offsets, gn, tb, ga, gb, gdelta)
         for l in range(L):
             if t0 + t < nsteps[l]:
@@ -417,7 +417,7 @@ def _sig_vjp_groups_kernel(V: int):
         gdelta = np.empty(d * L)
         blk = np.empty(T * d * L)
         neg = np.empty(T * d * L)
-        buf = np.empty((2 * d ** max(m - 2, 1) + d ** max(m - 1, 1)) * L)         # see _lane_step_d
+        buf = np.empty((2 * d ** max(m - 2, 1) + (d ** max(m - 1, 1) if rows4k else 0)) * L)     # _top_rows' T
         nsteps = np.zeros(L, dtype=np.int64)
         for grp in range(lo, hi):
             steps = 0
