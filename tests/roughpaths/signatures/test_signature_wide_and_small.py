@@ -1,7 +1,8 @@
 """Claim: the wide (d >= 6) and small-batch kernels equal iisignature and give batch-independent bits.
 
 * ``signature`` / ``logsignature`` equal ``iisignature.sig`` / ``logsig`` to 1e-12 at d = 6, 8, 20
-  (the one-unit kernel that every d >= 6 runs) and depths 2..8 where the sizes stay small;
+  (the one-unit kernel that every d >= 6 runs) and depths 2..8 where the sizes stay small, and on the lane
+  kernel where the top level's rows are 4 KiB apart (d = 2 at depth 8, d = 4 at depth 4);
 * ``signature_vjp`` / ``logsignature_vjp`` equal ``iisignature.sigbackprop`` / ``logsigbackprop``
   at d = 6, 8 and (depth 2, the closed-form level-2 kernel) 20;
 * a path computed alone equals, bit for bit, the same path inside batches of 1..10 members (which
@@ -27,7 +28,7 @@ def _paths(rng, b, n, d):
 
 
 SIG_CASES = [(6, 2), (6, 3), (6, 4), (6, 5), (6, 6), (8, 2), (8, 3), (8, 4), (8, 5), (20, 2), (20, 3),
-             (2, 8), (3, 8)]
+             (2, 8), (3, 8), (4, 4)]     # (2, 8), (4, 4): three paths on lanes, rows of the top level 4 KiB apart
 
 
 @pytest.mark.parametrize("d,m", SIG_CASES)
