@@ -43,6 +43,8 @@ FAMILIES = {
     "jax step (sig depth 3)": ("sig jax", "jax.grad(lambda a: rj.signature(a, 3).sum())(x)"),
     # one short path: the compiled XLA handlers of roughpaths.jax (roughpaths.signatures.xla_handlers) take it
     "jax step, one path (depth 3)": ("sig jax", "jax.grad(lambda a: rj.signature(a, 3).sum())(x[0, :8])"),
+    # a deep signature: the one-unit kernel's run-time variant that updates the lower levels in place
+    "signature depth 9 (in place)": ("sig", "rp.signature(x[:2], 9)"),
     "signature_coefficients (words)": ("sig", "rp.signature_coefficients(x, [(0, 1), (2, 0, 1), (1, 1, 2, 0)])"),
     # the first job split over threads: the workers' idle and watch loops (roughpaths._threads._idle, _watch, _open) compile
     "parallel_ranges (work sharing)": ("", "from roughpaths.validation import parallel_ranges\n"
