@@ -332,7 +332,7 @@ def width_sweep(args) -> None:
         from roughpaths.signatures import _blocked, _lanes
 
         _lanes.lane_key = lambda d, m: (0, 0)
-        _blocked.block_key = lambda d, m: (0, 0, False)
+        _blocked.block_key = _blocked.runtime_key
         print("kernels general in d only: the run-time variants of the lane and blocked kernels")
     threads = numba.get_num_threads()
     ds = _int_list(args.sweep_d)

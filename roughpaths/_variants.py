@@ -20,7 +20,7 @@ from functools import wraps
 
 
 def _named(kernel, key: tuple):
-    """``kernel`` with its key in its qualified name (``block_units_variant[0, 0, False]``), before it compiles.
+    """``kernel`` with its key in its qualified name (``block_units_variant[0, 0, 0]``), before it compiles.
 
     numba names a compiled function's symbols after its qualified name and a counter of the compiling
     process, and the variants of one factory share a qualified name: two variants compiled in two

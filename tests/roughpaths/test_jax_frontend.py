@@ -358,7 +358,7 @@ def test_kernel_variants_have_their_own_symbols():
     from roughpaths.signatures import _blocked, _lanes
 
     addresses = {key: xla_handlers.kernel_address(_blocked._block_units_kernel(*key), xla_handlers.BLOCK_ARGS)
-                 for key in [(0, 0, False), (6, 4, True), (4, 0, False)]}
+                 for key in [(0, 0, 0), (6, 4, 1), (4, 0, 0)]}
     assert len(set(addresses.values())) == 3
     names = {key: _blocked._block_units_kernel(*key).overloads[xla_handlers.BLOCK_ARGS].fndesc.llvm_func_name
              for key in addresses}

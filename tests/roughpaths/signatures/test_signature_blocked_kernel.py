@@ -3,11 +3,12 @@
 * ``signature`` equals ``iisignature.sig`` to 1e-12 on paths longer than a block (so the top level, or
   at depth 2 the table of areas (``_level2``, d >= 6, 16 points a sweep),
   is added in several sweeps, the last one partial), at the compiled widths (d = 8 at depths 3/4, d = 6
-  at depth 4) and at run-time ones (d = 6 at depth 3, 7, 20; d = 4 at depth 6, a lone path; d = 3 at depth 9,
-  whose lower levels are updated in place);
+  at depth 4) and at run-time ones (d = 6 at depth 3, 7, 20; d = 4 at depth 6, a lone path; d = 3 at depth 9 and
+  d = 4 at depth 7, whose lower levels are updated in place and both top levels deferred over a block);
 * :func:`_blocked.block_units` gives the bits of the segment-by-segment kernel
   (``_lanes.scalar_units``), whatever the block and the number of segments: the deferred sweep adds
-  every product in the order of the segments;
+  every product in the order of the segments (with both top levels deferred, at (10, 5) and (17, 4): level 3's
+  289 words in chunks of 128, 128 and 33, a packed row and a lone entry);
 * a path gets the same bits in a lane group of the run-time-``d`` lane kernel (d = 6, 7 at depth 3) as
   alone in the blocked kernel, whose rows at such widths end in partial packed rows;
 * a lone path of at most 8 points (the plain one-unit kernel) gets the bits of the blocked kernel and of a lane;
@@ -26,7 +27,7 @@ from roughpaths.algebra.flat import level_offsets
 from roughpaths.signatures import _blocked, _lanes, _layout
 from roughpaths.signatures._engine import _reversed_to_rowmajor, _units
 
-CASES = [(6, 3), (6, 4), (8, 3), (8, 4), (20, 3), (7, 3), (4, 6), (7, 2), (20, 2), (3, 9)]   # depth 2: _level2
+CASES = [(6, 3), (6, 4), (8, 3), (8, 4), (20, 3), (7, 3), (4, 6), (7, 2), (20, 2), (3, 9), (4, 7)]   # depth 2: _level2
 
 #: One worker runs the module (``--dist loadgroup``): its cases compile the same wide-alphabet variants (about
 #: a minute of CPU in all), which two workers splitting the cases compiled twice, at the same time.
@@ -41,11 +42,11 @@ def test_blocked_signature_matches_iisignature(rng, d, m):
 
 
 # by default the widths whose reference kernel is the one wide-alphabet variant (step_key -1) and every scheme
-# of the blocked kernel ((6, 4) in place, (8, 3), the run-time one at partial packed rows, and in place at (10, 5),
-# where a row of the top level's T passes 4096 entries); with -m slow also
+# of the blocked kernel ((6, 4) in place, (8, 3), the run-time one at partial packed rows, and in place with both top
+# levels deferred at (10, 5) and (17, 4), where a row of the top level's T passes 4096 entries); with -m slow also
 # the reference's own variants at d = 20, 5, 4 and 3 (about 10 s of compile each; d = 4 at depth 7 is the
 # other in-place variant)
-@pytest.mark.parametrize("d,m", [(6, 4), (8, 3), (10, 3), (9, 4), (13, 2), (10, 5)]
+@pytest.mark.parametrize("d,m", [(6, 4), (8, 3), (10, 3), (9, 4), (13, 2), (10, 5), (17, 4)]
                          + [pytest.param(d, m, marks=pytest.mark.slow) for d, m in ((20, 3), (5, 3), (4, 7), (3, 5))])
 def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     n = 2 * _blocked.KBLOCK + 5
