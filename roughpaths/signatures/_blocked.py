@@ -62,7 +62,7 @@ from .._variants import variants
 
 from ._inplace import CHUNK, _unit_inplace, _unit_two
 from ._simd import LANES
-from ._sweep import KBLOCK, _row, _tb_stride, _top_sweep
+from ._sweep import KBLOCK, _increment, _row, _tb_stride, _top_sweep
 
 _NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
 
@@ -124,7 +124,6 @@ def _fused_d(lw, so, sn, delta, d, m, offsets, fac, cb, hs, tb, to):
 def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, ts, dl, delta, w, lw, ls):
     """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 2``); the
     lower levels run in ``lw`` (two copies ``ls`` apart) and are copied into ``s`` at the end."""
-    ud = np.uint64(d)
     n = np.uint64(d ** (m - 1))
     ok = offsets[m]
     for r in range(ok, s.shape[0]):
@@ -137,10 +136,7 @@ def _unit_d(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, ts, dl, delta, w, 
         nk = min(KBLOCK, k1 - t0)
         for k in range(nk):
             kk = np.uint64(k)
-            for i in range(ud):
-                v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
-                dl[kk * ud + i] = v
-                delta[i] = v
+            _increment(x, b, t0 + k, k, d, dl, delta)
             _fused_d(lw, so, sn, delta, d, m, offsets, fac, buf, hs, tb, kk * np.uint64(ts))
             so, sn = sn, so
         _top_sweep(s, ok, n, n, d, tb, ts, dl, nk, w)

@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
-from ._sweep import KBLOCK, _row_tail, _top_sweep
+from ._sweep import KBLOCK, _increment, _row_tail, _top_sweep
 
 #: Entries of level ``m - 1`` whose top-level products one pass of :func:`_unit_two` forms at a time.
 CHUNK = 128
@@ -49,6 +49,13 @@ def _fused_lower(s, delta, d, m, offsets, fac, cb, hs):
 
 
 @njit(cache=True, inline="always")
+def _top_chains(m, hs):
+    """Where :func:`_fused_lower` leaves ``C^{m-1}_{m-2}`` and ``C^m_{m-2}`` in its buffer (``(2 l + (m - 2) % 2) hs``)."""
+    par = np.uint64((m - 2) % 2)
+    return (np.uint64(2 * (m - 1)) + par) * np.uint64(hs), (np.uint64(2 * m) + par) * np.uint64(hs)
+
+
+@njit(cache=True, inline="always")
 def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, ts, dl, delta, w):
     """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s`` (depth ``m >= 3``), the lower levels
     updated in place: levels ``1..m-2`` by :func:`_fused_lower`, then level ``m - 1`` with the block's row
@@ -58,19 +65,14 @@ def _unit_inplace(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, tb, ts, dl, delt
     n1 = np.uint64(d ** (m - 2))
     ok = offsets[m]
     o1 = np.uint64(offsets[m - 1])
-    par = np.uint64((m - 2) % 2)
-    cm1 = (np.uint64(2 * (m - 1)) + par) * np.uint64(hs)
-    cm = (np.uint64(2 * m) + par) * np.uint64(hs)
+    cm1, cm = _top_chains(m, hs)
     for r in range(s.shape[0]):
         s[r] = 0.0
     for t0 in range(k0, k1, KBLOCK):
         nk = min(KBLOCK, k1 - t0)
         for k in range(nk):
             kk = np.uint64(k)
-            for i in range(ud):
-                v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
-                dl[kk * ud + i] = v
-                delta[i] = v
+            _increment(x, b, t0 + k, k, d, dl, delta)
             _fused_lower(s, delta, d, m, offsets, fac, buf, hs)
             to = kk * np.uint64(ts)
             for q in range(ud):
@@ -101,9 +103,7 @@ def _unit_two(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, cs, cst, tt, ts, dl,
     o1 = np.uint64(offsets[m - 1])
     ucst = np.uint64(cst)
     uts = np.uint64(ts)
-    par = np.uint64((m - 2) % 2)
-    cm1 = (np.uint64(2 * (m - 1)) + par) * np.uint64(hs)
-    cm = (np.uint64(2 * m) + par) * np.uint64(hs)
+    cm1, cm = _top_chains(m, hs)
     for r in range(s.shape[0]):
         s[r] = 0.0
     for t0 in range(k0, k1, KBLOCK):
@@ -111,10 +111,7 @@ def _unit_two(x, b, k0, k1, s, d, m, offsets, fac, buf, hs, cs, cst, tt, ts, dl,
         unk = np.uint64(nk)
         for k in range(nk):
             kk = np.uint64(k)
-            for i in range(ud):
-                v = x[b, t0 + k + 1, i] - x[b, t0 + k, i]
-                dl[kk * ud + i] = v
-                delta[i] = v
+            _increment(x, b, t0 + k, k, d, dl, delta)
             _fused_lower(s, delta, d, m, offsets, fac, buf, hs)
             o = 2 * kk * ucst
             for i in range(n1):

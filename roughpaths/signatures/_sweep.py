@@ -27,6 +27,18 @@ _SWEEP_CHUNK = 128
 
 
 @njit(cache=True, inline="always")
+def _increment(x, b, t, k, d, dl, delta):
+    """Segment ``t`` of path ``b`` (points ``t`` and ``t + 1``): its increment into ``delta`` and into row ``k`` of
+    the block's increments ``dl``."""
+    ud = np.uint64(d)
+    kk = np.uint64(k)
+    for i in range(ud):
+        v = x[b, t + 1, i] - x[b, t, i]
+        dl[kk * ud + i] = v
+        delta[i] = v
+
+
+@njit(cache=True, inline="always")
 def _row(y, yo, x, xo, c, z, zo, n):
     """``y[yo + p] = x[xo + p] * c + z[zo + p]`` for ``p < n``, in whole packed rows of LANES.
 
