@@ -49,8 +49,9 @@ Large cells and the machine: on a virtual machine that gives freed memory back t
 reporting; this project's machines do), a write to memory the process has not touched lately costs up to
 about 2 ms a MB, charged to whichever library allocates next. Cells whose signatures take several MB a path
 then move by 30-100 % between runs for both libraries (16 x 256 at d = 11, depth 6: pysiglib 1430 ms in one
-sweep, 3112 in another; 64 x 256 at d = 12, depth 5: ours 1.58 of pysiglib in a sweep, 0.73-0.79 alone). Time
-such a cell alone (``--sweep-d``, ``--sweep-depths``) before reading much into one sweep's ratio.
+sweep, 3112 in another; 64 x 256 at d = 12, depth 5, log-signature: ours 0.98 of pysiglib in a whole sweep, its
+signature 0.45 in the same sweep). Time such a cell alone (``--sweep-d``, ``--sweep-depths``) before reading much
+into one sweep's ratio.
 
 ``--fixed-cost`` prints only the cost of a call on tiny inputs (one path of 8 points in d = 2, 3 at
 depths 2-3, and 32 x 128 in d = 3), where the Python around the kernels is most of the time: ours,
