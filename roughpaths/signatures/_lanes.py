@@ -33,6 +33,15 @@ fit in the L1 cache, and one unit's rows are long enough to fill the vector regi
 lane group that would hold at most two units. d = 6, 7 at depth 3 run on lanes with a compile-time
 ``d`` and ``m`` (:func:`lane_key`).
 
+*The top level deferred.* In the variants with d = 3, 5, 6, 7 the top level's ``T^(k)_{m-1}`` of each segment is
+stored and added to ``S_m`` once every :data:`~roughpaths.signatures._lane_top.SUB` segments
+(:func:`_block_deferred`), each entry of ``S_m`` loaded and stored once a sweep instead of once a segment (d = 2, 4
+keep the per-segment update, whose rows 4 KiB apart :func:`~roughpaths.signatures._lane_top._top_rows` handles). The
+same bits. One thread, CPU time a unit and segment, three interleaved process pairs against the per-segment update:
+1000 x 1000 points, d = 3, depth 3 9.7-10.1 ns against 10.6-10.8; 64 x 256 points, d = 3 at depths 3/4/5/6
+11.4-13.1 / 22.8-23.3 / 54-56 / 165-179 against 13.2-13.9 / 23.8-25.2 / 60-62 / 181-190, d = 5 at depths 3/4 24-25 /
+92-104 against 26-27 / 122-125; 16 x 256 points at depth 3, d = 6 37-41 against 43-45, d = 7 47-52 against 57-59.
+
 Measured (one thread, CPU time per unit and segment, this 2-core machine): d = 3 at depths
 3/4/5 about 10/23/58 ns, d = 5 at depths 3/4/5 about 25/140/660 ns, 4-9x less than the same
 loops written with scalar lane loops. At d = 5, depth 5 the LANES signatures (250 KB) live in
@@ -46,6 +55,7 @@ from numba import njit
 
 from .._variants import variants
 
+from ._lane_top import SUB, _lane_sweep, _top_registers, _top_rows, _top_stored
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
 _NOGIL = dict(cache=True, nogil=True, no_cfunc_wrapper=True)
@@ -234,62 +244,13 @@ def step_key(d: int) -> int:
 
 
 @njit(cache=True, inline="always")
-def _top_registers(s, delta, do, d, ok, o, size, cur, buf, half):
-    """``S_lev += T_{lev-1} ⊗ D`` (level ``lev`` at ``ok``) of :func:`_lane_step_d`, ``T_{lev-1} = T_{lev-2} ⊗ D/2 +
-    S_{lev-1}`` (``T_{lev-2}``: ``size`` rows at ``cur`` in ``buf``; ``S_{lev-1}`` at ``o``) formed one row at a time in
-    registers and used at once (never stored)."""
-    L = LANES
-    f = vsplat(0.5)
-    big = size * d
-    for p in range(size):
-        t = vload(buf, cur + p * L)
-        for q1 in range(d):
-            p1 = p + q1 * size
-            sc = vmul(vload(delta, do + q1 * L), f)
-            t1 = vadd(vmul(t, sc), vload(s, o + p1 * L))
-            for q in range(d):
-                r = ok + (p1 + q * big) * L
-                vstore(s, r, vadd(vload(s, r), vmul(t1, vload(delta, do + q * L))))
-
-
-@njit(cache=True, inline="always")
-def _top_rows(s, delta, do, d, ok, o, size, cur, buf, half):
-    """:func:`_top_registers`, except where the rows of ``S_lev`` are a multiple of 4 KiB apart (``d^(lev-1)`` a
-    multiple of 64: d = 4 at level 4, d = 2 from level 7). There each row's store was followed by the load of the row
-    4 KiB on, which waits for the store (4K aliasing), so ``T_{lev-1}`` is stored in ``buf`` (after its two blocks of
-    ``T_1 .. T_{lev-2}``) and ``S_lev`` swept row by row: the same operations on every entry, the same bits.
-    16 x 256 points, one thread, CPU time, three process pairs: d = 4, depth 4 0.197-0.205 ms against 0.22-0.38
-    (the old loop's time depended on where the process placed its arrays; 64 paths 0.78-0.80 against 0.81-1.52),
-    d = 2, depth 7 0.22-0.23 against 0.27-0.36. Kernels whose ``d`` cannot have such rows (d = 3) take
-    :func:`_top_registers` instead: this loop, compiled into them, cost 0.25 s more on a first call."""
-    L = LANES
-    big = size * d
-    if (big * L) % 512 != 0:
-        _top_registers(s, delta, do, d, ok, o, size, cur, buf, half)
-        return
-    f = vsplat(0.5)
-    tt = 2 * half
-    for p in range(size):
-        t = vload(buf, cur + p * L)
-        for q1 in range(d):
-            p1 = p + q1 * size
-            sc = vmul(vload(delta, do + q1 * L), f)
-            vstore(buf, tt + p1 * L, vadd(vmul(t, sc), vload(s, o + p1 * L)))
-    for q in range(d):
-        dq = vload(delta, do + q * L)
-        r0 = ok + q * big * L
-        for p1 in range(big):
-            r = r0 + p1 * L
-            vstore(s, r, vadd(vload(s, r), vmul(vload(buf, tt + p1 * L), dq)))
-
-
-@njit(cache=True, inline="always")
 def _lane_step_d(s, delta, do, d, m, offsets, buf, top):
     """``S <- S ⊗ exp(D)`` on every lane; ``D`` is rows ``do/LANES ..`` of ``delta``.
 
     ``T_1 .. T_{k-2}`` go through ``buf`` (two blocks of ``d^(m-2)`` rows, then ``d^(m-1)`` for :func:`_top_rows`);
-    ``T_{k-1}``, the largest, and the update of the top level are ``top``'s: :func:`_top_registers` or
-    :func:`_top_rows`, chosen by the kernel for its ``d``.
+    ``T_{k-1}``, the largest, and the update of the top level are ``top``'s: :func:`_top_registers`,
+    :func:`_top_rows` or :func:`_top_stored` (the top level's ``T`` kept for a later sweep), chosen by the kernel for
+    its ``d`` (:mod:`roughpaths.signatures._lane_top`).
     """
     L = LANES
     half = d ** max(m - 2, 1) * L
@@ -338,6 +299,28 @@ def _block_d(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part, top):
                 u = g * L + l
                 for r in range(dim):
                     part[u, r] = s[r * L + l]
+
+
+@njit(cache=True, inline="always")
+def _block_deferred(s, blk, nt, t0, g, nsteps, d, m, offsets, buf, part):
+    """:func:`_block_d` with the top level deferred over :data:`~roughpaths.signatures._lane_top.SUB` segments
+    (:func:`~roughpaths.signatures._lane_top._top_stored`, then one sweep); a unit that ends is copied out after the
+    sweep of its segment (the zero increments of the segments left are an exact identity on a finite signature:
+    no entry is -0.0, whose sign adding +0.0 would change)."""
+    L = LANES
+    dim = offsets[m + 1]
+    big = d ** (m - 1)
+    base = 2 * d ** max(m - 2, 1) * L
+    for t in range(nt):
+        _lane_step_d(s, blk, t * d * L, d, m, offsets, buf, _top_stored)
+        if (t + 1) % SUB == 0 or t == nt - 1:
+            k0 = t - t % SUB
+            _lane_sweep(s, offsets[m] * L, big, d, buf, base, t + 1 - k0, blk, k0)
+            for l in range(L):
+                if k0 < nsteps[l] - t0 <= t + 1:             # unit done: copy it out
+                    u = g * L + l
+                    for r in range(dim):
+                        part[u, r] = s[r * L + l]
 
 
 @njit(cache=True, inline="always")
@@ -391,6 +374,7 @@ def _lane_groups_kernel(D: int, M: int):
     """The compiled :func:`lane_groups` of variant ``(D, M)`` (:func:`lane_key`)."""
 
     rows4k = D in (0, 2, 4)            # rows of a level 4 KiB apart can occur (d = 2, 4): :func:`_top_rows`
+    defer = D in (3, 5, 6, 7)          # the top level deferred over SUB segments (:func:`_block_deferred`)
 
     @njit(**_NOGIL)
     def lane_groups_variant(x, ub, ulo, uhi, m, offsets, lo, hi, part):
@@ -401,7 +385,8 @@ def _lane_groups_kernel(D: int, M: int):
         dim = offsets[mm + 1]
         nunits = ub.shape[0]
         s = np.empty(dim * L)
-        buf = np.empty((2 * d ** max(mm - 2, 1) + (d ** max(mm - 1, 1) if rows4k else 0)) * L)   # _top_rows' T
+        buf = np.empty((2 * d ** max(mm - 2, 1) + (d ** max(mm - 1, 1) if rows4k else 0)       # _top_rows' T
+                        + (SUB * d ** (mm - 1) if defer else 0)) * L)                        # the stored T^(k)
         blk = np.empty(T * d * L)
         nsteps = np.zeros(L, dtype=np.int64)
         for g in range(lo, hi):
@@ -416,7 +401,9 @@ def _lane_groups_kernel(D: int, M: int):
             for t0 in range(0, steps, T):
                 nt = min(T, steps - t0)
                 _gather_d(x, ub, ulo, nsteps, g, t0, nt, d, blk)
-                if rows4k:             # a branch on the variant's constant: numba compiles only the one taken
+                if defer:
+                    _block_deferred(s, blk, nt, t0, g, nsteps, d, mm, offsets, buf, part)
+                elif rows4k:           # a branch on the variant's constant: numba compiles only the one taken
                     _block_d(s, blk, nt, t0, g, nsteps, d, mm, offsets, buf, part, _top_rows)
                 else:                  # (a function held in the closure instead made numba's cache miss)
                     _block_d(s, blk, nt, t0, g, nsteps, d, mm, offsets, buf, part, _top_registers)

@@ -23,7 +23,8 @@ import numpy as np
 from numba import njit
 
 from .._variants import variants
-from ._lanes import (BLOCK, _addto, _axpy, _horner_step_d, _lane_step_d, _top_registers, _top_rows, _wide_step,
+from ._lane_top import _top_registers, _top_rows
+from ._lanes import (BLOCK, _addto, _axpy, _horner_step_d, _lane_step_d, _wide_step,
                      mul_inplace, step_key)
 from ._simd import LANES, vadd, vload, vmul, vsplat, vstore
 
@@ -399,7 +400,7 @@ def _back_block_d(x, ub, uhi, nsteps, grp, t0, nt, d, m, offsets, s, g, gn, blk,
 @variants
 def _sig_vjp_groups_kernel(V: int):
     """The compiled lane backward pass for the variant ``V`` (:func:`vjp_key`)."""
-    rows4k = V in (0, 2)               # rows of a level 4 KiB apart can occur (d = 2, 4): :func:`._lanes._top_rows`
+    rows4k = V in (0, 2)               # rows of a level 4 KiB apart can occur (d = 2, 4): :func:`._lane_top._top_rows`
 
     @njit(**_NOGIL)
     def sig_vjp_groups_variant(x, ub, ulo, uhi, m, offsets, part, gunit, lo, hi, gd):

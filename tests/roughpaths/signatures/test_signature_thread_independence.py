@@ -43,8 +43,8 @@ def test_one_thread_equals_two_threads(shape, m):
 
 @pytest.mark.parametrize("nchunks", [1, 5])
 # d <= 5, (2, 4), (6, 3) and (7, 3) specialised (lane_key); key (0, 0): the run-time variant (what d = 1
-# reaches) at d = 6
-@pytest.mark.parametrize("d,m,key", [(2, 4, None), (2, 5, None), (3, 4, None), (5, 3, None), (6, 3, None),
+# reaches) at d = 6; d = 3 defers the top level over 16 segments (units end inside such a run of segments)
+@pytest.mark.parametrize("d,m,key", [(2, 4, None), (2, 5, None), (3, 3, None), (3, 4, None), (5, 3, None), (6, 3, None),
                                      (7, 3, None), (6, 3, (0, 0))])
 def test_lanes_equal_one_unit_at_a_time_and_any_split(nchunks, d, m, key):
     # 9 paths: a group of 8 lanes and one of 1; with 5 chunks the last chunk of each path is
