@@ -38,6 +38,20 @@ def _top_registers(s, delta, do, d, ok, o, size, cur, buf, half):
 
 
 @njit(cache=True, inline="always")
+def _store_t(s, delta, do, d, o, size, cur, buf, dst):
+    """``T_{lev-1} = T_{lev-2} ⊗ D/2 + S_{lev-1}`` into ``buf`` from ``dst`` (``T_{lev-2}``: ``size`` rows at ``cur``;
+    ``S_{lev-1}`` at ``o``): the operations of :func:`_top_registers`, stored instead of used at once."""
+    L = LANES
+    f = vsplat(0.5)
+    for p in range(size):
+        t = vload(buf, cur + p * L)
+        for q1 in range(d):
+            p1 = p + q1 * size
+            sc = vmul(vload(delta, do + q1 * L), f)
+            vstore(buf, dst + p1 * L, vadd(vmul(t, sc), vload(s, o + p1 * L)))
+
+
+@njit(cache=True, inline="always")
 def _top_rows(s, delta, do, d, ok, o, size, cur, buf, half):
     """:func:`_top_registers`, except where the rows of ``S_lev`` are a multiple of 4 KiB apart (``d^(lev-1)`` a
     multiple of 64: d = 4 at level 4, d = 2 from level 7). There each row's store was followed by the load of the row
@@ -52,14 +66,8 @@ def _top_rows(s, delta, do, d, ok, o, size, cur, buf, half):
     if (big * L) % 512 != 0:
         _top_registers(s, delta, do, d, ok, o, size, cur, buf, half)
         return
-    f = vsplat(0.5)
     tt = 2 * half
-    for p in range(size):
-        t = vload(buf, cur + p * L)
-        for q1 in range(d):
-            p1 = p + q1 * size
-            sc = vmul(vload(delta, do + q1 * L), f)
-            vstore(buf, tt + p1 * L, vadd(vmul(t, sc), vload(s, o + p1 * L)))
+    _store_t(s, delta, do, d, o, size, cur, buf, tt)
     for q in range(d):
         dq = vload(delta, do + q * L)
         r0 = ok + q * big * L
@@ -78,14 +86,7 @@ def _top_stored(s, delta, do, d, ok, o, size, cur, buf, half):
     if ok + big * d * L != s.shape[0]:
         _top_registers(s, delta, do, d, ok, o, size, cur, buf, half)
         return
-    f = vsplat(0.5)
-    slot = 2 * half + (do // (d * L)) % SUB * big * L
-    for p in range(size):
-        t = vload(buf, cur + p * L)
-        for q1 in range(d):
-            p1 = p + q1 * size
-            sc = vmul(vload(delta, do + q1 * L), f)
-            vstore(buf, slot + p1 * L, vadd(vmul(t, sc), vload(s, o + p1 * L)))
+    _store_t(s, delta, do, d, o, size, cur, buf, 2 * half + (do // (d * L)) % SUB * big * L)
 
 
 @njit(cache=True, inline="always")
