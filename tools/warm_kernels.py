@@ -85,6 +85,7 @@ def warm_more_signatures() -> None:
     rp.signature(_walk(rng, 9, 700, 7), 3)                 # the lanes' (7, 3) variant
     rp.signature(_walk(rng, 9, 700, 1), 3)                 # the lanes' run-time variant (d = 1 reaches it)
     rp.signature(_walk(rng, 2, 39, 3), 9)                  # the one-unit kernel in place at a run-time d
+    rp.signature(_walk(rng, 2, 39, 4), 7)                  # the one-unit kernel in place at d = 4 (a test's variant)
     X = rp.RoughPath.from_path(_walk(rng, 10, 9, 3))
     for m in (2, 3):
         s = rp.rough_path_signature(X, m)

@@ -230,7 +230,7 @@ def _block_units_kernel(D: int, M: int, LOWER: int):
         for k in range(1, mm + 1):
             fac[k] = 1.0 / k
         cst = (d ** (mm - 2) + 2 * L - 1) // L * L if LOWER == 2 else 0
-        cs = np.zeros(2 * rows * cst)                           # the block's chains (_unit_two)
+        cs = np.empty(2 * rows * cst)                           # the block's chains (_unit_two: read where written)
         tts = _tb_stride(CHUNK)
         tt = np.zeros(rows * tts + L if LOWER == 2 else 1)      # a chunk of the block's T (_unit_two)
         for u in range(lo, hi):
