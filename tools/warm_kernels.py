@@ -81,6 +81,7 @@ def warm_more_signatures() -> None:
             rp.logsignature(x, m)
             rp.signature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.sigdim(np.shape(x)[-1], m),)))
             rp.logsignature_vjp(x, m, np.ones(np.shape(x)[:-2] + (rp.logsigdim(np.shape(x)[-1], m),)))
+    rp.signature(lone, 4)                                  # the one-unit kernel's run-time variant (depth 3: its own)
     rp.signature(_walk(rng, 2 * 8192 + 8, 3), 2)           # level 2, chunked
     rp.signature(_walk(rng, 9, 700, 7), 3)                 # the lanes' (7, 3) variant
     rp.signature(_walk(rng, 9, 700, 1), 3)                 # the lanes' run-time variant (d = 1 reaches it)

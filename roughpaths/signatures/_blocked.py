@@ -44,13 +44,11 @@ process, 8 processes: 64 x 256 points, d = 8 depth 4 6.1-7.1 ms against 6.4-7.9 
 Measured (one thread, CPU time, this 2-core machine): the sweep 0.14-0.17 ns per entry and
 segment (the rank-one update: 0.31; two packed multiplies and two packed adds a cycle give
 0.125 at 2 GHz; tiles of 2 packed rows x 4 rows: 0.04-0.06); per segment (16 x 256 points, one
-thread, interleaved with pysiglib 4.0 ``n_jobs=1``) d = 8 depth 3 58 ns (pysiglib 130), depth 4
-450-500 (590-890), d = 6 depth 4 200-230 (300), d = 20 depth 3 780 (2000). d = 8 at depths 3 and
-4 and d = 6 at depth 4 are compiled with constant ``d`` and ``m`` (loops unrolled: at d = 8, depth 3
-58 ns a segment against 85 with a run-time ``d``), d = 4 with a constant ``d``; every other width runs
-the run-time variant. Compile
-cost (cold, empty cache, one variant, CPU, with the import): 4.6 s for the run-time variant (2.8 s
-before the packed row ends and the 2 x 4 tiles), 4.0 s for (8, 3) (2.5 s).
+thread, interleaved with pysiglib 4.0 ``n_jobs=1``) d = 8 depth 4 450-500 ns (pysiglib 590-890), d = 6 depth 4
+200-230 (300). d = 8 and d = 6 at depth 4 are compiled with constant ``d`` and ``m`` (loops unrolled), d = 4 with a
+constant ``d``; every other width runs a run-time variant, and depth 3 its own
+(:mod:`roughpaths.signatures._depth3`: level 2 transposed). Compile cost (cold, empty cache, one variant, CPU, with
+the import): 4.6 s for the run-time variant (2.8 s before the packed row ends and the 2 x 4 tiles).
 """
 
 from __future__ import annotations
@@ -60,6 +58,7 @@ from numba import njit
 
 from .._variants import variants
 
+from ._depth3 import _unit_3
 from ._inplace import CHUNK, _unit_inplace, _unit_two
 from ._simd import LANES
 from ._sweep import KBLOCK, _increment, _row, _tb_stride, _top_sweep
@@ -148,14 +147,15 @@ def block_key(d: int, m: int) -> tuple:
     """``(D, M, LOWER)``: the compile-time alphabet size and depth of the one-unit kernel's variant (0: at run time),
     and how it updates the lower levels (``LOWER``: 0 double-buffered, :func:`_unit_d`; 1 in place,
     :func:`~roughpaths.signatures._inplace._unit_inplace`; 2 in place with levels ``m - 1`` and ``m`` both deferred
-    over a block, :func:`~roughpaths.signatures._inplace._unit_two`). The same bits in every variant.
+    over a block, :func:`~roughpaths.signatures._inplace._unit_two`; 3 at depth 3, level 2 transposed,
+    :func:`~roughpaths.signatures._depth3._unit_3`). The same bits in every variant.
 
     Compile-time widths (and depths) let LLVM unroll the loops over the letters and the levels:
-    (d, m) = (8, 3) (the lower levels 40 against 57 ns a segment), (8, 4) and (6, 4) (cells (d) and (h)
-    of ``benchmarks/bench_signatures.py``: the run-time variant measured 10 % and 15-25 % slower there),
-    and d = 4 at any depth. Every other width runs the run-time variant (:func:`runtime_key`): (20, 3) had a variant
-    of its own until the run-time one came within 5-8 % of it (cell (e)). Each variant is its own kernel,
-    compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
+    (d, m) = (8, 4) and (6, 4) (cells (d) and (h) of ``benchmarks/bench_signatures.py``: the run-time variant
+    measured 10 % and 15-25 % slower there), and d = 4 at any depth. Every other width runs a run-time variant
+    (:func:`runtime_key`): (20, 3) had a variant of its own until the run-time one came within 5-8 % of it (cell
+    (e)), and (8, 3) until the depth-3 variant passed it (53 ns a segment against 59-60). Each variant is its own
+    kernel, compiled on first use (a few seconds of CPU, then cached), so a call compiles only the one it runs.
 
     In place (the same bits): (6, 4) and d = 4 from depth 7. There the double buffer's second copy of the lower
     levels, its zeroing and its copy-out cost more than the rows that end one entry at a time: measured (one thread,
@@ -168,18 +168,27 @@ def block_key(d: int, m: int) -> tuple:
     """
     if (d, m) == (6, 4):
         return 6, 4, 1
-    if (d, m) in ((8, 3), (8, 4)):
-        return d, m, 0
+    if (d, m) == (8, 4):
+        return 8, 4, 0
     if d == 4:
         return 4, 0, 1 if m >= 7 else 0
     return runtime_key(d, m)
 
 
 def runtime_key(d: int, m: int) -> tuple:
-    """:func:`block_key` of the run-time variant: double-buffered, or in place with both top levels deferred where a
-    row of ``T`` passes 4096 entries (32 KiB, the L1 cache) at depth 3 or more.
+    """:func:`block_key` of the run-time variants: at depth 3, level 2 transposed (``LOWER`` 3,
+    :func:`~roughpaths.signatures._depth3._unit_3`); deeper, double-buffered, or in place with both top levels deferred
+    where a row of ``T`` passes 4096 entries (32 KiB, the L1 cache).
 
-    There the second copy of the lower levels is memory traffic, and so is the block's ``T`` (16 rows of
+    Depth 3 (``(0, 3, 3)``): at d = 10 the double-buffered kernel spent about half its time on levels 1 and 2 (68 ns
+    a segment of 123, the kernel alone, against ~20 by their operation count). One thread, ns a segment, 16 x 256
+    points, ``signature``, three interleaved process pairs: d = 8 53 against 59-60 (the (8, 3) variant), d = 9 92-95
+    against 115-121, d = 10 108-111 against 128-134, d = 11 144-145 against 171-178, d = 12 141-142 against 165,
+    d = 13 199-202 against 232-237, d = 14 283-294 against 312-321, d = 16 394-405 against 425-433, d = 20 553-556
+    against 579-594; the same bits. Compile (cold, the first call at d = 10 / d = 8): 4.6 / 4.3-4.7 s against
+    5.2-5.5 / 4.6-4.8 (the run-time and (8, 3) variants).
+
+    Deeper, where a row of ``T`` passes 4096 entries, the second copy of the lower levels is memory traffic, and so is the block's ``T`` (16 rows of
     ``d^(m-1)`` entries, written and read back: 12.8 MB at d = 10, depth 6, more than the signature's top level):
     :func:`~roughpaths.signatures._inplace._unit_two` keeps only the chains of level ``m - 2`` for the block and forms
     ``T`` a chunk at a time in the L1 cache. One thread, CPU time, 4 x 256 points, three interleaved process pairs,
@@ -190,6 +199,8 @@ def runtime_key(d: int, m: int) -> tuple:
     10.2-10.3; the same bits (hashed: signatures, log-signatures, VJPs; one and two threads). At 4096 entries and
     below (d = 8 at depth 5, d = 16, 12, 10 at depth 4, d = 5 at depth 6) in place was even or slower.
     """
+    if m == 3:
+        return 0, 3, 3
     return 0, 0, 2 if m >= 3 and d ** (m - 1) > 4096 else 0
 
 
@@ -218,14 +229,14 @@ def _block_units_kernel(D: int, M: int, LOWER: int):
         for u in range(lo, hi):
             most = max(most, uhi[u] - ulo[u])
         rows = min(KBLOCK, most)
-        n1 = d ** (mm - 1) if LOWER < 2 else 1
+        n1 = d ** (mm - 1) if LOWER != 2 else 1
         ts = _tb_stride(n1)
         tb = np.empty(rows * ts + L)                            # the block's T (a short path's: its segments)
         for r in range(rows):
             tb[r * ts + n1:r * ts + n1 + L] = 0.0
         w = np.zeros((d + 3) * 4 * LANES)                       # the rows' ends (_top_sweep)
         dl = np.zeros(KBLOCK * d + 3)
-        delta = np.empty(d)
+        delta = np.zeros(d + L)                                 # (zero past d: _unit_3's packed rows)
         fac = np.empty(mm + 1)
         for k in range(1, mm + 1):
             fac[k] = 1.0 / k
@@ -233,8 +244,13 @@ def _block_units_kernel(D: int, M: int, LOWER: int):
         cs = np.empty(2 * rows * cst)                           # the block's chains (_unit_two: read where written)
         tts = _tb_stride(CHUNK)
         tt = np.zeros(rows * tts + L if LOWER == 2 else 1)      # a chunk of the block's T (_unit_two)
+        r2 = (d + L - 1) // L * L
+        lw3 = np.empty(r2 * (d + 1) if LOWER == 3 else 1)         # _unit_3's levels 1 and 2 (transposed)
+        sp = np.empty(d ** 3 if LOWER == 3 else 1)                # and its level 3
         for u in range(lo, hi):
-            if LOWER == 2:
+            if LOWER == 3:
+                _unit_3(x, ub[u], ulo[u], uhi[u], part[u], d, fac, tb, ts, dl, delta, w, lw3, r2, sp)
+            elif LOWER == 2:
                 _unit_two(x, ub[u], ulo[u], uhi[u], part[u], d, mm, offsets, fac, buf, hs, cs, cst, tt, tts, dl, delta,
                           w)
             elif LOWER == 1:

@@ -358,12 +358,13 @@ def test_kernel_variants_have_their_own_symbols():
     from roughpaths.signatures import _blocked, _lanes
 
     addresses = {key: xla_handlers.kernel_address(_blocked._block_units_kernel(*key), xla_handlers.BLOCK_ARGS)
-                 for key in [(0, 0, 0), (6, 4, 1), (4, 0, 0)]}
-    assert len(set(addresses.values())) == 3
+                 for key in [(0, 0, 0), (0, 3, 3), (6, 4, 1), (4, 0, 0)]}
+    assert len(set(addresses.values())) == 4
     names = {key: _blocked._block_units_kernel(*key).overloads[xla_handlers.BLOCK_ARGS].fndesc.llvm_func_name
              for key in addresses}
-    assert len(set(names.values())) == 3
-    assert xla_handlers.kernels(200, 7, 3, False)[0] == addresses[0, 0, False]     # the engine's blocked kernel
+    assert len(set(names.values())) == 4
+    assert xla_handlers.kernels(200, 7, 4, False)[0] == addresses[0, 0, 0]         # the engine's blocked kernels
+    assert xla_handlers.kernels(200, 7, 3, False)[0] == addresses[0, 3, 3]
     assert xla_handlers.kernels(8, 7, 3, False)[0] == xla_handlers.kernel_address(     # a short path: the plain one
         _lanes.scalar_units(7), xla_handlers.BLOCK_ARGS)
 

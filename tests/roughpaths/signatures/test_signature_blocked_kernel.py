@@ -8,7 +8,8 @@
 * :func:`_blocked.block_units` gives the bits of the segment-by-segment kernel
   (``_lanes.scalar_units``), whatever the block and the number of segments: the deferred sweep adds
   every product in the order of the segments (with both top levels deferred, at (10, 5) and (17, 4): level 3's
-  289 words in chunks of 128, 128 and 33, a packed row and a lone entry);
+  289 words in chunks of 128, 128 and 33, a packed row and a lone entry; at depth 3 with level 2 and the sweep
+  transposed, rows of one, two and three packed rows);
 * a path gets the same bits in a lane group of the run-time-``d`` lane kernel (d = 6, 7 at depth 3) as
   alone in the blocked kernel, whose rows at such widths end in partial packed rows;
 * a lone path of at most 8 points (the plain one-unit kernel) gets the bits of the blocked kernel and of a lane;
@@ -42,11 +43,12 @@ def test_blocked_signature_matches_iisignature(rng, d, m):
 
 
 # by default the widths whose reference kernel is the one wide-alphabet variant (step_key -1) and every scheme
-# of the blocked kernel ((6, 4) in place, (8, 3), the run-time one at partial packed rows, and in place with both top
-# levels deferred at (10, 5) and (17, 4), where a row of the top level's T passes 4096 entries); with -m slow also
+# of the blocked kernel ((6, 4) in place; depth 3 with level 2 transposed, its rows of one (d = 8), two (d = 10) and
+# three packed rows (d = 17); the run-time one at partial packed rows, and in place with both top levels deferred
+# at (10, 5) and (17, 4), where a row of the top level's T passes 4096 entries); with -m slow also
 # the reference's own variants at d = 20, 5, 4 and 3 (about 10 s of compile each; d = 4 at depth 7 is the
 # other in-place variant)
-@pytest.mark.parametrize("d,m", [(6, 4), (8, 3), (10, 3), (9, 4), (13, 2), (10, 5), (17, 4)]
+@pytest.mark.parametrize("d,m", [(6, 4), (8, 3), (10, 3), (17, 3), (9, 4), (13, 2), (10, 5), (17, 4)]
                          + [pytest.param(d, m, marks=pytest.mark.slow) for d, m in ((20, 3), (5, 3), (4, 7), (3, 5))])
 def test_blocked_bits_equal_the_segment_kernel(rng, d, m):
     n = 2 * _blocked.KBLOCK + 5
