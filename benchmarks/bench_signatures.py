@@ -53,13 +53,17 @@ sweep, 3112 in another; 64 x 256 at d = 12, depth 5, log-signature: ours 0.98 of
 signature 0.45 in the same sweep). Time such a cell alone (``--sweep-d``, ``--sweep-depths``) before reading much
 into one sweep's ratio.
 
+``--bars`` is the done-when of issue 41 in one run: the peer table (d)-(h), the cases (a)-(c) and the width sweep
+(with its options), in one process, then every cell against its bar (1.0 on one thread, 1.1 with all threads) and
+the cells above it.
+
 ``--fixed-cost`` prints only the cost of a call on tiny inputs (one path of 8 points in d = 2, 3 at
 depths 2-3, and 32 x 128 in d = 3), where the Python around the kernels is most of the time: ours,
 iisignature and pysiglib on one thread, CPU time, medians of interleaved calls, and the ratios.
 
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
 [--depths 3,4] [--only-streams] [--sweep [--sweep-d 2-20] [--sweep-depths 2-6] [--sweep-batches 16,64]
-[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6] [--sweep-general]] [--fixed-cost]`` (the cells, kinds and depths
+[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6] [--sweep-general]] [--bars] [--fixed-cost]`` (the cells, kinds and depths
 select peer-table cells and skip the rest).
 """
 
@@ -259,6 +263,7 @@ def peer_table(cases: dict, args, rng) -> None:
     print("time ratio = ours / pysiglib (below 1: ours faster); ms; 1t: numba.set_num_threads(1) against "
           f"n_jobs=1, CPU time; {threads}t: our default threads against n_jobs=-1, wall time")
     print(head)
+    ratios = []
     for name, (x, depths, kinds) in cases.items():
         nb = int(np.prod(x.shape[:-2]))
         n, d = x.shape[-2:]
@@ -306,7 +311,62 @@ def peer_table(cases: dict, args, rng) -> None:
                     floor = f"{'':>9}{'':>9}"
                 print(f"{name:<24}{kind:<9}{m:>4}{1e3 * t_o1:>10.3f}{1e3 * t_p1:>10.3f}{t_o1 / t_p1:>9.2f}"
                       f"{1e3 * t_on:>10.3f}{1e3 * t_pn:>10.3f}{t_on / t_pn:>7.2f}{floor}{err:>10.1e}", flush=True)
+                ratios.append((f"{name} depth {m} {kind}", t_o1 / t_p1, t_on / t_pn))
     print()
+    return ratios
+
+
+def earlier_cases(cases: dict, args) -> list:
+    """The cases (a)-(c) of the earlier runs, levels 2-5, signature and log-signature, all threads (wall time),
+    against pysiglib and iisignature; returns ``(cell, ratio to pysiglib)``."""
+    import iisignature
+    import pysiglib
+
+    from roughpaths import logsignature, signature
+
+    ratios = []
+    print("the cases of the earlier runs (all threads, wall time)")
+    print("time ratio = ours / peer (below 1: ours faster)\n")
+    head = (f"{'case':<22}{'lvl':>4}{'':>2}{'ours':>10}{'pysiglib':>10}{'iisig':>10}"
+            f"{'ratio/pysiglib':>16}{'ratio/iisig':>13}{'max |ours-iisig|':>18}")
+    for kind in ("signature", "log-signature"):
+        print(kind)
+        print(head)
+        for name, x in cases.items():
+            d = x.shape[-1]
+            for m in (2, 3, 4, 5):
+                if kind == "signature":
+                    ours = lambda: signature(x, m)
+                    peer = lambda: pysiglib.sig(x, m, n_jobs=-1)
+                    ii = lambda: iisignature.sig(x, m)
+                else:
+                    pysiglib.prepare_log_sig(d, m, method=2)
+                    prep = iisignature.prepare(d, m)
+                    ours = lambda: logsignature(x, m)
+                    peer = lambda: pysiglib.log_sig(x, m, method=2, n_jobs=-1)
+                    ii = lambda: iisignature.logsig(x, prep)
+                t_o, t_p, t_i = interleaved_medians((ours, peer, ii), args.repeats)
+                ref = ii()
+                err = float(np.max(np.abs(ours() - ref)) / max(1.0, float(np.max(np.abs(ref)))))
+                ratios.append((f"{name} depth {m} {kind}", t_o / t_p))
+                print(f"{name:<22}{m:>4}{'':>2}{1e3 * t_o:>10.2f}{1e3 * t_p:>10.2f}{1e3 * t_i:>10.2f}"
+                      f"{t_o / t_p:>16.2f}{t_o / t_i:>13.2f}{err:>18.1e}", flush=True)
+        print()
+    return ratios
+
+
+def bars(table: list, earlier: list, sweep: list) -> None:
+    """Issue 41's done-when over one run's cells: every one-thread ratio <= 1.0 and every all-threads one <= 1.1
+    (the cases (a)-(c) are timed with all threads only)."""
+    one = [(r, c) for c, r, _ in table + sweep if r is not None]
+    many = [(r, c) for c, _, r in table + sweep if r is not None] + [(r, c) for c, r in earlier]
+    over1 = sorted(((r, c) for r, c in one if r > 1.0), reverse=True)
+    over_n = sorted(((r, c) for r, c in many if r > 1.1), reverse=True)
+    print(f"done-when bars, this run (load average at the end {os.getloadavg()[0]:.1f}): {len(one)} one-thread cells, "
+          f"worst {max(one)[0]:.2f} ({max(one)[1]}); {len(many)} all-threads cells, worst {max(many)[0]:.2f} "
+          f"({max(many)[1]})")
+    print(f"  above 1.0 on one thread ({len(over1)}): {'; '.join(f'{c} {r:.2f}' for r, c in over1) or 'none'}")
+    print(f"  above 1.1 with all threads ({len(over_n)}): {'; '.join(f'{c} {r:.2f}' for r, c in over_n) or 'none'}")
 
 
 def _int_list(text: str) -> list:
@@ -359,7 +419,7 @@ def width_sweep(args) -> None:
           f"n_jobs=1, CPU time; {threads}t: default threads against n_jobs=-1, wall time)")
     print(f"{'batch':>8}{'d':>4}{'lvl':>4}  {'what':<9}{'ours 1t':>10}{'peer 1t':>10}{'ratio 1t':>9}"
           f"{'ours ' + str(threads) + 't':>10}{'peer -1':>10}{'ratio':>7}")
-    skipped, over1, over_n, worst = [], [], [], []
+    skipped, over1, over_n, worst, ratios = [], [], [], [], []
     for nb in batches:
         for d in ds:
             x = np.cumsum(rng.standard_normal((nb, 256, d)), axis=-2) / 16
@@ -389,6 +449,7 @@ def width_sweep(args) -> None:
                         finally:
                             numba.set_num_threads(threads)
                         r1 = t_o1 / t_p1
+                        ratios.append((f"sweep {nb}x256 d={d} depth {m} {kind}", r1, None))
                         row += f"{1e3 * t_o1:>10.3f}{1e3 * t_p1:>10.3f}{r1:>9.2f}"
                         worst.append((r1, f"{nb}x256 d={d} depth {m}", kind))
                         if r1 > 1.0:
@@ -398,6 +459,7 @@ def width_sweep(args) -> None:
                     if "n" in modes:
                         t_on, t_pn = timed((ours, lambda: peer(-1)), time.perf_counter)
                         rn = t_on / t_pn
+                        ratios.append((f"sweep {nb}x256 d={d} depth {m} {kind}", None, rn))
                         row += f"{1e3 * t_on:>10.3f}{1e3 * t_pn:>10.3f}{rn:>7.2f}"
                         if rn > 1.1:
                             over_n.append(f"{nb}x256 d={d} depth {m} {kind}: {rn:.2f}")
@@ -411,6 +473,7 @@ def width_sweep(args) -> None:
         r, where, kind = max(worst)
         print(f"worst one-thread ratio: {r:.2f} ({where} {kind})")
     print()
+    return ratios
 
 
 def main() -> None:
@@ -433,6 +496,9 @@ def main() -> None:
                         help="sweep with the run-time (general in d) kernel variants only")
     parser.add_argument("--sweep-max-sigdim", type=float, default=2e6,
                         help="skip sweep cells with more signature floats per path")
+    parser.add_argument("--bars", action="store_true",
+                        help="issue 41's done-when in one run: the peer table, the cases (a)-(c) and the width sweep, "
+                             "then every cell against its bar")
     parser.add_argument("--fixed-cost", action="store_true",
                         help="print the per-call cost on small inputs only (against iisignature and pysiglib)")
     args = parser.parse_args()
@@ -485,35 +551,13 @@ def main() -> None:
     threads = numba.get_num_threads()
     print(f"numba threads {threads}, cpu count {os.cpu_count()}, load average {os.getloadavg()[0]:.1f}, "
           f"median of {args.repeats} interleaved pairs; times in ms\n")
-    peer_table(wide, args, rng)
-    if args.only_peer_table:
+    table = peer_table(wide, args, rng)
+    if args.only_peer_table and not args.bars:
         return
-    print("the cases of the earlier runs (all threads, wall time)")
-    print("time ratio = ours / peer (below 1: ours faster)\n")
-    head = (f"{'case':<22}{'lvl':>4}{'':>2}{'ours':>10}{'pysiglib':>10}{'iisig':>10}"
-            f"{'ratio/pysiglib':>16}{'ratio/iisig':>13}{'max |ours-iisig|':>18}")
-    for kind in ("signature", "log-signature"):
-        print(kind)
-        print(head)
-        for name, x in cases.items():
-            d = x.shape[-1]
-            for m in (2, 3, 4, 5):
-                if kind == "signature":
-                    ours = lambda: signature(x, m)
-                    peer = lambda: pysiglib.sig(x, m, n_jobs=-1)
-                    ii = lambda: iisignature.sig(x, m)
-                else:
-                    pysiglib.prepare_log_sig(d, m, method=2)
-                    prep = iisignature.prepare(d, m)
-                    ours = lambda: logsignature(x, m)
-                    peer = lambda: pysiglib.log_sig(x, m, method=2, n_jobs=-1)
-                    ii = lambda: iisignature.logsig(x, prep)
-                t_o, t_p, t_i = interleaved_medians((ours, peer, ii), args.repeats)
-                ref = ii()
-                err = float(np.max(np.abs(ours() - ref)) / max(1.0, float(np.max(np.abs(ref)))))
-                print(f"{name:<22}{m:>4}{'':>2}{1e3 * t_o:>10.2f}{1e3 * t_p:>10.2f}{1e3 * t_i:>10.2f}"
-                      f"{t_o / t_p:>16.2f}{t_o / t_i:>13.2f}{err:>18.1e}", flush=True)
-        print()
+    earlier = earlier_cases(cases, args)
+    if args.bars:
+        bars(table, earlier, width_sweep(args))
+        return
 
     # gradients, depth 4 on (b)
     x = cases["(b) 1000 x 1000, d=3"]
