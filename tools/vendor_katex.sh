@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Vendor KaTeX (the npm package `katex`, pinned below) into docs/assets/vendor/katex/ so that the
 # documentation site typesets its mathematics with no CDN. Idempotent: does nothing when the pinned
-# version is already there. Needs npm (Node.js); the folder is gitignored.
+# version is already there (its VERSION, script and style sheet: a folder missing either is vendored again).
+# Needs npm (Node.js); the folder is gitignored.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 KATEX_VERSION=0.16.22
 DEST=docs/assets/vendor/katex
-if [ -f "$DEST/VERSION" ] && [ "$(cat "$DEST/VERSION")" = "$KATEX_VERSION" ]; then
+if [ -f "$DEST/VERSION" ] && [ "$(cat "$DEST/VERSION")" = "$KATEX_VERSION" ] \
+        && [ -f "$DEST/katex.min.js" ] && [ -f "$DEST/katex.min.css" ]; then
     exit 0
 fi
 if ! command -v npm >/dev/null 2>&1; then
