@@ -32,7 +32,7 @@ FAMILIES = {
     "signature depth 2-4": ("sig", "rp.signature(x, 2); rp.signature(x, 3); rp.signature(x, 4)"),
     "logsignature depth 4": ("sig", "rp.logsignature(x, 4)"),
     "signature_vjp depth 4": ("sig", "rp.signature_vjp(x, 4, np.ones((16, rp.sigdim(3, 4))))"),
-    # one path: the one-unit kernels (forward and backward), not the lanes
+    # one path: the one-unit kernels (forward: the blocked kernel's depth-3 variant; backward), not the lanes
     "signature_vjp, one path": ("sig", "rp.signature_vjp(x[0], 3, np.ones(rp.sigdim(3, 3)))"),
     # two paths of 2100 points: each cut into work units, whose cotangents a kernel of their own glues first
     "signature_vjp, long paths": ("sig", "xl = np.cumsum(rng.standard_normal((2, 2100, 3)), axis=1) * 0.01\n"

@@ -63,8 +63,8 @@ iisignature and pysiglib on one thread, CPU time, medians of interleaved calls, 
 
 Usage: ``python benchmarks/bench_signatures.py [--repeats 5] [--quick] [--cells d,e] [--kinds sig,logsig]
 [--depths 3,4] [--only-streams] [--sweep [--sweep-d 2-20] [--sweep-depths 2-6] [--sweep-batches 16,64]
-[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6] [--sweep-general]] [--bars] [--fixed-cost]`` (the cells, kinds and depths
-select peer-table cells and skip the rest).
+[--sweep-kinds sig,logsig] [--sweep-modes 1,n] [--sweep-max-sigdim 2e6] [--sweep-general]] [--bars]
+[--fixed-cost]`` (the cells, kinds and depths select peer-table cells and skip the rest).
 """
 
 from __future__ import annotations

@@ -186,10 +186,12 @@ def runtime_key(d: int, m: int) -> tuple:
     against 115-121, d = 10 108-111 against 128-134, d = 11 144-145 against 171-178, d = 12 141-142 against 165,
     d = 13 199-202 against 232-237, d = 14 283-294 against 312-321, d = 16 394-405 against 425-433, d = 20 553-556
     against 579-594; the same bits. Compile (cold, the first call at d = 10 / d = 8): 4.6 / 4.3-4.7 s against
-    5.2-5.5 / 4.6-4.8 (the run-time and (8, 3) variants).
+    5.2-5.5 / 4.6-4.8 (the run-time and (8, 3) variants); ``benchmarks/bench_first_call.py``'s cell "signature_vjp,
+    one path" compiles it (its forward pass).
 
-    Deeper, where a row of ``T`` passes 4096 entries, the second copy of the lower levels is memory traffic, and so is the block's ``T`` (16 rows of
-    ``d^(m-1)`` entries, written and read back: 12.8 MB at d = 10, depth 6, more than the signature's top level):
+    Deeper, where a row of ``T`` passes 4096 entries, the second copy of the lower levels is memory traffic, and so is
+    the block's ``T`` (16 rows of ``d^(m-1)`` entries, written and read back: 12.8 MB at d = 10, depth 6, more than the
+    signature's top level):
     :func:`~roughpaths.signatures._inplace._unit_two` keeps only the chains of level ``m - 2`` for the block and forms
     ``T`` a chunk at a time in the L1 cache. One thread, CPU time, 4 x 256 points, three interleaved process pairs,
     against the code before (one level deferred in place here, which had measured against double-buffered: d = 10 at

@@ -97,8 +97,8 @@ def _unit_3(x, b, k0, k1, s, d, fac, tb, ts, dl, delta, w, lw, r2, sp):
     """Signature (reversed layout) of points ``k0..k1`` of path ``b`` into ``s``, depth 3.
 
     ``lw``: level 1 (``r2`` entries) then level 2 transposed, row ``i`` at ``r2 (1 + i)`` (``r2``: ``d`` rounded up
-    to whole packed rows); ``sp``: level 3 transposed in its first two letters (``d^3`` entries); ``delta`` and
-    ``dl`` zero past their last entry up to a packed row (the lanes past ``d`` then stay zero in ``lw``).
+    to whole packed rows); ``sp``: level 3 transposed in its first two letters (``d^3`` entries); ``delta`` zero
+    past its ``d`` entries up to a packed row (the lanes past ``d`` then stay zero in ``lw``).
     """
     L = np.uint64(LANES)
     ud = np.uint64(d)

@@ -50,7 +50,8 @@ def _fused_lower(s, delta, d, m, offsets, fac, cb, hs):
 
 @njit(cache=True, inline="always")
 def _top_chains(m, hs):
-    """Where :func:`_fused_lower` leaves ``C^{m-1}_{m-2}`` and ``C^m_{m-2}`` in its buffer (``(2 l + (m - 2) % 2) hs``)."""
+    """Where :func:`_fused_lower` leaves ``C^{m-1}_{m-2}`` and ``C^m_{m-2}`` in its buffer
+    (``(2 l + (m - 2) % 2) hs``)."""
     par = np.uint64((m - 2) % 2)
     return (np.uint64(2 * (m - 1)) + par) * np.uint64(hs), (np.uint64(2 * m) + par) * np.uint64(hs)
 
