@@ -53,11 +53,11 @@ tree itself (see :mod:`roughpaths.drivers.tree`); the error estimate (of the rig
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
 from ._attempts import _advance_nb, _doubling_nb, _judge_nb, _ratios_nb, _snap_nb
+from .step_control import _checked_init, _checked_ratios, _checked_steps, _checked_verdict
 
 __all__ = []
 
@@ -81,18 +81,6 @@ def _step_doubling(solver, fields, y, a):
     y2 = solver.integrate(fields, y, a.times, a.dX, a.dXX, a.save, stop_on_failure=a.stop)[0]
     return y2, solver.integrate(fields, y, a.times[..., [0, -1]], DX2[n:, None], DXX2[n:, None], a.save[:1],
                                 stop_on_failure=False)[0]
-
-
-def _one_each(value, n, dtype, what):
-    """``value`` as a contiguous ``(n,)`` array of ``dtype`` for the compiled bookkeeping (no bounds checks there):
-    one entry for all is repeated, as numpy broadcast it; another count is refused, naming ``what``."""
-    v = np.asarray(value, dtype=dtype)
-    if v.shape == (n,) and v.flags.c_contiguous:
-        return v
-    if v.size != 1:
-        raise ValueError(f"{what} has {v.size} entries for {n} lane(s) or member(s); give one each, shape ({n},), "
-                         f"or one for all.")
-    return np.full(n, v.reshape(-1)[0], dtype=dtype)
 
 
 class _Attempt:
@@ -139,22 +127,7 @@ class _TreeSteps:
         self.paths = np.broadcast_to(np.arange(tree.n_paths).reshape(tree.batch_shape), run.batch).ravel()
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
         order = solver.error_order if solver.error_order is not None else solver.order
-        self.state = control.init(t0, t1, n, order)
-        if not isinstance(self.state, dict) or "h" not in self.state:     # else a bare KeyError or TypeError below
-            raise TypeError(f"{type(control).__name__}.init returned {type(self.state).__name__}"
-                            f"{' without the key h' if isinstance(self.state, dict) else ''}; it must return a fresh "
-                            f"dict holding at least 'h', the first step of each of the {n} lane(s) (contract item 2).")
-        dt_min = control.dt_min(T)
-        if isinstance(dt_min, (bool, np.bool_)) or not isinstance(dt_min, (numbers.Real, np.floating, np.integer)) \
-                or not 0 <= dt_min < math.inf:         # the cell count below is ceil(dt_min / cell)
-            raise ValueError(f"{type(control).__name__}.dt_min({T!r}) returned {dt_min!r}; the smallest step must be a "
-                             f"finite number >= 0 (contract item 5; StepController's default is span * 2**-30).")
-        self.dt_min = float(dt_min)
-        dt_max = control.dt_max(T)
-        if not self.dt_min <= dt_max:                  # the steps would be held at dt_min, above dt_max, silently
-            raise ValueError(f"{type(control).__name__}: dt_min({T!r}) = {self.dt_min!r} exceeds dt_max({T!r}) = "
-                             f"{dt_max!r} on the tree's [t0, t1] = [{t0}, {t1}] (dt_max is at most t1 - t0); pass "
-                             f"dt_min <= dt_max.")
+        self.state, self.dt_min = _checked_init(control, t0, t1, n, order)
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
         self.i, self.j, self.iterations = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), 0
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))
@@ -192,24 +165,7 @@ class _TreeSteps:
                              f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] for {who} "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")
-        h = self.state["h"] = _one_each(self.state["h"], self.lanes, np.float64,
-                                        f'the step control\'s state["h"] ({type(self.control).__name__})')
-        # the snapping kernel takes log2(span / h): NaN, 0 or < 0 there gave one step to t1 or a division by zero
-        if not (h.min() > 0 and h.max() < math.inf) and (bad := live & ~((h > 0) & (h < math.inf))).any():
-            k = int(np.argmax(bad))
-            raise ValueError(f'the step control\'s state["h"] ({type(self.control).__name__}) holds the step {h[k]!r} '
-                             f"for lane {k} at t = {self.t0 + int(self.i[k]) * self.cell:.6g}; a step must be a finite "
-                             f"number > 0 (t1 - t0 = {self.span!r} for one step to the end): fix the controller's init "
-                             f"or adapt.")
-        if not self.control.adaptive and (live & (h < 8 * self.cell)).any():
-            # a schedule's step must survive the snapping to the tree's grid (spacing at most h/8, a change of at most
-            # 1/16): on a coarse tree (small resolution) a shorter step was silently rounded, up to 2 cells at least
-            k = int(np.argmax(live & (h < 8 * self.cell)))
-            need = min(62, self.L + max(1, math.ceil(math.log2(8 * self.cell / h[k]))))
-            raise ValueError(f"{type(self.control).__name__} proposes the step {h[k]!r} (lane {k}), shorter than 8 cells of "
-                             f"the tree's grid ((t1 - t0)·2^-{self.L} = {self.cell:.3g}), whose step ends it would move "
-                             f"by more than 1/16 of the step (to 2 cells at least); build the BrownianTree with "
-                             f"resolution={need} or more, or take steps of at least {8 * self.cell:.3g}.")
+        h = _checked_steps(self.control, self.state, live, self.t0, self.i, self.span, self.L)
         n = _snap_nb(self.i, h, self.targets, self.end, self.L, self.fine, self.min_cells, self.t0,
                      self.span, self.cell, self.dt_min, self.j, self.floor, self.act, self.cols, self.t_at, self.h_at)
         act, i, j = self.act[:n], self.cols[:n, 0], self.cols[:n, -1]
@@ -238,11 +194,7 @@ class _TreeSteps:
     def judge(self, a, y_new, saved, first_bad, err):
         """Keep an attempt's result: its members' new states, error ratios and non-finite flags."""
         y_new, m = np.ascontiguousarray(y_new, dtype=np.float64), a.members.size     # a user's solver or controller
-        if err is None and a.h is not None:       # read as 'no estimate': every step accepted at zero error, silently
-            raise TypeError(f"{type(self.control).__name__}.error_ratio returned None; an adaptive controller must "
-                            f"return the error ratio of each member (contract item 3), e.g. an array of shape ({m},).")
-        if err is not None:                                                            # may return other types
-            err = _one_each(err, m, np.float64, f"{type(self.control).__name__}.error_ratio's result")
+        err = _checked_ratios(self.control, err, m, a.h is not None)
         if y_new.shape != (m, self.run.e):
             raise ValueError(f"the solver returned states of shape {y_new.shape} for {m} member(s) of dimension "
                              f"{self.run.e}; a solver's step must return shape (members, e).")
@@ -259,12 +211,7 @@ class _TreeSteps:
             k = self.lane_of[m[0]]
             run.fail(m, self.accepted[self.lane_of[m]], unmet=(float(np.max(self.err[m])), self.t_at[k], self.h_at[k],
                                                                 self.control, self.dt_min, self.L))
-        verdict = self.control.adapt(self.state, self.t_at.copy(), self.h_at.copy(), r.copy() if adaptive else None)
-        if verdict is None:                       # np.asarray(None, bool) is False: every attempt rejected until max_steps
-            raise TypeError(f"{type(self.control).__name__}.adapt returned None; it must return whether each lane's "
-                            f"attempt is accepted (contract item 4), e.g. np.ones(lanes, dtype=bool) for a schedule.")
-        accept = _one_each(verdict, self.lanes, bool, f"{type(self.control).__name__}.adapt's result")
-        accept = accept.copy()                      # written in place below; the controller may keep what it returned
+        accept = _checked_verdict(self.control, self.state, self.t_at, self.h_at, r if adaptive else None)
         n, nbad = _advance_nb(accept, self.floor, self.live, self.tried, self.bad, run.healthy, self.lane_of,
                               self.accepted, self.rejected, self.i, self.j, run.y, self.y_new, self.done, self.failing,
                               self.held)

@@ -104,3 +104,18 @@ def _failure_message(failed_step, times, batch) -> tuple:
             "grid. Pass on_failure='mask' to keep the healthy members' results (Solution.failed marks "
             "the others).")
     return msg, members, steps
+
+
+def _unmet_message(members, batch, r, t, h, control, dt_min=None, resolution=None):
+    """The message of a step at ``dt_min`` whose error exceeds the tolerance (``on_failure="raise"``); a step held
+    above ``dt_min`` by the driver's grid (two cells of a coarse tree) names the tree's ``resolution`` instead."""
+    first = tuple(int(v) for v in np.unravel_index(int(members[0]), batch))
+    by_grid = dt_min is not None and resolution is not None and h > dt_min * (1 + 1e-9)
+    at = (f"the shortest step of the tree's grid (2 cells of (t1 - t0)·2^-{resolution}; dt_min = {dt_min:.3g})"
+          if by_grid else f"dt_min = {h:.3g}")
+    lower = (f"build the BrownianTree with a higher resolution (now {resolution}, at most 62)" if by_grid else
+             "lower dt_min (PIController(dt_min=...))")
+    return (f"the error tolerance cannot be met: the step [{t:.6g}, {t + h:.6g}] at {at} still has "
+            f"{r:.3g} times the error {control!r} allows, for {len(members)} batch member(s) (first {first}); "
+            f"loosen rtol/atol, {lower}, or pass on_failure='mask' to mark these "
+            f"members failed (Solution.failed) and finish the others.")

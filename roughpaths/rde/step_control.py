@@ -34,6 +34,7 @@ the failure policy, the saved states and the statistics.
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 from numba import njit
@@ -249,3 +250,79 @@ def _pi_adapt_nb(r, h, h_next, r_prev, rejected, accept, q, safety, icoeff, pcoe
         rejected[k] = not a
         h_next[k] = min(dt_max, max(dt_min, h[k] * f))
         accept[k] = a
+
+
+# The loop's checks of a controller's answers, where it reads them (contract items 2-5): a controller written by a
+# user gets a message naming the item it broke, never a bare KeyError, a silent broadcast or a crawl.
+
+def _one_each(value, n, dtype, what):
+    """``value`` as a contiguous ``(n,)`` array of ``dtype`` for the compiled bookkeeping (no bounds checks there):
+    one entry for all is repeated, as numpy broadcast it; another count is refused, naming ``what``."""
+    v = np.asarray(value, dtype=dtype)
+    if v.shape == (n,) and v.flags.c_contiguous:
+        return v
+    if v.size != 1:
+        raise ValueError(f"{what} has {v.size} entries for {n} lane(s) or member(s); give one each, shape ({n},), "
+                         f"or one for all.")
+    return np.full(n, v.reshape(-1)[0], dtype=dtype)
+
+
+def _checked_init(control, t0, t1, lanes, error_order):
+    """``(state, dt_min)``: ``control.init``'s state, holding ``"h"`` (item 2), and ``dt_min`` a finite number
+    ``>= 0``, at most ``dt_max`` (item 5)."""
+    name, T = type(control).__name__, t1 - t0
+    state = control.init(t0, t1, lanes, error_order)
+    if not isinstance(state, dict) or "h" not in state:     # else a bare KeyError or TypeError in the loop
+        raise TypeError(f"{name}.init returned {type(state).__name__}"
+                        f"{' without the key h' if isinstance(state, dict) else ''}; it must return a fresh dict "
+                        f"holding at least 'h', the first step of each of the {lanes} lane(s) (contract item 2).")
+    dt_min = control.dt_min(T)
+    if isinstance(dt_min, (bool, np.bool_)) or not isinstance(dt_min, (numbers.Real, np.floating, np.integer)) \
+            or not 0 <= dt_min < math.inf:         # the loop's smallest cell count is ceil(dt_min / cell)
+        raise ValueError(f"{name}.dt_min({T!r}) returned {dt_min!r}; the smallest step must be a finite number >= 0 "
+                         f"(contract item 5; StepController's default is span * 2**-30).")
+    dt_max = control.dt_max(T)
+    if not dt_min <= dt_max:                  # the steps would be held at dt_min, above dt_max, silently
+        raise ValueError(f"{name}: dt_min({T!r}) = {float(dt_min)!r} exceeds dt_max({T!r}) = {dt_max!r} on the tree's "
+                         f"[t0, t1] = [{t0}, {t1}] (dt_max is at most t1 - t0); pass dt_min <= dt_max.")
+    return state, float(dt_min)
+
+
+def _checked_steps(control, state, live, t0, i, span, L):
+    """``state["h"]`` as ``(lanes,)`` floats, each step of a ``live`` lane finite and ``> 0``; a schedule's step
+    (not adaptive) at least 8 cells of the tree's grid (``span · 2^-L``), which its snapping moves by at most 1/16
+    (a shorter one was silently rounded, to 2 cells at least). ``t0 + i · cell`` are the lanes' times."""
+    name, cell = type(control).__name__, span / (1 << L)
+    h = state["h"] = _one_each(state["h"], live.size, np.float64, f'the step control\'s state["h"] ({name})')
+    # the snapping kernel takes log2(span / h): NaN, 0 or < 0 there gave one step to t1 or a division by zero
+    if not (h.min() > 0 and h.max() < math.inf) and (bad := live & ~((h > 0) & (h < math.inf))).any():
+        k = int(np.argmax(bad))
+        raise ValueError(f'the step control\'s state["h"] ({name}) holds the step {h[k]!r} for lane {k} at t = '
+                         f"{t0 + int(i[k]) * cell:.6g}; a step must be a finite number > 0 (t1 - t0 = {span!r} for "
+                         f"one step to the end): fix the controller's init or adapt.")
+    if not control.adaptive and (live & (h < 8 * cell)).any():
+        k = int(np.argmax(live & (h < 8 * cell)))
+        need = min(62, L + max(1, math.ceil(math.log2(8 * cell / h[k]))))
+        raise ValueError(f"{name} proposes the step {h[k]!r} (lane {k}), shorter than 8 cells of the tree's grid "
+                         f"((t1 - t0)·2^-{L} = {cell:.3g}), whose step ends it would move by more than 1/16 of the "
+                         f"step (to 2 cells at least); build the BrownianTree with resolution={need} or more, or take "
+                         f"steps of at least {8 * cell:.3g}.")
+    return h
+
+
+def _checked_ratios(control, err, m, adaptive):
+    """``error_ratio``'s result for ``m`` members as ``(m,)`` floats (item 3); ``None`` only without estimate."""
+    if err is None and adaptive:       # read as 'no estimate': every step accepted at zero error, silently
+        raise TypeError(f"{type(control).__name__}.error_ratio returned None; an adaptive controller must return the "
+                        f"error ratio of each member (contract item 3), e.g. an array of shape ({m},).")
+    return None if err is None else _one_each(err, m, np.float64, f"{type(control).__name__}.error_ratio's result")
+
+
+def _checked_verdict(control, state, t, h, r):
+    """``control.adapt``'s verdict on the attempts ``[t, t + h]`` as a fresh ``(lanes,)`` bool array (item 4);
+    the controller gets copies, and may keep what it returns (the loop writes its copy)."""
+    verdict = control.adapt(state, t.copy(), h.copy(), None if r is None else r.copy())
+    if verdict is None:            # np.asarray(None, bool) is False: every attempt rejected until max_steps
+        raise TypeError(f"{type(control).__name__}.adapt returned None; it must return whether each lane's attempt is "
+                        f"accepted (contract item 4), e.g. np.ones(lanes, dtype=bool) for a schedule.")
+    return _one_each(verdict, t.size, bool, f"{type(control).__name__}.adapt's result").copy()
