@@ -4,7 +4,8 @@ The block kernels of :mod:`._so3_kernels` take every step in a vectorised loop w
 Rodrigues factors; a member whose ``|sigma|²`` is past it (or non-finite), and every member of the implicit
 midpoint rule (the chord iteration), takes the scalar step here: :func:`_so3_step` per member, with the
 exact trigonometric factors. :func:`so3_rare_steps` is its own kernel, compiled only when a Lie–Euler or
-Lie–Heun solve first reaches such a step.
+Lie–Heun solve first reaches such a step. Members on steps of their own (adaptive steps per member) take it too,
+each with its own ``dt`` (:func:`._so3_kernels.so3_member_steps`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ import math
 
 import numba
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from ..systems.lie_algebra import SMALL_ANGLE2, taylor_coefficients
 
@@ -155,10 +158,22 @@ def _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_it
     return n0, n1, n2, True
 
 
+def _dt_of(dt, p):  # pragma: no cover - compiled only, by its overload
+    """Member ``p``'s step: ``dt[p]`` of an array of steps per member, or ``dt`` itself, one step for all."""
+
+
+@overload(_dt_of, inline="always")
+def _dt_of_overload(dt, p):
+    if isinstance(dt, types.Array):
+        return lambda dt, p: dt[p]
+    return lambda dt, p: dt
+
+
 @numba.njit(cache=True, inline="always")
 def so3_scalar_steps(ma, mb, mc, ea, eb, ec, bad, dt, q, lin, minv, theta, code, tol, max_iter, first_bad, reason, k):
-    """The scalar exact step (:func:`_so3_step`) for the members flagged in ``bad``; a member that fails gets NaN
-    and, on its first failure, ``first_bad = k`` and ``reason``. Returns the number of first failures."""
+    """The scalar exact step (:func:`_so3_step`) for the members flagged in ``bad``, with the step ``dt`` (a float,
+    or ``(B,)``, one per member); a member that fails gets NaN and, on its first failure, ``first_bad = k`` and
+    ``reason``. Returns the number of first failures."""
     nnew = 0
     for p in range(ma.shape[0]):
         if bad[p]:
@@ -167,7 +182,8 @@ def so3_scalar_steps(ma, mb, mc, ea, eb, ec, bad, dt, q, lin, minv, theta, code,
             ok = False
             finite_out = False
             if finite_in:
-                m0, m1, m2, ok = _so3_step(m0, m1, m2, e0, e1, e2, dt, q, lin, minv, theta, code, tol, max_iter)
+                m0, m1, m2, ok = _so3_step(m0, m1, m2, e0, e1, e2, _dt_of(dt, p), q, lin, minv, theta, code, tol,
+                                            max_iter)
                 finite_out = math.isfinite(m0 + m1 + m2)
             if not (ok and finite_out):
                 if first_bad[p] < 0:
@@ -183,7 +199,7 @@ def so3_scalar_steps(ma, mb, mc, ea, eb, ec, bad, dt, q, lin, minv, theta, code,
 def so3_rare_steps(y, e, bad, dt, q, lin, minv, theta, code, tol, max_iter, first_bad, reason, k):
     """:func:`so3_scalar_steps` on rows ``y`` (B, 3), ``e`` (B, 3) of one block: the steps the vector loop left
     (``|sigma|²`` past the Taylor branch, or non-finite). Its own kernel, compiled only when a solve reaches
-    such a step (about 1.4 s of CPU that a sane run never pays)."""
+    such a step (about 1.4 s of CPU at load 1, 3 s at load 2, that a sane run never pays)."""
     ma, mb, mc = y[:, 0].copy(), y[:, 1].copy(), y[:, 2].copy()
     nnew = so3_scalar_steps(ma, mb, mc, e[:, 0].copy(), e[:, 1].copy(), e[:, 2].copy(), bad, dt, q, lin, minv,
                              theta, code, tol, max_iter, first_bad, reason, k)

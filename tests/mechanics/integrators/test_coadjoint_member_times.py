@@ -10,7 +10,11 @@ Claims:
 * ``integrate`` with times of shape ``(members, K + 1)`` takes each member along its own grid: it agrees to
   round-off with solving each member alone on its grid by the fixed-step route (for so(3) and se(3) that is the
   compiled block kernels, another implementation of the same steps), and so does ``step`` with ``dt`` of
-  shape ``(members, 1)``.
+  shape ``(members, 1)``;
+* on so(3) without forces, where steps per member run compiled (``_so3_kernels.so3_member_steps``), a step with
+  ``dt`` per member equals the numpy path's step of each member alone with its ``dt`` as a float (the closed-form
+  exponential, another implementation) to round-off, for small and large ``|sigma|`` (the Taylor and the
+  trigonometric branch), and a non-finite member comes back NaN, failed, alone.
 """
 
 import numpy as np
@@ -98,3 +102,27 @@ def test_integrate_on_member_times_follows_each_members_grid(name):
         np.testing.assert_allclose(y[i], alone.final[0], rtol=0, atol=1e-12)
         np.testing.assert_allclose(saved[i], alone.states[0, 1:][save], rtol=0, atol=1e-12)
         np.testing.assert_allclose(stepped[i], alone.final[0], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("solver", [LieEuler(), LieHeun(), ImplicitMidpoint()], ids=repr)
+def test_so3_steps_per_member_agree_with_the_numpy_step_of_each_member(solver):
+    system = rigid_body(np.array([1.0, 2.0, 3.0]), sigma=0.5, theta=1.0)
+    rng = np.random.default_rng(11)
+    n = 6
+    mu = rng.standard_normal((n, 3))
+    dt = np.array([1e-4, 1e-3, 0.01, 0.05, 0.2, 0.4])[:, None]
+    dX = rng.standard_normal((n, 3)) * np.sqrt(dt) * np.array([1, 1, 1, 1, 8, 8])[:, None]   # past the Taylor branch
+    dXX = 0.5 * dX[:, :, None] * dX[:, None, :] + 0.3 * dt[:, :, None] * np.array([[0, 1, 0], [-1, 0, 2], [0, -2, 0]])
+    eta = solver._eta(system, dX, dXX)
+    assert np.any(np.sum(eta[-2:] ** 2, -1) > 1e-2)                 # the trigonometric branch is taken
+    new, ok, _ = solver._advance(system, mu, dt, eta)                # dt per member: the compiled steps
+    assert ok.all()
+    for p in range(n):
+        ref, ref_ok, _ = solver._advance(system, mu[p], float(dt[p, 0]), eta[p])     # a float: the numpy path
+        assert ref_ok
+        np.testing.assert_allclose(new[p], ref, rtol=0, atol=1e-13 * (1 + np.abs(ref).max()))
+    bad = mu.copy()
+    bad[2, 1] = np.nan
+    new2, ok2, _ = solver._advance(system, bad, dt, eta)
+    assert not ok2[2] and np.isnan(new2[2]).all() and ok2[[0, 1, 3, 4, 5]].all()
+    assert np.array_equal(new2[[0, 1, 3, 4, 5]], new[[0, 1, 3, 4, 5]])        # the others' bits are their own
