@@ -127,8 +127,13 @@ class _TreeSteps:
         self.paths = np.broadcast_to(np.arange(tree.n_paths).reshape(tree.batch_shape), run.batch).ravel()
         self.whole_batch = self.shared and tuple(tree.batch_shape) == tuple(run.batch)
         order = solver.error_order if solver.error_order is not None else solver.order
-        self.state, self.dt_min = _checked_init(control, t0, t1, n, order)
+        self.state, self.dt_min, dt_max = _checked_init(control, t0, t1, n, order)
         self.min_cells = max(2, int(math.ceil(self.dt_min / cell)))
+        if dt_max < 2 * cell:                   # the shortest step the grid allows would exceed dt_max, silently
+            need = min(62, L + math.ceil(math.log2(2 * cell / dt_max)))
+            raise ValueError(f"{type(control).__name__}: dt_max({T!r}) = {dt_max!r} is shorter than the shortest step "
+                             f"of the tree's grid, {2 * cell:.3g} (2 cells of (t1 - t0)·2^-{L}); build the "
+                             f"BrownianTree with resolution={need} or more, or raise dt_max.")
         self.i, self.j, self.iterations = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), 0
         self.accepted, self.rejected, self.at_min = (np.zeros(n, dtype=np.int64) for _ in range(3))
         # step ends snapped to spacing (h/4, h/2] per path, adaptive; else (h/16, h/8] (module docstring)
@@ -161,7 +166,8 @@ class _TreeSteps:
             k = int(np.argmax(over))            # a lane still short of t1 (one done in max_steps attempts is fine)
             who = ("the batch's shared steps" if self.shared else
                    f"batch member {tuple(int(v) for v in np.unravel_index(k, self.run.batch))}")
-            raise ValueError(f"adaptive solve took {self.control.max_steps} attempts and reached t = "
+            raise ValueError(f"{'adaptive ' if self.control.adaptive else ''}solve took {self.control.max_steps} "
+                             f"attempts and reached t = "
                              f"{self.t0 + int(self.i[k]) * self.cell:.6g} of [{self.t0}, {self.t1}] for {who} "
                              f"({int(self.accepted[k])} accepted, {int(self.rejected[k])} rejected); loosen rtol/atol "
                              f"or raise the controller's max_steps.")

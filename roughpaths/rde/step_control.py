@@ -106,6 +106,10 @@ class FixedSteps(StepController):
         if self.dt is None:
             raise ValueError("FixedSteps() takes the driver's grid, but this driver has none (a BrownianTree): pass "
                              "FixedSteps(dt=...), an adaptive PIController(rtol, atol), or driver=tree.rough_path(times).")
+        if (t1 - t0) / self.dt > self.max_steps:      # else max_steps attempts of a crawl, then a ValueError
+            raise ValueError(f"FixedSteps(dt={self.dt!r}) needs {(t1 - t0) / self.dt:.3g} steps on [t0, t1] = [{t0}, "
+                             f"{t1}], more than max_steps = {self.max_steps} (the most attempts of a lane); take a "
+                             f"longer dt, or solve on a grid of that step: driver=tree.rough_path(times).")
         return {"h": np.full(lanes, float(self.dt))}
 
     def adapt(self, state, t, h, r):
@@ -268,8 +272,8 @@ def _one_each(value, n, dtype, what):
 
 
 def _checked_init(control, t0, t1, lanes, error_order):
-    """``(state, dt_min)``: ``control.init``'s state, holding ``"h"`` (item 2), and ``dt_min`` a finite number
-    ``>= 0``, at most ``dt_max`` (item 5)."""
+    """``(state, dt_min, dt_max)``: ``control.init``'s state, holding ``"h"`` (item 2), ``dt_min`` a finite number
+    ``>= 0``, at most ``dt_max``, and ``dt_max`` long enough for ``max_steps`` to reach ``t1`` (item 5)."""
     name, T = type(control).__name__, t1 - t0
     state = control.init(t0, t1, lanes, error_order)
     if not isinstance(state, dict) or "h" not in state:     # else a bare KeyError or TypeError in the loop
@@ -285,7 +289,12 @@ def _checked_init(control, t0, t1, lanes, error_order):
     if not dt_min <= dt_max:                  # the steps would be held at dt_min, above dt_max, silently
         raise ValueError(f"{name}: dt_min({T!r}) = {float(dt_min)!r} exceeds dt_max({T!r}) = {dt_max!r} on the tree's "
                          f"[t0, t1] = [{t0}, {t1}] (dt_max is at most t1 - t0); pass dt_min <= dt_max.")
-    return state, float(dt_min)
+    if not (dt_max > 0 and T / dt_max <= control.max_steps):  # else a crawl to max_steps, blamed on the tolerance
+        raise ValueError(f"{name}: dt_max({T!r}) = {dt_max!r} needs at least "
+                         f"{T / dt_max if dt_max > 0 else math.inf:.3g} steps on the tree's [t0, t1] = [{t0}, {t1}], "
+                         f"more than max_steps = {control.max_steps} (the most attempts of a lane); raise dt_max or "
+                         f"max_steps.")
+    return state, float(dt_min), float(dt_max)
 
 
 def _checked_steps(control, state, live, t0, i, span, L):

@@ -250,20 +250,37 @@ def test_an_unmet_tolerance_on_a_coarse_tree_names_the_resolution_not_dt_min():
 def test_dt_max_below_the_default_dt_min_is_honoured_and_dt_min_above_dt_max_refused():
     """On a long interval the default dt_min, (t1 - t0)·2^-30, exceeds a small dt_max: the steps were held at
     dt_min (9.3e-5 for t1 - t0 = 1e5), silently ten times the dt_max=1e-5 asked for. The default dt_min is now
-    at most dt_max; a dt_min above dt_max on the tree's interval (e.g. above t1 - t0) is refused by name."""
-    import re
-
+    at most dt_max, and the steps follow dt_max (within the snapping's 1/16 with shared steps); a dt_min above
+    dt_max on the tree's interval (e.g. above t1 - t0) is refused by name."""
+    ctrl = rp.PIController(1e-1, 1e-1, dt_max=1e-5)
+    assert ctrl.dt_min(1e5) <= ctrl.dt_max(1e5) == 1e-5
     M = 1e-3 * np.array([[[0.0, 1.0], [-1.0, 0.0]], [[0.5, 0.0], [0.0, -0.5]]])
     V = rp.LinearVectorFields(M)
-    tree = rp.BrownianTree(2, seed=0, batch_shape=(2,), t1=1e5)
-    with pytest.raises(ValueError, match=r"took 20 attempts and reached t = (\S+) ") as info:
-        rp.solve(V, tree, np.ones(2), rp.Davie(), shared_steps=True,
-                 step_control=rp.PIController(1e-1, 1e-1, dt_max=1e-5, max_steps=20))
-    reached = float(re.search(r"reached t = (\S+) ", str(info.value)).group(1))
-    assert 0 < reached <= 20 * 1e-5 * (1 + 1 / 16)                     # 20 steps of at most dt_max
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(2,), t1=2.0 ** -10, resolution=50)
+    sol = rp.solve(V, tree, np.ones(2), rp.Davie(), shared_steps=True,
+                   step_control=rp.PIController(1e-1, 1e-1, dt_max=2.0 ** -17, dt_min=2.0 ** -40))
+    assert np.diff(sol.times).max() <= 2.0 ** -17 * (1 + 1 / 16) and sol.stats["accepted"] >= 2 ** 7
     with pytest.raises(ValueError, match=r"dt_min\(1\.0\) = 2\.0 exceeds dt_max\(1\.0\) = 1\.0"):
         rp.solve(V, rp.BrownianTree(2, seed=0), np.ones(2), rp.Davie(),
                  step_control=rp.PIController(1e-2, 1e-2, dt_min=2.0))
+
+
+def test_steps_that_cannot_reach_t1_within_max_steps_are_refused_at_once():
+    """A dt_max (or a FixedSteps dt) that needs more than max_steps steps to reach t1 crawled through all
+    max_steps attempts (8 s for dt_max=1e-14 or FixedSteps(1e-9) on [0, 1]) and then blamed the tolerance ('loosen
+    rtol/atol'); a dt_max below the tree's shortest step (2 cells of its grid) was exceeded silently. All three are
+    refused before the first step, naming the argument and the fix."""
+    V = rp.LinearVectorFields(M)
+    tree = rp.BrownianTree(2, seed=0, batch_shape=(2,), t1=1e5)
+    with pytest.raises(ValueError, match=r"dt_max\(100000\.0\) = 1e-05 needs at least 1e\+10 steps .* more than "
+                                         r"max_steps = 20 .* raise dt_max or max_steps"):
+        rp.solve(V, tree, Y0, rp.Davie(), step_control=rp.PIController(1e-1, 1e-1, dt_max=1e-5, max_steps=20))
+    with pytest.raises(ValueError, match=r"FixedSteps\(dt=1e-09\) needs 1e\+09 steps .* driver=tree\.rough_path"):
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(), step_control=rp.FixedSteps(1e-9))
+    with pytest.raises(ValueError, match=r"dt_max\(1\.0\) = 1e-13 is shorter than the shortest step of the tree's "
+                                         r"grid.*resolution=45 or more"):
+        rp.solve(V, rp.BrownianTree(2, seed=0, batch_shape=(2,)), Y0, rp.Davie(),
+                 step_control=rp.PIController(1e-1, 1e-1, dt_max=1e-13, dt_min=1e-14, max_steps=10 ** 14))
 
 
 def test_running_out_of_attempts_names_the_member_that_did_not_reach_t1():
