@@ -140,39 +140,78 @@ def refine_segments(w, G, delta, z):
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
-def _solve_pairs(N, a, y, iu, ju, C):
-    """In place: ``y <- (a I + M(N))⁻¹ y`` in pair coordinates (Cholesky; the matrix is a covariance)."""
-    p = iu.size
+def _solve_pairs(S, d, a, oc, oy):
+    """In place: ``y <- (a I + M(N))⁻¹ y`` in pair coordinates (Cholesky; the matrix is a covariance).
+
+    ``N = S[:d, :d]``, ``y = S[oy, :p]``; rows ``oc .. oc + p - 1`` of ``S`` hold the factor's lower
+    triangle (the only part read). Rows of the split kernel's workspace rather than slices of it: a slice
+    is a view, whose reference counting costs about as much as this solve at ``d = 2``. ``p = 1`` and
+    ``p = 3`` (``d = 2, 3``) are the loops below written out, the same operations in the same order: 11 and
+    30 ns per call against 20 and 86 ns for the loops, for about 0.1 s more compile (about 0.3 s more CPU
+    in a tree's first calls, whose kernels link this one). The loops walk the pairs ``i < j`` in row-major
+    order by counters (index tables would cost an allocation per call, and numba's compile of it).
+    """
+    p = d * (d - 1) // 2
+    if p == 1:
+        L00 = math.sqrt((a + S[1, 1]) + S[0, 0])
+        S[oy, 0] = (S[oy, 0] / L00) / L00
+        return
+    if p == 3:                    # pairs (0, 1), (0, 2), (1, 2); the factor's entries 0.0 + N or 0.0 - N as below
+        L00 = math.sqrt((a + S[1, 1]) + S[0, 0])
+        L10 = (0.0 + S[2, 1]) / L00
+        L11 = math.sqrt(((a + S[2, 2]) + S[0, 0]) - L10 * L10)
+        L20 = (0.0 - S[2, 0]) / L00
+        L21 = ((0.0 + S[1, 0]) - L20 * L10) / L11
+        L22 = math.sqrt((((a + S[2, 2]) + S[1, 1]) - L20 * L20) - L21 * L21)
+        y0 = S[oy, 0] / L00
+        y1 = (S[oy, 1] - L10 * y0) / L11
+        y2 = ((S[oy, 2] - L20 * y0) - L21 * y1) / L22
+        y2 = y2 / L22
+        y1 = (y1 - L21 * y2) / L11
+        S[oy, 0] = ((y0 - L10 * y1) - L20 * y2) / L00
+        S[oy, 1] = y1
+        S[oy, 2] = y2
+        return
+    i = 0
+    j = 1
     for q in range(p):
-        i, j = iu[q], ju[q]
+        k = 0
+        l = 1
         for t in range(p):
-            k, l = iu[t], ju[t]
             v = a if q == t else 0.0
             if i == k:
-                v += N[j, l]
+                v += S[j, l]
             if j == l:
-                v += N[i, k]
+                v += S[i, k]
             if i == l:
-                v -= N[j, k]
+                v -= S[j, k]
             if j == k:
-                v -= N[i, l]
-            C[q, t] = v
+                v -= S[i, l]
+            S[oc + q, t] = v
+            l += 1
+            if l == d:
+                k += 1
+                l = k + 1
+        j += 1
+        if j == d:
+            i += 1
+            j = i + 1
     for q in range(p):
         for t in range(q + 1):
-            v = C[q, t]
+            v = S[oc + q, t]
             for u in range(t):
-                v -= C[q, u] * C[t, u]
-            C[q, t] = math.sqrt(v) if q == t else v / C[t, t]
+                v -= S[oc + q, u] * S[oc + t, u]
+            S[oc + q, t] = math.sqrt(v) if q == t else v / S[oc + t, t]
     for q in range(p):
-        v = y[q]
+        v = S[oy, q]
         for u in range(q):
-            v -= C[q, u] * y[u]
-        y[q] = v / C[q, q]
+            v -= S[oc + q, u] * S[oy, u]
+        S[oy, q] = v / S[oc + q, q]
     for q in range(p - 1, -1, -1):
-        v = y[q]
+        v = S[oy, q]
         for u in range(q + 1, p):
-            v -= C[u, q] * y[u]
-        y[q] = v / C[q, q]
+            v -= S[oc + u, q] * S[oy, u]
+        S[oy, q] = v / S[oc + q, q]
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
@@ -180,7 +219,24 @@ def _refine_segments_nb(w, G, delta, z, fine, GL, GR):
     """:func:`refine_segments` compiled, one path at a time (same formulas; writes ``fine``, ``GL``, ``GR``).
 
     The numpy version spends most of its time in tiny batched matrix products; this loop is about 10x
-    faster at ``P = 2·10⁴``, ``n = 8``, ``d = 2``.
+    faster at ``P = 2·10⁴``, ``n = 8``, ``d = 2``. The outputs must not overlap the inputs (``fine`` is
+    written before ``w`` and ``z`` are read for the last time).
+
+    Written for the adaptive steps' single-path splits (``P = 1``, ``n = 8``) with every product and the
+    order of every sum of the earlier, plainer loop nest, so the same bits for finite inputs (the test
+    ``test_tree_split_kernel_bits`` keeps that loop nest as its oracle): one workspace instead of twelve
+    arrays; the symmetric ``N``, ``N_L``, ``N_R`` summed once per entry ``a <= b`` (``x y == y x``
+    exactly) and, in the same pass over the segments, the pair ``a < b``'s other sums; ``G_L``, ``G_R``
+    computed above the diagonal only (below it the same operations on negated operands, whose rounding is
+    the negated rounding; on the diagonal, terms that cancel exactly); the pair solves written out for
+    ``d = 2, 3`` (:func:`_solve_pairs`). Per call at ``P = 1``, ``n = 8`` (min of interleaved repeats of
+    2·10⁵ calls, 2-core machine): ``d = 2`` 507 -> 264 ns, ``d = 3`` 863 -> 505 ns, ``d = 1`` 356 -> 144 ns,
+    ``d = 4, 5, 6`` 16, 9, 5 % less. First calls of a ``BrownianTree(3)`` on an empty numba cache (shared
+    times, then per-path times: the seeded split and the walk, both linking this kernel) take 0.3-0.6 s
+    more CPU (10.0 -> 10.3 s, medians of six interleaved runs), about 0.3 s of it the written-out solves.
+    Tried and not kept: ``d = 3`` written out whole (one pass per half, every sum in a register), 265 ns for
+    about 1.1 s more compile; one pass per entry for all sums including the diagonal's (more work: slower);
+    unsigned indices to skip numba's negative-index wrap (about 20 ns at ``d = 3``, a cast on every index).
     """
     P, n, d = w.shape
     p = d * (d - 1) // 2
@@ -194,99 +250,113 @@ def _refine_segments_nb(w, G, delta, z, fine, GL, GR):
     ra = math.sqrt(a_half)
     s = dp / 12.0
     rs = math.sqrt(s)
-    iu = np.empty(p, dtype=np.int64)
-    ju = np.empty(p, dtype=np.int64)
-    q = 0
-    for i in range(d):
-        for j in range(i + 1, d):
-            iu[q] = i
-            ju[q] = j
-            q += 1
-    c = np.empty((n, d))
-    x = np.empty((2 * n, d))
-    NL = np.empty((d, d))
-    NR = np.empty((d, d))
-    N = np.empty((d, d))
-    L0 = np.empty((d, d))
-    R0 = np.empty((d, d))
-    Y = np.empty((d, d))
-    for a in range(d):            # zero diagonals (only the pairs a < b are written below); a loop, not np.zeros,
-        for b in range(d):        # whose 2-D overload numba compiles on its own (about 0.3 s)
-            L0[a, b] = 0.0
-            R0[a, b] = 0.0
-            Y[a, b] = 0.0
-    C = np.empty((p, p))
-    y = np.empty(p)
+    # the workspace's rows: N, N_L, N_R, Y (d each), c (n), the solve's factor (p), then y, L0, R0 (pair coordinates)
+    iL, iR, iY, ic = d, 2 * d, 3 * d, 4 * d
+    oc = ic + n
+    oy = oc + p
+    S = np.empty((oy + 3, max(d, p)))
+    for a in range(d):
+        S[iY + a, a] = 0.0
     o1, oa, ol = 2 * k, 2 * k + p, 4 * k + p
     for r in range(P):
-        # 1. the midpoints given G
+        # 1. the midpoints given G. N[a, b] once for a <= b (x y == y x: N[b, a] is the same sum), and in the
+        # same pass over the segments the pair a < b's sums: independent sums advancing together
+        q = 0
         for a in range(d):
-            for b in range(d):
+            for b in range(a, d):
                 v = 0.0
-                for j in range(n):
-                    v += w[r, j, a] * w[r, j, b]
-                N[a, b] = (delta / 12.0) * v
-        for q in range(p):
-            a, b = iu[q], ju[q]
-            t0 = 0.0
-            kk = 0.0
-            for j in range(n):
-                t0 += w[r, j, a] * z[r, k + j * d + b] - z[r, k + j * d + a] * w[r, j, b]
-                kk += z[r, j * d + a] * w[r, j, b] - w[r, j, a] * z[r, j * d + b]
-            y[q] = G[r, a, b] - 0.5 * sc * kk - r1 * (r1z * z[r, o1 + q] + h2 * t0)
-        _solve_pairs(N, n * delta * delta / 12.0, y, iu, ju, C)
-        for q in range(p):
-            Y[iu[q], ju[q]] = y[q]
-            Y[ju[q], iu[q]] = -y[q]
+                if a == b:
+                    for j in range(n):
+                        v += w[r, j, a] * w[r, j, b]
+                else:
+                    t0 = 0.0
+                    kk = 0.0
+                    for j in range(n):
+                        v += w[r, j, a] * w[r, j, b]
+                        t0 += w[r, j, a] * z[r, k + j * d + b] - z[r, k + j * d + a] * w[r, j, b]
+                        kk += z[r, j * d + a] * w[r, j, b] - w[r, j, a] * z[r, j * d + b]
+                    S[oy, q] = G[r, a, b] - 0.5 * sc * kk - r1 * (r1z * z[r, o1 + q] + h2 * t0)
+                    q += 1
+                v = (delta / 12.0) * v
+                S[a, b] = v
+                S[b, a] = v
+        _solve_pairs(S, d, n * delta * delta / 12.0, oc, oy)
+        q = 0
+        for a in range(d):
+            for b in range(a + 1, d):
+                S[iY + a, b] = S[oy, q]
+                S[iY + b, a] = -S[oy, q]
+                q += 1
         for i in range(n):
             for a in range(d):
                 v = 0.0
                 for b in range(d):
-                    v += Y[a, b] * w[r, i, b]
-                c[i, a] = z[r, i * d + a] * sc + (delta / 8.0) * v
-                x[2 * i, a] = 0.5 * w[r, i, a] + c[i, a]
-                x[2 * i + 1, a] = 0.5 * w[r, i, a] - c[i, a]
-        # 2. the rest of the tail split between the halves
+                    v += S[iY + a, b] * w[r, i, b]
+                ci = z[r, i * d + a] * sc + (delta / 8.0) * v
+                S[ic + i, a] = ci
+                fine[r, 2 * i, a] = 0.5 * w[r, i, a] + ci
+                fine[r, 2 * i + 1, a] = 0.5 * w[r, i, a] - ci
+        # 2. the rest of the tail split between the halves (its sums as in step 1)
+        q = 0
         for a in range(d):
-            for b in range(d):
+            for b in range(a, d):
                 nl = 0.0
                 nr = 0.0
-                for j in range(n):
-                    nl += x[j, a] * x[j, b]
-                    nr += x[n + j, a] * x[n + j, b]
-                NL[a, b] = nl
-                NR[a, b] = nr
-                N[a, b] = s * (nl + nr)
-        for q in range(p):
-            a, b = iu[q], ju[q]
-            gl = 0.0
-            gr = 0.0
-            kk = 0.0
-            for j in range(n):
-                gl += x[j, a] * z[r, oa + j * d + b] - z[r, oa + j * d + a] * x[j, b]
-                gr += x[n + j, a] * z[r, oa + (n + j) * d + b] - z[r, oa + (n + j) * d + a] * x[n + j, b]
-                kk += c[j, a] * w[r, j, b] - w[r, j, a] * c[j, b]
-            L0[a, b] = ra * z[r, ol + q] + rs * gl
-            R0[a, b] = ra * z[r, ol + p + q] + rs * gr
-            L0[b, a] = -L0[a, b]
-            R0[b, a] = -R0[a, b]
-            y[q] = G[r, a, b] - 0.5 * kk - L0[a, b] - R0[a, b]
-        _solve_pairs(N, 2.0 * a_half, y, iu, ju, C)
-        for q in range(p):
-            Y[iu[q], ju[q]] = y[q]
-            Y[ju[q], iu[q]] = -y[q]
-        for i in range(2 * n):
-            for a in range(d):
-                fine[r, i, a] = x[i, a]
+                if a == b:
+                    for j in range(n):
+                        nl += fine[r, j, a] * fine[r, j, b]
+                        nr += fine[r, n + j, a] * fine[r, n + j, b]
+                else:
+                    gl = 0.0
+                    gr = 0.0
+                    kk = 0.0
+                    for j in range(n):
+                        nl += fine[r, j, a] * fine[r, j, b]
+                        nr += fine[r, n + j, a] * fine[r, n + j, b]
+                        gl += fine[r, j, a] * z[r, oa + j * d + b] - z[r, oa + j * d + a] * fine[r, j, b]
+                        gr += (fine[r, n + j, a] * z[r, oa + (n + j) * d + b]
+                               - z[r, oa + (n + j) * d + a] * fine[r, n + j, b])
+                        kk += S[ic + j, a] * w[r, j, b] - w[r, j, a] * S[ic + j, b]
+                    l0 = ra * z[r, ol + q] + rs * gl
+                    r0 = ra * z[r, ol + p + q] + rs * gr
+                    S[oy + 1, q] = l0
+                    S[oy + 2, q] = r0
+                    S[oy, q] = G[r, a, b] - 0.5 * kk - l0 - r0
+                    q += 1
+                S[iL + a, b] = nl
+                S[iL + b, a] = nl
+                S[iR + a, b] = nr
+                S[iR + b, a] = nr
+                v = s * (nl + nr)
+                S[a, b] = v
+                S[b, a] = v
+        _solve_pairs(S, d, 2.0 * a_half, oc, oy)
+        q = 0
         for a in range(d):
-            for b in range(d):
+            for b in range(a + 1, d):
+                S[iY + a, b] = S[oy, q]
+                S[iY + b, a] = -S[oy, q]
+                q += 1
+        # G_L = L0 + a_half Y + s (Y N_L + N_L Y), antisymmetric: for finite inputs the sum below the diagonal
+        # is the negated sum (+0.0 where that is 0), the diagonal +0.0 (Y[a, e] N_L[e, a] - Y[a, e] N_L[a, e])
+        q = 0
+        for a in range(d):
+            GL[r, a, a] = 0.0
+            GR[r, a, a] = 0.0
+            for b in range(a + 1, d):
                 yl = 0.0
                 yr = 0.0
                 for e in range(d):
-                    yl += Y[a, e] * NL[e, b] + NL[a, e] * Y[e, b]
-                    yr += Y[a, e] * NR[e, b] + NR[a, e] * Y[e, b]
-                GL[r, a, b] = L0[a, b] + a_half * Y[a, b] + s * yl
-                GR[r, a, b] = R0[a, b] + a_half * Y[a, b] + s * yr
+                    yl += S[iY + a, e] * S[iL + e, b] + S[iL + a, e] * S[iY + e, b]
+                    yr += S[iY + a, e] * S[iR + e, b] + S[iR + a, e] * S[iY + e, b]
+                ay = a_half * S[iY + a, b]
+                l0 = S[oy + 1, q]
+                r0 = S[oy + 2, q]
+                GL[r, a, b] = l0 + ay + s * yl
+                GR[r, a, b] = r0 + ay + s * yr
+                GL[r, b, a] = -l0 - ay + s * (-yl if yl != 0.0 else yl)
+                GR[r, b, a] = -r0 - ay + s * (-yr if yr != 0.0 else yr)
+                q += 1
 
 
 def refine_segments_fast(w, G, delta, z):

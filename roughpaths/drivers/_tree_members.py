@@ -21,7 +21,9 @@ attempt (7 with one pair): the splits, about 1.5-2 µs each, and 0.7 µs of walk
 kernel's code linked into the walk; from numba's cache, 0.03 s. (Measured at load 1.3-1.4: 2.60-2.73 s, against
 2.54-2.62 s with one pair per depth; at load 2.3-2.9, three pairs kept in least-recently-used order took 2.7-3.0 s
 against 2.2-2.4 s, more compile than their 0.03 s per solve is worth.) Measured again at load 1 (exclusive compile
-times from numba's events): ``_walk_nb`` 2.1-2.4 s, ``_refine_segments_nb`` 1.4-1.6 s, its ``_solve_pairs`` 0.45-0.6 s.
+times from numba's events): ``_walk_nb`` 2.1-2.4 s, ``_refine_segments_nb`` 1.4-1.6 s, its ``_solve_pairs`` 0.45-0.6 s;
+after the split kernel's rewrite (its pair solves for ``d = 2, 3`` written out; 14 runs at load about 1) 2.4-2.7 s,
+1.3-1.5 s and 0.8-1.1 s.
 Inlining (``inline="always"``) does not pay here: ``_refine_segments_nb`` inlined into the walk took 5.4 s against
 4.2 s for the three kernels apart (numba copies and re-types the callee's IR per call site, and the code that LLVM
 re-optimises inside the walk is only about a third of a kernel's compile), and ``_stream_states`` or
