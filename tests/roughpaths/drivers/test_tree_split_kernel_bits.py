@@ -11,20 +11,18 @@ seeds; for inputs scaled far from 1 (d up to 6); and for degenerate finite input
 normals, entries of either zero sign, equal coordinates), where the mirrored entries' signs of zero
 show. Finite inputs only: the tree never splits a node holding an inf or a NaN.
 
-Compile cost: about 6.5 s of CPU on an empty numba cache (the frozen copy and the kernel, each compiled
-once and cached on disk; from the cache the module runs in under a second).
+The frozen copy runs as plain Python (float arithmetic is IEEE double there as in numba, which contracts no
+multiply-add), so the module compiles nothing but the kernel the tree compiles anyway.
 """
 
 import math
 
 import numpy as np
 import pytest
-from numba import njit
 
 from roughpaths.drivers._tree_kernels import _refine_segments_nb, split_width
 
 
-@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _reference_solve_pairs(N, a, y, iu, ju, C):
     """``_solve_pairs`` as it was when :func:`_reference_refine` was frozen (do not edit)."""
     p = iu.size
@@ -60,7 +58,6 @@ def _reference_solve_pairs(N, a, y, iu, ju, C):
         y[q] = v / C[q, q]
 
 
-@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _reference_refine(w, G, delta, z, fine, GL, GR):
     """The split kernel as it was before its loops were reordered for speed (frozen copy; do not edit)."""
     P, n, d = w.shape
