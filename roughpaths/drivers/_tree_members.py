@@ -15,7 +15,10 @@ splits only the few nodes near its new times (the same nodes, Chen-multiplied in
 root). A rejected attempt's retry ends between the nodes its halves split, which one pair per depth had
 overwritten. Adaptive steps of the noise-burst problem (:mod:`roughpaths.rde.adaptive`, 64 paths, rtol 1e-3): 2.79
 splits per path-attempt (3.74 with one pair per depth, 2.65 with three, 2.63 with four), about 5 µs per path and
-attempt (7 with one pair): the splits, about 1.5-2 µs each, and 0.7 µs of walking and Chen products. Compiling
+attempt (7 with one pair): the splits, about 1.5-2 µs each, and 0.7 µs of walking and Chen products. Since the split
+kernel's rewrite (the same bits), 3.2 µs against 4.3 (the solve's 97 149 path-queries replayed on one thread): per
+split about 0.07 µs of seeding, 0.4 µs of normals (65 at d = 2) and 0.4 µs of the split's arithmetic; the rigid body
+(d = 3, 3.6 splits per path-attempt, 105 normals each) 5.4 µs against 6.2-6.7. Compiling
 :func:`_walk_nb` (first call, empty cache) costs about 2.7 s of CPU after the tree's split kernel
 (``_refine_segments_nb``, 2.8 s, compiled with it on a first adaptive solve), of which about 1 s re-optimises that
 kernel's code linked into the walk; from numba's cache, 0.03 s. (Measured at load 1.3-1.4: 2.60-2.73 s, against
