@@ -15,6 +15,7 @@ fails, is marked by itself (``reason`` NON_FINITE or CHORD_FAILED, as in :mod:`.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba
@@ -341,3 +342,77 @@ def integrate_se3(system, code, tol, max_iter, y, dX, dXX, dts, save, stop_on_fa
     parallel_ranges(lambda lo, hi: _se3_midpoint_block(*args, *consts, float(tol), int(max_iter), *tail, lo, hi),
                     nb, BLOCK)
     return y, out, first_bad, reason
+
+
+@functools.lru_cache(maxsize=None)
+def _member_kernel(C: int):
+    """One step of scheme ``C`` (0 Lie–Euler, 1 Lie–Heun, 2 implicit midpoint) for members each on a step of its own
+    (``dt (B,)``): the numpy path's scheme (:mod:`mechanics.integrators.base`) with this module's velocity, ``ad*``,
+    closed-form exponential and chord iteration, a member at a time. ``C`` is a compile-time constant, so Lie–Euler
+    and Lie–Heun compile without the chord iteration. A member whose input, Lie–Heun predictor or result is not
+    finite, or whose chord iteration fails, comes back NaN with ``first_bad = 0`` and its ``reason``."""
+
+    @numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)
+    def se3_members(y, e, dt, q, lin, f, minv, theta, tol, max_iter, first_bad, reason):
+        V = np.empty((12, 6))
+        mu, ee, w0, w1, s, a, b, mp, g, t1, t2, new = V[0], V[1], V[2], V[3], V[4], V[5], V[6], V[7], V[8], V[9], \
+            V[10], V[11]
+        if C == 2:                           # the chord iteration's buffers (no allocation compiled otherwise)
+            L, Dw, J, Ji, W = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12))
+            m1, mid, u = np.empty(6), np.empty(6), np.empty(6)
+        for p in range(y.shape[0]):
+            finite_in = True
+            for i in range(6):
+                mu[i], ee[i] = y[p, i], e[p, i]
+                if not (math.isfinite(mu[i]) and math.isfinite(ee[i])):
+                    finite_in = False
+            ok = finite_in
+            conv = True
+            if finite_in:
+                _velocity(mu, q, lin, f, minv, theta, g, t1, t2, w0)
+                for i in range(6):
+                    s[i] = w0[i] * dt[p] + ee[i]
+                    if not math.isfinite(s[i]):
+                        ok = False
+                if ok and C == 1:               # predictor mu + a + ½ ad*_s a, a = ad*_s mu; corrector on its velocity
+                    _ad_star(s, mu, a)
+                    _ad_star(s, a, b)
+                    for i in range(6):
+                        mp[i] = mu[i] + a[i] + 0.5 * b[i]
+                        if not math.isfinite(mp[i]):
+                            ok = False
+                    _velocity(mp, q, lin, f, minv, theta, g, t1, t2, w1)
+                    for i in range(6):
+                        s[i] = 0.5 * (w0[i] + w1[i]) * dt[p] + ee[i]
+                elif ok and C == 2:
+                    conv = _se3_chord(mu, ee, s, dt[p], q, lin, f, minv, theta, tol, max_iter, L, Dw, J, Ji, W, g,
+                                      t1, t2, m1, mid, u)
+                    ok = conv
+                if ok:
+                    _exp(s, mu, new)
+                    for i in range(6):
+                        if not math.isfinite(new[i]):
+                            ok = False
+            for i in range(6):
+                y[p, i] = new[i] if ok else np.nan
+            if not ok:
+                first_bad[p] = 0
+                reason[p] = NON_FINITE if conv else CHORD_FAILED
+
+    return se3_members
+
+
+def se3_member_steps(system, code, tol, max_iter, mu, dt, eta):
+    """One step of every member on its own step (contract item 10: adaptive steps per member), compiled
+    (:func:`_member_kernel`); ``mu``, ``eta`` (B, 6), ``dt`` (B,). Returns ``(mu, ok, converged)`` as the numpy
+    path's ``_advance`` does (``converged`` None but for the implicit midpoint, ``code`` 2). The heavy top, LieHeun
+    adaptive per member, 1000 paths at rtol 1e-3: see ``docs/adaptive-steps.md``."""
+    data = system.quadratic_velocity_data()
+    B = mu.shape[0]
+    y = np.array(mu, dtype=np.float64, order="C")
+    first_bad, reason = np.full(B, -1, dtype=np.int64), np.zeros(B, dtype=np.int8)
+    _member_kernel(int(code))(y, np.ascontiguousarray(eta, dtype=np.float64),
+                              np.ascontiguousarray(dt, dtype=np.float64), data["q"], np.ascontiguousarray(data["linear"]),
+                              np.ascontiguousarray(data["dissipation_change"]), data["metric_inv"],
+                              float(data["theta"]), float(tol), int(max_iter), first_bad, reason)
+    return y, first_bad < 0, (reason != CHORD_FAILED) if code == 2 else None

@@ -11,8 +11,8 @@ Claims:
   round-off with solving each member alone on its grid by the fixed-step route (for so(3) and se(3) that is the
   compiled block kernels, another implementation of the same steps), and so does ``step`` with ``dt`` of
   shape ``(members, 1)``;
-* on so(3) without forces, where steps per member run compiled (``_so3_kernels.so3_member_steps``), a step with
-  ``dt`` per member equals the numpy path's step of each member alone with its ``dt`` as a float (the closed-form
+* on so(3) and se(3) without forces, where steps per member run compiled (``so3_member_steps``,
+  ``se3_member_steps``), a step with ``dt`` per member equals the numpy path's step of each member alone with its ``dt`` as a float (the closed-form
   exponential, another implementation) to round-off, for small and large ``|sigma|`` (the Taylor and the
   trigonometric branch), and a non-finite member comes back NaN, failed, alone.
 """
@@ -105,16 +105,18 @@ def test_integrate_on_member_times_follows_each_members_grid(name):
 
 
 @pytest.mark.parametrize("solver", [LieEuler(), LieHeun(), ImplicitMidpoint()], ids=repr)
-def test_so3_steps_per_member_agree_with_the_numpy_step_of_each_member(solver):
-    system = rigid_body(np.array([1.0, 2.0, 3.0]), sigma=0.5, theta=1.0)
+@pytest.mark.parametrize("algebra", ["so3", "se3"])
+def test_steps_per_member_agree_with_the_numpy_step_of_each_member(solver, algebra):
+    system = (rigid_body(np.array([1.0, 2.0, 3.0]), sigma=0.5, theta=1.0) if algebra == "so3" else
+              heavy_top(np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 1.0]), sigma=0.3, s=S, theta=0.5))
     rng = np.random.default_rng(11)
     n = 6
-    mu = rng.standard_normal((n, 3))
+    mu = rng.standard_normal((n, system.dim))
     dt = np.array([1e-4, 1e-3, 0.01, 0.05, 0.2, 0.4])[:, None]
     dX = rng.standard_normal((n, 3)) * np.sqrt(dt) * np.array([1, 1, 1, 1, 8, 8])[:, None]   # past the Taylor branch
     dXX = 0.5 * dX[:, :, None] * dX[:, None, :] + 0.3 * dt[:, :, None] * np.array([[0, 1, 0], [-1, 0, 2], [0, -2, 0]])
     eta = solver._eta(system, dX, dXX)
-    assert np.any(np.sum(eta[-2:] ** 2, -1) > 1e-2)                 # the trigonometric branch is taken
+    assert np.any(np.sum(eta[-2:, :3] ** 2, -1) > 1e-2)             # the trigonometric branch is taken
     new, ok, _ = solver._advance(system, mu, dt, eta)                # dt per member: the compiled steps
     assert ok.all()
     for p in range(n):
