@@ -81,6 +81,16 @@ FAMILIES = {
                                          "s = LiePoissonSystem(g, np.ones(g.dim), 0.3 * np.eye(g.dim)[:3], theta=0.1)\n"
                                          "rp.solve(s, rp.BrownianDriver(3, seed=0, dt=0.01, n_steps=20, "
                                          "batch_shape=(4,)), np.ones((4, g.dim)), LieHeun())"),
+    # adaptive steps per member on a tree: the walk, the loop's kernels and the so(3) / se(3) member steps
+    "rigid body, adaptive": ("", "from mechanics import rigid_body, LieHeun\n"
+                                 "b = rigid_body([1.0, 2.0, 3.0], sigma=0.5)\n"
+                                 "rp.solve(b, rp.BrownianTree(3, seed=0, batch_shape=(4,)), np.ones((4, 3)), "
+                                 "LieHeun(), step_control=rp.PIController(1e-2, 1e-2))"),
+    "heavy top, adaptive": ("", "from mechanics import heavy_top, LieHeun\n"
+                                "t = heavy_top([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], sigma=0.3)\n"
+                                "rp.solve(t, rp.BrownianTree(3, seed=0, batch_shape=(4,)), "
+                                "np.tile([0.1, 0.2, 0.3, 0.0, 0.0, 1.0], (4, 1)), LieHeun(), "
+                                "step_control=rp.PIController(1e-2, 1e-2))"),
     "run_ensemble (rigid body)": ("", "from mechanics import rigid_body, run_ensemble\n"
                                       "run_ensemble(rigid_body([1.0, 2.0, 3.0], sigma=0.1), np.ones(3), dt=0.01, "
                                       "n_steps=8, n_paths=4, seed=0)"),

@@ -9,10 +9,10 @@ see ``roughpaths.signatures._engine._kernel_array``), depths as Python ints.
 Compile time is the install's budget, so the list is short: batches of d = 2 and 3 paths (signature,
 log-signature, both gradients, depths 2-4), the signature kernels (Goursat PDE, its adjoint, the MMD
 statistics), the Brownian tree (d = 2, 3), and the coadjoint kernels of Lie–Heun (so(3), se(3), a
-user algebra, with and without areas; the streamed ensemble; so(3), se(3) members on steps of their own). Each kernel specialised on a size or a
-scheme is compiled per variant on its first use (``roughpaths._variants``): everything else (other
-alphabet sizes, lone or long chunked paths, Lie–Euler and the implicit midpoint rule) compiles its own
-variant on a user's first call, a few seconds each (``benchmarks/bench_first_call.py``).
+user algebra, with and without areas; the streamed ensemble; so(3), se(3) members on steps of their own). Each
+kernel specialised on a size or a scheme is compiled per variant on its first use (``roughpaths._variants``):
+everything else (other alphabet sizes, lone or long chunked paths, Lie–Euler and the implicit midpoint rule)
+compiles its own variant on a user's first call, a few seconds each (``benchmarks/bench_first_call.py``).
 
 ``--more`` adds what the test suite reaches besides (lone, wide and long chunked paths, the rough-path
 signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule, the coadjoint schemes on rough

@@ -58,13 +58,13 @@ fails is reported through ``first_bad`` (contract item 8).
 
 Steps per member (contract item 10, ``member_times``): ``integrate`` also takes ``times (..., K + 1)``, one grid
 per member, and ``step`` a ``dt (..., 1)``; the compiled block kernels take one time grid, so on so(3) and se(3)
-without forces every member takes a compiled scalar step with its own ``dt`` (:func:`._so3_kernels.so3_member_steps`,
-:func:`._se3_kernels.se3_member_steps`), and otherwise the numpy path runs, member by member in one call, on the
-matrix twin of a structure-constant algebra that has a matrix basis (``_dispatch.member_system``). Adaptive solves
-(:func:`roughpaths.solve` with ``step_control=PIController(...)``) use it by default, each member with steps of its
-own; the stochastic rigid body at ``rtol = 10⁻³``, 1000 paths (101 attempts a path), one thread: 0.81-0.86 s of
-CPU, of which the tree's walk is about 0.65 s (0.94-1.12 s with the numpy steps); the heavy top, 1000 paths, 0.42-0.44
-s against 0.73-1.15 s.
+without forces every member takes a compiled scalar step with its own ``dt``
+(:func:`._so3_kernels.so3_member_steps`, :func:`._se3_kernels.se3_member_steps`), and otherwise the numpy path
+runs, member by member in one call, on the matrix twin of a structure-constant algebra that has a matrix basis
+(``_dispatch.member_system``). Adaptive solves (:func:`roughpaths.solve` with ``step_control=PIController(...)``)
+use it by default, each member with steps of its own; at ``rtol = 10⁻³``, 1000 paths, one thread, the stochastic
+rigid body (101 attempts a path) took 0.81-0.86 s of CPU, of which the tree's walk is about 0.65 s (0.94-1.12 s
+with the numpy steps), the heavy top 0.42-0.44 s (0.73-1.15 s).
 
 Threads: the compiled kernels split the paths into blocks and run them on numba's threads; set their
 number with ``numba.set_num_threads(k)`` (or the environment variable ``NUMBA_NUM_THREADS`` before the
