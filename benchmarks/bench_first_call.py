@@ -81,7 +81,7 @@ FAMILIES = {
                                          "s = LiePoissonSystem(g, np.ones(g.dim), 0.3 * np.eye(g.dim)[:3], theta=0.1)\n"
                                          "rp.solve(s, rp.BrownianDriver(3, seed=0, dt=0.01, n_steps=20, "
                                          "batch_shape=(4,)), np.ones((4, g.dim)), LieHeun())"),
-    # adaptive steps per member on a tree: the walk, the loop's kernels and the so(3) / se(3) member steps
+    # adaptive steps per member on a tree: the walk, the loop's kernels and the so(3) / se(3) / generic member steps
     "rigid body, adaptive": ("", "from mechanics import rigid_body, LieHeun\n"
                                  "b = rigid_body([1.0, 2.0, 3.0], sigma=0.5)\n"
                                  "rp.solve(b, rp.BrownianTree(3, seed=0, batch_shape=(4,)), np.ones((4, 3)), "
@@ -91,6 +91,10 @@ FAMILIES = {
                                 "rp.solve(t, rp.BrownianTree(3, seed=0, batch_shape=(4,)), "
                                 "np.tile([0.1, 0.2, 0.3, 0.0, 0.0, 1.0], (4, 1)), LieHeun(), "
                                 "step_control=rp.PIController(1e-2, 1e-2))"),
+    "su(2), adaptive": ("", "from mechanics import LiePoissonSystem, LieHeun, su2\n"
+                            "s = LiePoissonSystem(su2(), np.diag([1.0, 2.0, 3.0]), 0.5 * np.eye(3), theta=1.0)\n"
+                            "rp.solve(s, rp.BrownianTree(3, seed=0, batch_shape=(4,)), np.ones((4, 3)), LieHeun(), "
+                            "step_control=rp.PIController(1e-2, 1e-2))"),
     "run_ensemble (rigid body)": ("", "from mechanics import rigid_body, run_ensemble\n"
                                       "run_ensemble(rigid_body([1.0, 2.0, 3.0], sigma=0.1), np.ones(3), dt=0.01, "
                                       "n_steps=8, n_paths=4, seed=0)"),

@@ -9,7 +9,7 @@ see ``roughpaths.signatures._engine._kernel_array``), depths as Python ints.
 Compile time is the install's budget, so the list is short: batches of d = 2 and 3 paths (signature,
 log-signature, both gradients, depths 2-4), the signature kernels (Goursat PDE, its adjoint, the MMD
 statistics), the Brownian tree (d = 2, 3), and the coadjoint kernels of Lie–Heun (so(3), se(3), a
-user algebra, with and without areas; the streamed ensemble; so(3), se(3) members on steps of their own). Each
+user algebra, with and without areas; the streamed ensemble; su(2), so(3), se(3) members on steps of their own). Each
 kernel specialised on a size or a scheme is compiled per variant on its first use (``roughpaths._variants``):
 everything else (other alphabet sizes, lone or long chunked paths, Lie–Euler and the implicit midpoint rule)
 compiles its own variant on a user's first call, a few seconds each (``benchmarks/bench_first_call.py``).
@@ -194,7 +194,8 @@ def warm_more_coadjoint() -> None:
     su3 = LiePoissonSystem(LieAlgebra(su(3).structure_constants, name="su3 (constants)"), np.ones(8),
                            0.3 * rng.standard_normal((3, 8)), theta=0.1)
     solve(su3, BrownianDriver(3, seed=0, dt=0.01, n_steps=2, batch_shape=(2,)), np.ones((2, 8)), ImplicitMidpoint())
-    for system in (rigid, top):    # so(3), se(3) members on steps of their own (adaptive solves)
+    su2_system = LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1)
+    for system in (su2_system, rigid, top):    # su(2), so(3), se(3) members on steps of their own (adaptive solves)
         for method in (LieEuler(), ImplicitMidpoint()):
             method.step(system, np.ones((2, system.dim)), np.zeros((2, 1)), np.full((2, 1), 0.01), np.zeros((2, 3)),
                         np.zeros((2, 3, 3)))
@@ -273,7 +274,7 @@ def warm_coadjoint() -> None:
         solve(system, X, np.ones((2, system.dim)), LieHeun())        # the other schemes: on first use
     for system in systems[1:]:      # the streamed statistics (so(3) moments in registers, se(3) generic)
         run_ensemble(system, np.ones(system.dim), dt=0.01, n_steps=4, n_paths=2, seed=0)
-    for system in systems[1:]:      # so(3), se(3) members each on a step of its own (adaptive solves)
+    for system in systems:          # su(2), so(3), se(3) members each on a step of its own (adaptive solves)
         LieHeun().step(system, np.ones((2, system.dim)), np.zeros((2, 1)), np.full((2, 1), 0.01), np.zeros((2, 3)),
                        np.zeros((2, 3, 3)))
 

@@ -57,14 +57,15 @@ per member otherwise). Either way a batch member's result depends on its own dat
 fails is reported through ``first_bad`` (contract item 8).
 
 Steps per member (contract item 10, ``member_times``): ``integrate`` also takes ``times (..., K + 1)``, one grid
-per member, and ``step`` a ``dt (..., 1)``; the compiled block kernels take one time grid, so on so(3) and se(3)
-without forces every member takes a compiled scalar step with its own ``dt``
-(:func:`._so3_kernels.so3_member_steps`, :func:`._se3_kernels.se3_member_steps`), and otherwise the numpy path
-runs, member by member in one call, on the matrix twin of a structure-constant algebra that has a matrix basis
-(``_dispatch.member_system``). Adaptive solves (:func:`roughpaths.solve` with ``step_control=PIController(...)``)
-use it by default, each member with steps of its own; at ``rtol = 10⁻³``, 1000 paths, one thread, the stochastic
-rigid body (101 attempts a path) took 0.81-0.86 s of CPU, of which the tree's walk is about 0.65 s (0.94-1.12 s
-with the numpy steps), the heavy top 0.42-0.44 s (0.73-1.15 s).
+per member, and ``step`` a ``dt (..., 1)``; the compiled block kernels take one time grid, so without forces every
+member takes a compiled scalar step with its own ``dt`` on a structure-constant algebra
+(:func:`._so3_kernels.so3_member_steps`, :func:`._se3_kernels.se3_member_steps`,
+:func:`._generic_member_steps.generic_member_steps`), or the numpy path's conjugation of matrices, member by member
+in one call, where the cost model predicts that cheaper (``_dispatch.member_system``: a matrix algebra or a matrix
+basis of dimension 15 and up, su(4) and larger). Adaptive solves (:func:`roughpaths.solve` with
+``step_control=PIController(...)``) use it by default, each member with steps of its own; at ``rtol = 10⁻³``, 1000
+paths, one thread, the stochastic rigid body (101 attempts a path) took 0.81-0.86 s of CPU, of which the tree's walk
+is about 0.65 s (0.94-1.12 s with the numpy steps), the heavy top 0.42-0.44 s (0.73-1.15 s).
 
 Threads: the compiled kernels split the paths into blocks and run them on numba's threads; set their
 number with ``numba.set_num_threads(k)`` (or the environment variable ``NUMBA_NUM_THREADS`` before the
@@ -85,13 +86,14 @@ import numpy as np
 from roughpaths import Solver
 from roughpaths.validation import as_float_array, check_positive_int
 
-from ..systems.lie_algebra import SE3Algebra, SO3Algebra
+from ..systems.lie_algebra import LieAlgebra, SE3Algebra, SO3Algebra
 from ..systems.lie_poisson import LiePoissonSystem
 from ..systems.matrix_algebra import MatrixLieAlgebra
 from . import _generic_kernels, _isospectral, _se3_kernels, _so3_kernels
 from ._chord import chord_solve
 from ._dispatch import choose, member_system
 from ._forced import forced_sigma_and_state
+from ._generic_member_steps import generic_member_steps
 
 __all__ = ["CoadjointSolver", "LieEuler", "LieHeun", "ImplicitMidpoint", "ChordConvergenceError",
            "check_on_orbit"]
@@ -171,12 +173,14 @@ class CoadjointSolver(Solver):
         """One step: ``(new mu, ok)``; failed members (non-finite or not converged) are NaN, ``ok`` False."""
         mu, eta = np.broadcast_arrays(np.asarray(mu, dtype=np.float64), np.asarray(eta, dtype=np.float64))
         dt = _member_dt(dt, mu.shape)
-        if not isinstance(dt, float) and isinstance(system.algebra, (SO3Algebra, SE3Algebra)) \
+        if not isinstance(dt, float) and isinstance(system.algebra, LieAlgebra) \
                 and system.hamiltonian.is_quadratic and not system.has_forces:
-            # steps per member on so(3), se(3): compiled, the same scheme (._so3_kernels, ._se3_kernels)
+            # steps per member on structure constants: compiled, the same scheme (._so3_kernels, ._se3_kernels,
+            # ._generic_member_steps)
             b, n = mu.shape[:-1], mu.shape[-1]
             steps = (_so3_kernels.so3_member_steps if isinstance(system.algebra, SO3Algebra) else
-                     _se3_kernels.se3_member_steps)
+                     _se3_kernels.se3_member_steps if isinstance(system.algebra, SE3Algebra) else
+                     generic_member_steps)
             new, ok, conv = steps(system, self._code, getattr(self, "tol", 1e-13), getattr(self, "max_iter", 1),
                                   mu.reshape(-1, n), dt.reshape(-1), eta.reshape(-1, n))
             return new.reshape(mu.shape), ok.reshape(b), None if conv is None else conv.reshape(b)

@@ -5,24 +5,30 @@ Claims:
 * adaptive steps per member are the default for the coadjoint solvers (``Solution.stats["shared_steps"]`` is
   ``False``), and a member's states, times and counts are bitwise the same solved alone or in any batch, for
   LieEuler, LieHeun and ImplicitMidpoint on so(3), for the heavy top on se(3), for a forced system (the numpy
-  path with ``force`` and ``noise_forces``), for su(3) as a matrix algebra and for su(3) from its matrix basis (a
-  structure-constant algebra, whose members are stepped on its matrix twin);
+  path with ``force`` and ``noise_forces``), for su(2) and sl(2, R) (the generic compiled steps), for su(3) as a
+  matrix algebra and from its matrix basis (both stepped on structure constants) and for su(4) from its matrix
+  basis (stepped on its matrix twin);
 * ``integrate`` with times of shape ``(members, K + 1)`` takes each member along its own grid: it agrees to
   round-off with solving each member alone on its grid by the fixed-step route (for so(3) and se(3) that is the
   compiled block kernels, another implementation of the same steps), and so does ``step`` with ``dt`` of
   shape ``(members, 1)``;
-* on so(3) and se(3) without forces, where steps per member run compiled (``so3_member_steps``,
-  ``se3_member_steps``), a step with ``dt`` per member equals the numpy path's step of each member alone with its ``dt`` as a float (the closed-form
-  exponential, another implementation) to round-off, for small and large ``|sigma|`` (the Taylor and the
-  trigonometric branch), and a non-finite member comes back NaN, failed, alone.
+* without forces, where steps per member run compiled on structure constants (``so3_member_steps``,
+  ``se3_member_steps``, ``generic_member_steps``: so(3), se(3), su(2), sl(2, R), a user's algebra of dimension 6,
+  su(3) as a matrix algebra), or on matrices where the cost model says so (su(4) from its basis), a step with ``dt``
+  per member equals the numpy path's step of each member alone with its ``dt`` as a float (the closed-form
+  exponential, a dense ``expm`` or a conjugation of matrices: other implementations) to round-off, for small and
+  large ``|sigma|`` (the Taylor and the trigonometric or scaling-and-squaring branch), and a non-finite member comes
+  back NaN, failed, alone.
 """
 
 import numpy as np
 import pytest
 
 import roughpaths as rp
-from mechanics import (ImplicitMidpoint, LieAlgebra, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body, so3,
-                       su)
+from mechanics import (ImplicitMidpoint, LieAlgebra, LieEuler, LieHeun, LiePoissonSystem, heavy_top, rigid_body, se3,
+                       sl2r, so3, su, su2)
+from mechanics.integrators._dispatch import member_system
+from mechanics.integrators._generic_member import THETA_VECTOR
 
 S = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.5], [0.0, -0.5, 0.0]])
 
@@ -33,8 +39,8 @@ def _forced():
                             noise_forces=lambda mu: 0.1 * np.stack([np.sin(mu), np.cos(mu) - 1.0, mu ** 2], axis=-1))
 
 
-def _su3(basis=False):
-    g = LieAlgebra.from_matrix_basis(su(3).basis) if basis else su(3)
+def _su(N, basis=False):
+    g = LieAlgebra.from_matrix_basis(su(N).basis) if basis else su(N)
     xi = 0.4 * np.random.default_rng(2).standard_normal((3, g.dim))
     return LiePoissonSystem(g, np.diag(1.0 + np.arange(g.dim) / g.dim), xi)
 
@@ -51,8 +57,13 @@ CASES = {
     "se3 ImplicitMidpoint": (lambda: heavy_top(np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 1.0]), sigma=0.3),
                              ImplicitMidpoint(), np.array([0.1, 0.2, 1.0, 0.0, 0.3, 0.9])),
     "forced LieHeun": (_forced, LieHeun(), np.array([0.6, 0.0, 0.8])),
-    "su3 LieHeun": (_su3, LieHeun(), None),
-    "su3 basis LieHeun": (lambda: _su3(basis=True), LieHeun(), None),       # stepped on its matrix twin
+    "su2 LieHeun": (lambda: LiePoissonSystem(su2(), np.diag([1.0, 2.0, 3.0]), 0.5 * np.eye(3), theta=1.0), LieHeun(),
+                    np.array([0.0, 0.6, 0.8])),
+    "sl2r ImplicitMidpoint": (lambda: LiePoissonSystem(sl2r(), np.diag([1.0, 2.0, 3.0]), 0.3 * np.eye(3), s=S),
+                              ImplicitMidpoint(), np.array([0.2, 0.6, 0.8])),
+    "su3 LieHeun": (lambda: _su(3), LieHeun(), None),                  # stepped on structure constants
+    "su3 basis LieHeun": (lambda: _su(3, basis=True), LieHeun(), None),
+    "su4 basis LieHeun": (lambda: _su(4, basis=True), LieHeun(), None),   # stepped on its matrix twin
 }
 
 
@@ -104,27 +115,57 @@ def test_integrate_on_member_times_follows_each_members_grid(name):
         np.testing.assert_allclose(stepped[i], alone.final[0], rtol=0, atol=1e-12)
 
 
+def _member_case(algebra):
+    """A system for the steps-per-member checks: so(3), se(3) (hand-written kernels), su(2), sl(2, R) and se(3) given
+    by its constants alone (a user's algebra, dimension 6: the midpoint rule's compiled variant), su(3) as a matrix
+    algebra (whose members are stepped on its structure constants) and su(4) from its matrix basis (on its matrix
+    twin)."""
+    if algebra == "so3":
+        return rigid_body(np.array([1.0, 2.0, 3.0]), sigma=0.5, theta=1.0)
+    if algebra == "se3":
+        return heavy_top(np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 1.0]), sigma=0.3, s=S, theta=0.5)
+    g = {"su2": su2, "sl2r": sl2r, "user6": lambda: LieAlgebra(se3().structure_constants, name="user"),
+         "su3 matrix": lambda: su(3), "su4 basis": lambda: LieAlgebra.from_matrix_basis(su(4).basis)}[algebra]()
+    xi = 0.4 * np.random.default_rng(5).standard_normal((3, g.dim))
+    return LiePoissonSystem(g, np.diag(1.0 + np.arange(g.dim) / g.dim), xi, s=S, theta=0.0 if "su" in algebra else 0.7)
+
+
 @pytest.mark.parametrize("solver", [LieEuler(), LieHeun(), ImplicitMidpoint()], ids=repr)
-@pytest.mark.parametrize("algebra", ["so3", "se3"])
+@pytest.mark.parametrize("algebra", ["so3", "se3", "su2", "sl2r", "user6", "su3 matrix", "su4 basis"])
 def test_steps_per_member_agree_with_the_numpy_step_of_each_member(solver, algebra):
-    system = (rigid_body(np.array([1.0, 2.0, 3.0]), sigma=0.5, theta=1.0) if algebra == "so3" else
-              heavy_top(np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 1.0]), sigma=0.3, s=S, theta=0.5))
+    system = _member_case(algebra)
+    compiled = algebra != "su4 basis"
+    stepped_on = member_system(system)
+    assert isinstance(stepped_on.algebra, LieAlgebra) == compiled        # the cost model's choice (_dispatch)
     rng = np.random.default_rng(11)
     n = 6
     mu = rng.standard_normal((n, system.dim))
     dt = np.array([1e-4, 1e-3, 0.01, 0.05, 0.2, 0.4])[:, None]
-    dX = rng.standard_normal((n, 3)) * np.sqrt(dt) * np.array([1, 1, 1, 1, 8, 8])[:, None]   # past the Taylor branch
+    dX = rng.standard_normal((n, 3)) * np.sqrt(dt) * np.array([1, 1, 1, 1, 8, 16])[:, None]  # past the Taylor branch
     dXX = 0.5 * dX[:, :, None] * dX[:, None, :] + 0.3 * dt[:, :, None] * np.array([[0, 1, 0], [-1, 0, 2], [0, -2, 0]])
-    eta = solver._eta(system, dX, dXX)
-    assert np.any(np.sum(eta[-2:, :3] ** 2, -1) > 1e-2)             # the trigonometric branch is taken
-    new, ok, _ = solver._advance(system, mu, dt, eta)                # dt per member: the compiled steps
-    assert ok.all()
+    if algebra == "so3":
+        eta = solver._eta(system, dX, dXX)
+        assert np.any(np.sum(eta[-2:, :3] ** 2, -1) > 1e-2)         # the trigonometric branch is taken
+    if compiled and algebra not in ("so3", "se3"):
+        # the generic kernel's exponential: Taylor on the vector for small steps, scaling and squaring for the last
+        c = np.abs(stepped_on.algebra.structure_constants)
+        theta = np.abs(solver._eta(stepped_on, dX, dXX)) @ np.max(np.sum(c, axis=2), axis=1)
+        assert theta[0] < THETA_VECTOR < theta[-1]
+    t = np.zeros((n, 1))
+    new = solver.step(system, mu, t, dt, dX, dXX)                    # dt per member: the compiled steps
+    fin = np.all(np.isfinite(new), axis=-1)
+    # the explicit schemes take every step; the midpoint rule's chord iteration may fail on the largest two (sl(2, R),
+    # su(4)), in both paths alike
+    assert fin.all() if solver._code != 2 else fin[:4].all()
     for p in range(n):
-        ref, ref_ok, _ = solver._advance(system, mu[p], float(dt[p, 0]), eta[p])     # a float: the numpy path
-        assert ref_ok
-        np.testing.assert_allclose(new[p], ref, rtol=0, atol=1e-13 * (1 + np.abs(ref).max()))
+        ref = solver.step(system, mu[p], 0.0, float(dt[p, 0]), dX[p], dXX[p])   # a float: the numpy path
+        assert np.all(np.isfinite(ref)) == fin[p] and np.isnan(new[p]).all() != fin[p]
+        if fin[p]:
+            np.testing.assert_allclose(new[p], ref, rtol=0, atol=1e-12 * (1 + np.abs(ref).max()))
     bad = mu.copy()
     bad[2, 1] = np.nan
-    new2, ok2, _ = solver._advance(system, bad, dt, eta)
-    assert not ok2[2] and np.isnan(new2[2]).all() and ok2[[0, 1, 3, 4, 5]].all()
-    assert np.array_equal(new2[[0, 1, 3, 4, 5]], new[[0, 1, 3, 4, 5]])        # the others' bits are their own
+    new2 = solver.step(system, bad, t, dt, dX, dXX)
+    others = [0, 1, 3, 4, 5]
+    assert np.isnan(new2[2]).all() and np.array_equal(np.all(np.isfinite(new2[others]), axis=-1), fin[others])
+    if compiled:
+        np.testing.assert_array_equal(new2[others], new[others])        # the others' bits are their own
