@@ -27,12 +27,18 @@ from functools import lru_cache
 import numba
 import numpy as np
 
+from roughpaths.validation import parallel_ranges
+
 from ._generic_member import DEGREE_THETA, DIMS3, DIMS6, ad_star1, exp1, midpoint1, velocity1
 from ._soa_rows import CHORD_FAILED, NON_FINITE, algebra_tables, sparse_rows
 
 __all__ = ["generic_member_steps"]
 
 _TABLES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+#: A member-step's cost (ns): a constant and a term per non-zero structure constant (Lie–Heun, measured: su(2) 0.47 µs,
+#: su(3) 1.8 µs); the members are split between numba's threads in ranges of about RANGE_NS each.
+MEMBER_NS = (300.0, 40.0)
+RANGE_NS = 2e5
 
 
 def _tables(system):
@@ -121,7 +127,10 @@ def generic_member_steps(system, code, tol, max_iter, mu, dt, eta):
     y = np.array(mu, dtype=np.float64, order="C")
     first_bad, reason = np.full(B, -1, dtype=np.int64), np.zeros(B, dtype=np.int8)
     N = n if code == 2 and n in (3, 6) else 0
-    _member_kernel(int(code), N)(y, np.ascontiguousarray(eta, dtype=np.float64),
-                                 np.ascontiguousarray(dt, dtype=np.float64), q, qs, lin, f, mts, theta, float(tol),
-                                 int(max_iter), ti, tj, tk, tv, cnorm, DEGREE_THETA, first_bad, reason)
+    kernel = _member_kernel(int(code), N)
+    e, dt = np.ascontiguousarray(eta, dtype=np.float64), np.ascontiguousarray(dt, dtype=np.float64)
+    parallel_ranges(lambda lo, hi: kernel(y[lo:hi], e[lo:hi], dt[lo:hi], q, qs, lin, f, mts, theta, float(tol),
+                                          int(max_iter), ti, tj, tk, tv, cnorm, DEGREE_THETA, first_bad[lo:hi],
+                                          reason[lo:hi]),
+                    B, max(32, int(RANGE_NS / (MEMBER_NS[0] + MEMBER_NS[1] * tv.shape[0]))))
     return y, first_bad < 0, (reason != CHORD_FAILED) if code == 2 else None
