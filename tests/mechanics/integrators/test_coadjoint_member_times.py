@@ -18,9 +18,11 @@ Claims:
   per member equals the numpy path's step of each member alone with its ``dt`` as a float (the closed-form
   exponential, a dense ``expm`` or a conjugation of matrices: other implementations) to round-off, for small and
   large ``|sigma|`` (the Taylor and the trigonometric or scaling-and-squaring branch), and a non-finite member comes
-  back NaN, failed, alone.
+  back NaN, failed, alone; split between numba's threads, a member's bits depend neither on their number nor on
+  the members beside it.
 """
 
+import numba
 import numpy as np
 import pytest
 
@@ -169,3 +171,31 @@ def test_steps_per_member_agree_with_the_numpy_step_of_each_member(solver, algeb
     assert np.isnan(new2[2]).all() and np.array_equal(np.all(np.isfinite(new2[others]), axis=-1), fin[others])
     if compiled:
         np.testing.assert_array_equal(new2[others], new[others])        # the others' bits are their own
+
+
+def test_compiled_steps_per_member_do_not_depend_on_threads_or_neighbours():
+    # su(3) as a matrix algebra, stepped on its structure constants: 200 members are split into ranges between
+    # numba's threads (about 80 members a range); every member's bits are its own whatever the split
+    system = _member_case("su3 matrix")
+    rng = np.random.default_rng(3)
+    B = 200
+    mu = rng.standard_normal((B, system.dim))
+    dt = rng.uniform(1e-3, 5e-2, (B, 1))
+    dX = rng.standard_normal((B, 3)) * np.sqrt(dt)
+    dXX = 0.5 * dX[:, :, None] * dX[:, None, :] + 0.1 * dt[:, :, None] * np.array([[0, 1, 0], [-1, 0, 2], [0, -2, 0]])
+    solver = LieHeun()
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = solver.step(system, mu, np.zeros((B, 1)), dt, dX, dXX)
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        many = solver.step(system, mu, np.zeros((B, 1)), dt, dX, dXX)
+    finally:
+        numba.set_num_threads(before)
+    assert np.all(np.isfinite(one))
+    np.testing.assert_array_equal(one, many)
+    for lo in (0, 57, 199):                                  # a member alone, and a slice of its neighbours
+        np.testing.assert_array_equal(solver.step(system, mu[lo:lo + 1], np.zeros((1, 1)), dt[lo:lo + 1], dX[lo:lo + 1],
+                                                  dXX[lo:lo + 1]), one[lo:lo + 1])
+    np.testing.assert_array_equal(solver.step(system, mu[50:130], np.zeros((80, 1)), dt[50:130], dX[50:130],
+                                              dXX[50:130]), one[50:130])
