@@ -106,9 +106,10 @@ def member_system(system):
     Hamiltonian without forces, the representation the cost model predicts cheaper (:func:`choose`) at the reference
     step :data:`MEMBER_DT`: structure constants (compiled, :mod:`._generic_member_steps`) or the matrix twin (the
     numpy path's conjugation of ``N × N`` matrices); otherwise ``system``. Chosen once per system: it depends on the
-    system only, never on the steps or the batch. Measured per member-step (LieHeun, 1000 members, dt in
-    [0.005, 0.02], one thread; su(N) from its matrix basis, constants against matrices): su(2) 0.47 against 2.6 µs,
-    su(3) 1.8 against 5.4 µs, su(4) 15 against 8.0 µs, su(6) 412 against 28 µs; the model picks the cheaper in each."""
+    system only, never on the steps or the batch. Measured per member-step (``benchmarks/bench_member_steps.py``:
+    LieHeun, 1000 members, dt in [0.005, 0.02], one thread; su(N) from its matrix basis, constants against
+    matrices): su(2) 0.43 against 2.2 µs, su(3) 1.8 against 3.3 µs, su(4) 14 against 5.7 µs, su(6) 413 against
+    26 µs; the model picks the cheaper in each."""
     if not system.hamiltonian.is_quadratic or system.has_forces:
         return system
     twins = _TWINS.setdefault(system, {})
