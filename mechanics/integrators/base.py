@@ -61,8 +61,8 @@ per member, and ``step`` a ``dt (..., 1)``; the compiled block kernels take one 
 member takes a compiled scalar step with its own ``dt`` on a structure-constant algebra
 (:func:`._so3_kernels.so3_member_steps`, :func:`._se3_kernels.se3_member_steps`,
 :func:`._generic_member_steps.generic_member_steps`), or the numpy path's conjugation of matrices, member by member
-in one call, where the cost model predicts that cheaper (``_dispatch.member_system``: a matrix algebra or a matrix
-basis of dimension 15 and up, su(4) and larger). Adaptive solves (:func:`roughpaths.solve` with
+in one call, where the cost model predicts that cheaper (``_dispatch.member_system``; at noise 0.4 per component
+su(4) and larger, as a matrix algebra or from a matrix basis). Adaptive solves (:func:`roughpaths.solve` with
 ``step_control=PIController(...)``) use it by default, each member with steps of its own; at ``rtol = 10⁻³``, 1000
 paths, one thread, the stochastic rigid body (101 attempts a path) took 0.81-0.86 s of CPU, of which the tree's walk
 is about 0.65 s (0.94-1.12 s with the numpy steps), the heavy top 0.42-0.44 s (0.73-1.15 s).
