@@ -194,6 +194,9 @@ def warm_more_coadjoint() -> None:
     su3 = LiePoissonSystem(LieAlgebra(su(3).structure_constants, name="su3 (constants)"), np.ones(8),
                            0.3 * rng.standard_normal((3, 8)), theta=0.1)
     solve(su3, BrownianDriver(3, seed=0, dt=0.01, n_steps=2, batch_shape=(2,)), np.ones((2, 8)), ImplicitMidpoint())
+    for system in (se3c, su3):     # the midpoint rule on members with steps of their own, dimensions 6 and 8
+        ImplicitMidpoint().step(system, np.ones((2, system.dim)), np.zeros((2, 1)), np.full((2, 1), 0.01),
+                                np.zeros((2, 3)), np.zeros((2, 3, 3)))
     su2_system = LiePoissonSystem(su2(), np.eye(3), np.eye(3), theta=0.1)
     for system in (su2_system, rigid, top):    # su(2), so(3), se(3) members on steps of their own (adaptive solves)
         for method in (LieEuler(), ImplicitMidpoint()):
