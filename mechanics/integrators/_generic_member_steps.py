@@ -128,7 +128,8 @@ def generic_member_steps(system, code, tol, max_iter, mu, dt, eta):
     first_bad, reason = np.full(B, -1, dtype=np.int64), np.zeros(B, dtype=np.int8)
     N = n if code == 2 and n in (3, 6) else 0
     kernel = _member_kernel(int(code), N)
-    e, dt = np.ascontiguousarray(eta, dtype=np.float64), np.ascontiguousarray(dt, dtype=np.float64)
+    e, dt = np.array(eta, dtype=np.float64, order="C"), np.array(dt, dtype=np.float64, order="C")   # writeable:
+    # whatever views the caller passes, the kernel meets one signature (a read-only dt would compile another)
     parallel_ranges(lambda lo, hi: kernel(y[lo:hi], e[lo:hi], dt[lo:hi], q, qs, lin, f, mts, theta, float(tol),
                                           int(max_iter), ti, tj, tk, tv, cnorm, DEGREE_THETA, first_bad[lo:hi],
                                           reason[lo:hi]),

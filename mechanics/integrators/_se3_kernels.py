@@ -411,8 +411,8 @@ def se3_member_steps(system, code, tol, max_iter, mu, dt, eta):
     B = mu.shape[0]
     y = np.array(mu, dtype=np.float64, order="C")
     first_bad, reason = np.full(B, -1, dtype=np.int64), np.zeros(B, dtype=np.int8)
-    _member_kernel(int(code))(y, np.ascontiguousarray(eta, dtype=np.float64),
-                              np.ascontiguousarray(dt, dtype=np.float64), data["q"], np.ascontiguousarray(data["linear"]),
-                              np.ascontiguousarray(data["dissipation_change"]), data["metric_inv"],
-                              float(data["theta"]), float(tol), int(max_iter), first_bad, reason)
+    own = lambda a: np.array(a, dtype=np.float64, order="C")      # noqa: E731  writeable copies: one signature
+    _member_kernel(int(code))(y, own(eta), own(dt), own(data["q"]), own(data["linear"]),
+                              own(data["dissipation_change"]), own(data["metric_inv"]), float(data["theta"]),
+                              float(tol), int(max_iter), first_bad, reason)
     return y, first_bad < 0, (reason != CHORD_FAILED) if code == 2 else None

@@ -398,8 +398,9 @@ def so3_member_steps(system, code, tol, max_iter, mu, dt, eta):
     B = mu.shape[0]
     cols = [np.array(mu[:, i], dtype=np.float64) for i in range(3)]
     first_bad, reason = np.full(B, -1, dtype=np.int64), np.zeros(B, dtype=np.int8)
-    _member_kernel(int(code))(*cols, *(np.array(eta[:, i], dtype=np.float64) for i in range(3)),
-                              np.ones(B, dtype=np.bool_), np.ascontiguousarray(dt, dtype=np.float64), data["q"],
-                              np.concatenate([data["linear"], data["dissipation_change"]]), data["metric_inv"],
-                              float(data["theta"]), float(tol), int(max_iter), first_bad, reason)
+    own = lambda a: np.array(a, dtype=np.float64, order="C")      # noqa: E731  writeable copies: one signature
+    _member_kernel(int(code))(*cols, *(own(eta[:, i]) for i in range(3)), np.ones(B, dtype=np.bool_), own(dt),
+                              own(data["q"]), np.concatenate([data["linear"], data["dissipation_change"]]),
+                              own(data["metric_inv"]), float(data["theta"]), float(tol), int(max_iter), first_bad,
+                              reason)
     return np.stack(cols, axis=-1), first_bad < 0, (reason != CHORD_FAILED) if code == 2 else None
