@@ -17,7 +17,7 @@ compiles its own variant on a user's first call, a few seconds each (``benchmark
 ``--more`` adds what the test suite reaches besides (lone, wide and long chunked paths, the rough-path
 signature, the tensor algebra, p-variation, Lie–Euler and the midpoint rule, the coadjoint schemes on rough
 paths built from arrays, the midpoint rule in six dimensions, the compile-time variants the oracle and
-bit-equality tests reach, the matrix algebras of Proposition 2.1's tests, a corrected ensemble on worker
+bit-equality tests reach, the matrix algebras of Proposition 2.1's tests, the norms, a corrected ensemble on worker
 processes): ``tools/setup_env.sh`` passes it when it installs the test extra, so those compiles happen at
 set-up on both cores, not inside the tests (where both xdist workers may compile the same kernel). ``SUITE_PROFILE`` (``tests/conftest.py``) and
 ``tools/suite_profile.py`` list what the suite still compiles.
@@ -140,6 +140,21 @@ def warm_more_drivers() -> None:
             if area == "exact" and d != 2:
                 continue
             rp.BrownianDriver(d, seed=0, dt=0.01, n_steps=4, batch_shape=(2,), levy_area=area).rough_path()
+
+
+def warm_more_norms() -> None:
+    """For the test suite (``--more``): the Hölder and p-variation kernels of levels 1 and 2 (each test worker
+    compiled them again, about 6 s of CPU)."""
+    import roughpaths as rp
+
+    t = np.linspace(0.0, 1.0, 9)
+    X = rp.RoughPath.from_path(np.sin(np.outer(t, [1.0, 2.0, 3.0])), times=t)
+    for f in (rp.holder_seminorm, rp.area_holder_seminorm, rp.rough_path_holder_norm):
+        f(X, 0.4)
+    rp.holder_seminorm(X.path, 0.4, times=t)
+    for f in (rp.p_variation, rp.area_p_variation, rp.rough_path_p_variation):
+        f(X, 2.5)
+    rp.p_variation(X, 2.5, return_partition=True)
 
 
 def warm_more_gradients() -> None:
@@ -288,7 +303,7 @@ PARTS = {
 }
 #: with ``--more`` (``tools/setup_env.sh`` when it installs the test extra): what the test suite reaches besides
 MORE = {"roughpaths": (("more signatures", warm_more_signatures), ("more drivers", warm_more_drivers),
-                       ("signature variants of the tests", warm_more_variants)),
+                       ("signature variants of the tests", warm_more_variants), ("norms", warm_more_norms)),
         "mechanics": (("more coadjoint schemes", warm_more_coadjoint),
                       ("more signature gradients", warm_more_gradients),
                       ("matrix algebras of the tests", warm_more_matrix_algebras),
