@@ -119,9 +119,9 @@ def test_integrate_on_member_times_follows_each_members_grid(name):
 
 def _member_case(algebra):
     """A system for the steps-per-member checks: so(3), se(3) (hand-written kernels), su(2), sl(2, R) and se(3) given
-    by its constants alone (a user's algebra, dimension 6: the midpoint rule's compiled variant), su(3) as a matrix
-    algebra (whose members are stepped on its structure constants) and su(4) from its matrix basis (on its matrix
-    twin)."""
+    by its constants alone (a user's algebra, dimension 6: the midpoint rule's compiled variant; the Lévy torque
+    outside the double bracket), su(3) as a matrix algebra (whose members are stepped on its structure constants)
+    and su(4) from its matrix basis (on its matrix twin)."""
     if algebra == "so3":
         return rigid_body(np.array([1.0, 2.0, 3.0]), sigma=0.5, theta=1.0)
     if algebra == "se3":
@@ -129,7 +129,9 @@ def _member_case(algebra):
     g = {"su2": su2, "sl2r": sl2r, "user6": lambda: LieAlgebra(se3().structure_constants, name="user"),
          "su3 matrix": lambda: su(3), "su4 basis": lambda: LieAlgebra.from_matrix_basis(su(4).basis)}[algebra]()
     xi = 0.4 * np.random.default_rng(5).standard_normal((3, g.dim))
-    return LiePoissonSystem(g, np.diag(1.0 + np.arange(g.dim) / g.dim), xi, s=S, theta=0.0 if "su" in algebra else 0.7)
+    # the user's algebra with the Lévy torque kept out of the double bracket: the velocity's f term is not zero
+    return LiePoissonSystem(g, np.diag(1.0 + np.arange(g.dim) / g.dim), xi, s=S, theta=0.0 if "su" in algebra else 0.7,
+                            levy_in_dissipation=algebra != "user6")
 
 
 @pytest.mark.parametrize("solver", [LieEuler(), LieHeun(), ImplicitMidpoint()], ids=repr)
