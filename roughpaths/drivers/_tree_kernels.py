@@ -139,6 +139,18 @@ def refine_segments(w, G, delta, z):
     return fine, GL, GR
 
 
+@njit(cache=True, inline="always")
+def _spread_pairs(S, d, oy, iY):
+    """Rows ``iY .. iY + d - 1`` of ``S`` above the diagonal <- the pair coordinates ``S[oy, :p]`` (row-major
+    pairs ``a < b``), below it their negatives: the antisymmetric ``d × d`` matrix (its diagonal is set once)."""
+    q = 0
+    for a in range(d):
+        for b in range(a + 1, d):
+            S[iY + a, b] = S[oy, q]
+            S[iY + b, a] = -S[oy, q]
+            q += 1
+
+
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def _solve_pairs(S, d, a, oc, oy):
     """In place: ``y <- (a I + M(N))⁻¹ y`` in pair coordinates (Cholesky; the matrix is a covariance).
@@ -281,12 +293,7 @@ def _refine_segments_nb(w, G, delta, z, fine, GL, GR):
                 S[a, b] = v
                 S[b, a] = v
         _solve_pairs(S, d, n * delta * delta / 12.0, oc, oy)
-        q = 0
-        for a in range(d):
-            for b in range(a + 1, d):
-                S[iY + a, b] = S[oy, q]
-                S[iY + b, a] = -S[oy, q]
-                q += 1
+        _spread_pairs(S, d, oy, iY)
         for i in range(n):
             for a in range(d):
                 v = 0.0
@@ -331,12 +338,7 @@ def _refine_segments_nb(w, G, delta, z, fine, GL, GR):
                 S[a, b] = v
                 S[b, a] = v
         _solve_pairs(S, d, 2.0 * a_half, oc, oy)
-        q = 0
-        for a in range(d):
-            for b in range(a + 1, d):
-                S[iY + a, b] = S[oy, q]
-                S[iY + b, a] = -S[oy, q]
-                q += 1
+        _spread_pairs(S, d, oy, iY)
         # G_L = L0 + a_half Y + s (Y N_L + N_L Y), antisymmetric: for finite inputs the sum below the diagonal
         # is the negated sum (+0.0 where that is 0), the diagonal +0.0 (Y[a, e] N_L[e, a] - Y[a, e] N_L[a, e])
         q = 0
